@@ -1,0 +1,43 @@
+// The amplitude of every FAP over time at a receiver (draft section 5).
+//
+// A bookmark's FAP starts from the amplitude actually reached at its start time (0 before
+// any bookmark, the previous target once its transition is over, the value on the curve
+// while it runs), rounded to a whole FAP unit, and moves to its target over T:
+//   C=1 linear:   v(t) = s + (a - s) * u                      u = (t - start) / T in [0, 1]
+//   C=2 triangle: v(t) = s + (a - s) * (1 - |2u - 1|)          back at s when u = 1
+//   C=3 spline:   v(t) = s + (a - s) * u^2 * (3 - 2u)          cubic Hermite, zero slope at ends
+// T = 0 jumps at once (a triangle with T = 0 leaves no trace). docs/format.md has the reasons.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "pfap/model.h"
+
+namespace pfap {
+
+class FapState {
+ public:
+  // Starts the transition of `fap` at `start_ns`. Bookmarks for one FAP must come in
+  // non-decreasing start order.
+  void apply(const Fap& fap, int64_t start_ns);
+  // The amplitude of FAP `index` at `time_ns`, for times at or after the start of the last
+  // bookmark applied to it (earlier times give that bookmark's starting amplitude).
+  double amplitude(int index, int64_t time_ns) const;
+  // What FAP `index` holds once its transition is over.
+  int32_t settled(int index) const;
+  // Every FAP back to 0 with no transition running, as after construction.
+  void reset();
+
+ private:
+  struct Track {
+    int32_t from = 0;  // amplitude when the transition started
+    int32_t target = 0;
+    int64_t start_ns = 0;
+    int64_t duration_ns = 0;
+    Curve curve = Curve::kLinear;
+  };
+  std::array<Track, kFapCount> tracks_{};
+};
+
+}  // namespace pfap

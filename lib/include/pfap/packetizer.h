@@ -1,0 +1,76 @@
+// Plans PFAP packets from a stream of phonemes and the FAPs that start with them.
+//
+// Rules (draft sections 6 and 7):
+//  - a phoneme is never separated from the FAPs before it;
+//  - every packet ends with a phoneme;
+//  - a packet starts at each sentence start (so the RTP M bit can be set) and ends at end
+//    of text;
+//  - the phonemes in one packet are contiguous in time: a gap starts a new packet;
+//  - a packet's payload stays within max_payload_size, except a single phoneme whose FAPs
+//    alone do not fit, which goes alone and is flagged `oversized`;
+//  - no phoneme waits longer than max_delay_ns of stream time for its packet: a phoneme
+//    joins a packet only if it starts less than max_delay_ns after the packet's first one,
+//    and a packet whose phonemes reach max_delay_ns is complete at once. After a gap the
+//    pending packet waits for the next push or a flush(), so a live caller flushes on a
+//    timer.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "pfap/model.h"
+#include "pfap/payload.h"
+
+namespace pfap {
+
+inline constexpr uint32_t kDefaultClockRate = 44100;
+
+// A stream time in nanoseconds as an RTP timestamp on a `clock_rate` clock, rounded to the
+// nearest tick and wrapped to 32 bits; time 0 is timestamp 0.
+uint32_t rtp_ticks(int64_t time_ns, uint32_t clock_rate);
+
+struct PacketizerConfig {
+  size_t max_payload_size = 1400 - 12;  // GStreamer's default MTU less the RTP header
+  int64_t max_delay_ns = 100'000'000;
+  uint32_t clock_rate = kDefaultClockRate;
+};
+
+struct TimedPhoneme {
+  int64_t start_ns = 0;  // start in stream time
+  Phoneme phoneme;
+  bool sentence_start = false;  // first phoneme of a sentence: starts a packet, sets M
+};
+
+struct PlannedPacket {
+  int64_t start_ns = 0;        // the first phoneme's start
+  uint32_t rtp_timestamp = 0;  // start_ns on the configured clock
+  bool marker = false;         // the first phoneme starts a sentence
+  bool oversized = false;      // one phoneme with more FAPs than max_payload_size holds
+  Packet packet;
+};
+
+class Packetizer {
+ public:
+  explicit Packetizer(const PacketizerConfig& config);
+
+  // Adds a phoneme and the FAPs that start with it; appends any packets it completes.
+  void push(const TimedPhoneme& phoneme, std::span<const Fap> faps,
+            std::vector<PlannedPacket>& out);
+  // Completes the pending packet, if any (EOS, or a caller-side timeout).
+  void flush(std::vector<PlannedPacket>& out);
+  // Drops the pending packet (FLUSH).
+  void reset();
+
+  bool has_pending() const { return !pending_.packet.phonemes.empty(); }
+  const PacketizerConfig& config() const { return config_; }
+
+ private:
+  PacketizerConfig config_;
+  PlannedPacket pending_;
+  size_t pending_size_ = 0;
+  int64_t pending_end_ns_ = 0;  // where the next contiguous phoneme starts
+};
+
+}  // namespace pfap

@@ -1,0 +1,83 @@
+#include "pfap/packetizer.h"
+
+#include <cstdlib>
+#include <utility>
+
+namespace pfap {
+namespace {
+
+constexpr int64_t kNsPerSecond = 1'000'000'000;
+// Phoneme starts within this of the pending packet's end count as contiguous: the caller's
+// start times come from a clock, the durations on the wire are whole milliseconds.
+constexpr int64_t kContiguityToleranceNs = 500'000;
+
+size_t phoneme_bytes(size_t fap_count) {
+  return kPhonemeDescriptorBytes + kFapDescriptorBytes * fap_count;
+}
+
+// Moves the pending packet to `out`; `pending` is left empty, ready for the next packet.
+void complete(PlannedPacket& pending, std::vector<PlannedPacket>& out) {
+  out.push_back(std::move(pending));
+  pending = PlannedPacket{};
+}
+
+}  // namespace
+
+uint32_t rtp_ticks(int64_t time_ns, uint32_t clock_rate) {
+  // Whole seconds (floored, so the rest is never negative) and the rest, so that no product
+  // overflows: rest * rate < 1e9 * 2^32 < 2^63. Only the low 32 bits of the seconds' ticks
+  // matter, and unsigned multiplication keeps them. Halves round up, the same either side
+  // of zero.
+  int64_t seconds = time_ns / kNsPerSecond;
+  int64_t rest_ns = time_ns % kNsPerSecond;
+  if (rest_ns < 0) {
+    --seconds;
+    rest_ns += kNsPerSecond;
+  }
+  const uint64_t rest_ticks =
+      (static_cast<uint64_t>(rest_ns) * clock_rate + kNsPerSecond / 2) / kNsPerSecond;
+  return static_cast<uint32_t>(static_cast<uint64_t>(seconds) * clock_rate + rest_ticks);
+}
+
+Packetizer::Packetizer(const PacketizerConfig& config) : config_(config) {}
+
+void Packetizer::push(const TimedPhoneme& phoneme, std::span<const Fap> faps,
+                      std::vector<PlannedPacket>& out) {
+  const size_t bytes = phoneme_bytes(faps.size());
+  if (has_pending()) {
+    const bool contiguous = std::abs(phoneme.start_ns - pending_end_ns_) <= kContiguityToleranceNs;
+    if (phoneme.sentence_start || !contiguous ||
+        phoneme.start_ns - pending_.start_ns >= config_.max_delay_ns ||
+        pending_size_ + bytes > config_.max_payload_size) {
+      complete(pending_, out);
+    }
+  }
+
+  if (!has_pending()) {
+    pending_.start_ns = phoneme.start_ns;
+    pending_.rtp_timestamp = rtp_ticks(phoneme.start_ns, config_.clock_rate);
+    pending_.marker = phoneme.sentence_start;
+    pending_.oversized = kPacketDescriptorBytes + bytes > config_.max_payload_size;
+    pending_size_ = kPacketDescriptorBytes;
+    pending_end_ns_ = phoneme.start_ns;
+  }
+  pending_.packet.add_phoneme(phoneme.phoneme, faps);
+  pending_size_ += bytes;
+  // Summed from the first start in whole milliseconds, so clock jitter does not accumulate.
+  pending_end_ns_ += int64_t{phoneme.phoneme.duration_ms} * kNsPerMs;
+
+  // Complete at once when no later phoneme may join: end of text, the delay bound reached,
+  // or no room for another phoneme (which an oversized packet never has).
+  if (phoneme.phoneme.end_of_text || pending_end_ns_ - pending_.start_ns >= config_.max_delay_ns ||
+      pending_size_ + kPhonemeDescriptorBytes > config_.max_payload_size) {
+    complete(pending_, out);
+  }
+}
+
+void Packetizer::flush(std::vector<PlannedPacket>& out) {
+  if (has_pending()) complete(pending_, out);
+}
+
+void Packetizer::reset() { pending_ = PlannedPacket{}; }
+
+}  // namespace pfap

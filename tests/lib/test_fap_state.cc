@@ -1,0 +1,306 @@
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdint>
+#include <ostream>
+#include <string>
+#include <utility>
+
+#include "pfap/fap_state.h"
+
+namespace pfap {
+namespace {
+
+constexpr int64_t kMs = 1'000'000;  // ns
+constexpr int64_t kStart = 5'000 * kMs;
+
+Fap make_fap(int index, int32_t amplitude, uint16_t transition_ms, Curve curve) {
+  return Fap{.index = static_cast<uint8_t>(index),
+             .amplitude = amplitude,
+             .transition_ms = transition_ms,
+             .curve = curve};
+}
+
+// Brings FAP `index` to `amplitude` at once, so that the next bookmark starts there.
+void jump_to(FapState& state, int index, int32_t amplitude, int64_t at_ns) {
+  state.apply(make_fap(index, amplitude, 0, Curve::kLinear), at_ns);
+}
+
+// ---- Curve values ----
+
+struct CurveCase {
+  const char* name;
+  Curve curve;
+  int32_t from;
+  int32_t target;
+  uint16_t transition_ms;
+  // At start, T/4, T/2, 3T/4, T and 2T.
+  std::array<double, 6> expected;
+};
+
+void PrintTo(const CurveCase& c, std::ostream* os) { *os << c.name; }
+
+constexpr int32_t kMax = kMaxAmplitude;
+constexpr uint16_t kLongest = kMaxTransitionMs;
+
+const CurveCase kCurveCases[] = {
+    {"LinearUp", Curve::kLinear, 0, 1000, 1000, {0, 250, 500, 750, 1000, 1000}},
+    {"LinearDown", Curve::kLinear, 200, -1000, 1000, {200, -100, -400, -700, -1000, -1000}},
+    {"LinearFullRange",
+     Curve::kLinear,
+     -kMax,
+     kMax,
+     kLongest,
+     {-kMax, -1264800, 0, 1264800, kMax, kMax}},
+    {"TriangleUp", Curve::kTriangle, 0, 1000, 1000, {0, 500, 1000, 500, 0, 0}},
+    {"TriangleDown", Curve::kTriangle, 200, -1000, 1000, {200, -400, -1000, -400, 200, 200}},
+    {"TriangleFullRange", Curve::kTriangle, kMax, -kMax, kLongest, {kMax, 0, -kMax, 0, kMax, kMax}},
+    {"SplineUp", Curve::kSpline, 0, 1000, 1000, {0, 156.25, 500, 843.75, 1000, 1000}},
+    {"SplineDown", Curve::kSpline, 200, -1000, 1000, {200, 12.5, -400, -812.5, -1000, -1000}},
+    {"SplineFullRange",
+     Curve::kSpline,
+     -kMax,
+     kMax,
+     kLongest,
+     {-kMax, -1739100, 0, 1739100, kMax, kMax}},
+};
+
+class CurveValues : public ::testing::TestWithParam<CurveCase> {};
+
+TEST_P(CurveValues, MatchTheCurveAtQuarterSteps) {
+  const CurveCase& c = GetParam();
+  FapState state;
+  jump_to(state, 3, c.from, 0);
+  state.apply(make_fap(3, c.target, c.transition_ms, c.curve), kStart);
+  const int64_t duration_ns = c.transition_ms * kMs;  // divisible by 4: quarters are exact
+  const std::array<int64_t, 6> times = {kStart,
+                                        kStart + duration_ns / 4,
+                                        kStart + duration_ns / 2,
+                                        kStart + 3 * duration_ns / 4,
+                                        kStart + duration_ns,
+                                        kStart + 2 * duration_ns};
+  for (size_t i = 0; i < times.size(); ++i) {
+    EXPECT_DOUBLE_EQ(state.amplitude(3, times[i]), c.expected[i]) << "point " << i;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(FapState, CurveValues, ::testing::ValuesIn(kCurveCases),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+TEST(FapState, BeforeItsStartABookmarkGivesItsStartingAmplitude) {
+  FapState state;
+  jump_to(state, 3, 300, 0);
+  state.apply(make_fap(3, 1000, 1000, Curve::kLinear), kStart);
+  EXPECT_EQ(state.amplitude(3, kStart - 1), 300);
+}
+
+// ---- Starting amplitude ----
+
+TEST(FapState, NeverBookmarkedFapStartsFromZero) {
+  FapState state;
+  EXPECT_EQ(state.amplitude(3, kStart), 0);
+  EXPECT_EQ(state.settled(3), 0);
+  state.apply(make_fap(3, 1000, 1000, Curve::kLinear), kStart);
+  EXPECT_EQ(state.amplitude(3, kStart), 0);
+  EXPECT_EQ(state.amplitude(3, kStart + 500 * kMs), 500);
+}
+
+TEST(FapState, AfterATransitionIsOverTheNextStartsFromItsTarget) {
+  FapState state;
+  state.apply(make_fap(3, 1000, 100, Curve::kLinear), 0);
+  state.apply(make_fap(3, -500, 1000, Curve::kLinear), kStart);
+  EXPECT_EQ(state.amplitude(3, kStart), 1000);
+  EXPECT_EQ(state.amplitude(3, kStart + 500 * kMs), 250);
+  EXPECT_EQ(state.settled(3), -500);
+}
+
+TEST(FapState, AfterASplineIsOverTheNextStartsFromItsTarget) {
+  FapState state;
+  state.apply(make_fap(3, 777, 100, Curve::kSpline), 0);
+  state.apply(make_fap(3, 0, 1000, Curve::kLinear), 100 * kMs);
+  EXPECT_EQ(state.amplitude(3, 100 * kMs), 777);
+}
+
+TEST(FapState, InterruptedTransitionStartsFromTheReachedRoundedValue) {
+  FapState state;
+  state.apply(make_fap(3, 1000, 3, Curve::kLinear), 0);  // 333.33 after 1 ms
+  state.apply(make_fap(3, 0, 1000, Curve::kLinear), 1 * kMs);
+  EXPECT_EQ(state.amplitude(3, 1 * kMs), 333);
+  EXPECT_EQ(state.amplitude(3, 1 * kMs + 500 * kMs), 166.5);
+}
+
+TEST(FapState, InterruptedSplineStartsFromTheReachedValue) {
+  FapState state;
+  state.apply(make_fap(3, 1000, 1000, Curve::kSpline), 0);  // 156.25 at T/4
+  state.apply(make_fap(3, 2000, 1000, Curve::kLinear), 250 * kMs);
+  EXPECT_EQ(state.amplitude(3, 250 * kMs), 156);
+}
+
+TEST(FapState, ReachedValueRoundsHalvesAwayFromZero) {
+  FapState state;
+  state.apply(make_fap(3, 1001, 2, Curve::kLinear), 0);   // 500.5 after 1 ms
+  state.apply(make_fap(4, -1001, 2, Curve::kLinear), 0);  // -500.5 after 1 ms
+  state.apply(make_fap(3, 0, 1000, Curve::kLinear), 1 * kMs);
+  state.apply(make_fap(4, 0, 1000, Curve::kLinear), 1 * kMs);
+  EXPECT_EQ(state.amplitude(3, 1 * kMs), 501);
+  EXPECT_EQ(state.amplitude(4, 1 * kMs), -501);
+}
+
+TEST(FapState, InterruptedTriangleOnItsWayBackStartsFromTheReachedValue) {
+  FapState state;
+  state.apply(make_fap(3, 1000, 1000, Curve::kTriangle), 0);  // 500 at 3T/4, going down
+  state.apply(make_fap(3, 2000, 1000, Curve::kLinear), 750 * kMs);
+  EXPECT_EQ(state.amplitude(3, 750 * kMs), 500);
+  EXPECT_EQ(state.amplitude(3, 1250 * kMs), 1250);
+  EXPECT_EQ(state.settled(3), 2000);
+}
+
+TEST(FapState, BookmarksAtTheSameStartChainFromTheSameValue) {
+  FapState state;
+  jump_to(state, 3, 100, 0);
+  state.apply(make_fap(3, 1000, 1000, Curve::kLinear), kStart);
+  state.apply(make_fap(3, -1000, 1000, Curve::kLinear), kStart);  // replaces it, from 100
+  EXPECT_EQ(state.amplitude(3, kStart), 100);
+  EXPECT_EQ(state.amplitude(3, kStart + 500 * kMs), -450);
+}
+
+// ---- Triangle ----
+
+TEST(FapState, TriangleHoldsItsStartAmplitudeAfterwards) {
+  FapState state;
+  jump_to(state, 3, 200, 0);
+  state.apply(make_fap(3, 1000, 1000, Curve::kTriangle), kStart);
+  EXPECT_EQ(state.amplitude(3, kStart + 500 * kMs), 1000);
+  EXPECT_EQ(state.amplitude(3, kStart + 1000 * kMs), 200);
+  EXPECT_EQ(state.amplitude(3, kStart + 60'000 * kMs), 200);
+  EXPECT_EQ(state.settled(3), 200);
+}
+
+TEST(FapState, BookmarkAfterATriangleStartsFromTheTrianglesStart) {
+  FapState state;
+  jump_to(state, 3, 200, 0);
+  state.apply(make_fap(3, 1000, 1000, Curve::kTriangle), kStart);
+  state.apply(make_fap(3, 0, 1000, Curve::kLinear), kStart + 2000 * kMs);
+  EXPECT_EQ(state.amplitude(3, kStart + 2000 * kMs), 200);
+}
+
+// ---- T = 0 ----
+
+TEST(FapState, ZeroTransitionJumpsAtItsStart) {
+  for (Curve curve : {Curve::kLinear, Curve::kSpline}) {
+    FapState state;
+    jump_to(state, 3, 100, 0);
+    state.apply(make_fap(3, -700, 0, curve), kStart);
+    EXPECT_EQ(state.amplitude(3, kStart - 1), 100);
+    EXPECT_EQ(state.amplitude(3, kStart), -700);
+    EXPECT_EQ(state.amplitude(3, kStart + 1), -700);
+    EXPECT_EQ(state.settled(3), -700);
+  }
+}
+
+TEST(FapState, ZeroTransitionTriangleLeavesNoTrace) {
+  FapState state;
+  jump_to(state, 3, 100, 0);
+  state.apply(make_fap(3, 900, 0, Curve::kTriangle), kStart);
+  EXPECT_EQ(state.amplitude(3, kStart), 100);
+  EXPECT_EQ(state.amplitude(3, kStart + 1), 100);
+  EXPECT_EQ(state.settled(3), 100);
+}
+
+// ---- Reset ----
+
+TEST(FapState, ZeroAmplitudeResetsTheFapOverItsTransition) {
+  FapState state;
+  jump_to(state, 3, 1000, 0);
+  state.apply(make_fap(3, 0, 1000, Curve::kLinear), kStart);
+  EXPECT_EQ(state.amplitude(3, kStart + 500 * kMs), 500);
+  EXPECT_EQ(state.amplitude(3, kStart + 1000 * kMs), 0);
+  EXPECT_EQ(state.settled(3), 0);
+}
+
+TEST(FapState, ResetBringsEveryFapBackToZero) {
+  FapState state;
+  for (int index = kMinFapIndex; index <= kMaxFapIndex; ++index) {
+    state.apply(make_fap(index, 1000 + index, 1000, Curve::kSpline), kStart);
+  }
+  state.reset();
+  for (int index = kMinFapIndex; index <= kMaxFapIndex; ++index) {
+    EXPECT_EQ(state.amplitude(index, kStart + 500 * kMs), 0) << "FAP " << index;
+    EXPECT_EQ(state.settled(index), 0) << "FAP " << index;
+  }
+  state.apply(make_fap(3, 1000, 1000, Curve::kLinear), kStart + 500 * kMs);
+  EXPECT_EQ(state.amplitude(3, kStart + 500 * kMs), 0);
+}
+
+// ---- Indexes ----
+
+TEST(FapState, FapIndexesAreIndependent) {
+  FapState state;
+  for (int index = kMinFapIndex; index <= kMaxFapIndex; ++index) {
+    state.apply(make_fap(index, index * 100, 1000, Curve::kLinear), kStart);
+  }
+  state.apply(make_fap(10, -5, 0, Curve::kLinear), kStart + 500 * kMs);
+  for (int index = kMinFapIndex; index <= kMaxFapIndex; ++index) {
+    if (index == 10) continue;
+    EXPECT_EQ(state.amplitude(index, kStart + 500 * kMs), index * 50) << "FAP " << index;
+    EXPECT_EQ(state.settled(index), index * 100) << "FAP " << index;
+  }
+  EXPECT_EQ(state.amplitude(10, kStart + 500 * kMs), -5);
+}
+
+TEST(FapState, ExpressionFapsBehaveLikeOtherFaps) {
+  const auto run = [](int index) {
+    FapState state;
+    state.apply(make_fap(index, 40, 2000, Curve::kSpline), kStart);
+    state.apply(make_fap(index, -30, 1000, Curve::kTriangle), kStart + 700 * kMs);
+    std::array<double, 4> seen = {};
+    for (size_t i = 0; i < seen.size(); ++i) {
+      seen[i] = state.amplitude(index, kStart + 700 * kMs + static_cast<int64_t>(i) * 300 * kMs);
+    }
+    return std::pair{seen, state.settled(index)};
+  };
+  const auto reference = run(kMinFapIndex);
+  for (int index = kFirstExpressionIndex; index <= kMaxFapIndex; ++index) {
+    EXPECT_EQ(run(index), reference) << "FAP " << index;
+  }
+}
+
+// ---- Spline shape ----
+
+TEST(FapState, SplineHasZeroSlopeAtBothEnds) {
+  FapState state;
+  state.apply(make_fap(3, 1000, 1000, Curve::kSpline), kStart);
+  const double mean_slope = 1000.0 / (1000 * kMs);  // per ns
+  const int64_t step = 1000;                        // 1 us, 1e-6 of T
+  const auto slope_after = [&](int64_t t) {
+    return (state.amplitude(3, t + step) - state.amplitude(3, t)) / step;
+  };
+  const double start_slope = slope_after(kStart);
+  const double end_slope = slope_after(kStart + 1000 * kMs - step);
+  const double mid_slope = slope_after(kStart + 500 * kMs);
+  EXPECT_NEAR(start_slope, 0, 1e-4 * mean_slope);
+  EXPECT_NEAR(end_slope, 0, 1e-4 * mean_slope);
+  EXPECT_NEAR(mid_slope, 1.5 * mean_slope, 1e-3 * mean_slope);  // 6u(1-u) at u = 1/2
+}
+
+TEST(FapState, SplineIsMonotone) {
+  for (int32_t target : {kMaxAmplitude, -kMaxAmplitude}) {
+    FapState state;
+    state.apply(make_fap(3, target, kMaxTransitionMs, Curve::kSpline), kStart);
+    const int64_t duration_ns = kMaxTransitionMs * kMs;
+    double previous = state.amplitude(3, kStart);
+    for (int i = 1; i <= 1000; ++i) {
+      const double value = state.amplitude(3, kStart + duration_ns * i / 1000);
+      if (target > 0) {
+        EXPECT_GE(value, previous) << "step " << i;
+      } else {
+        EXPECT_LE(value, previous) << "step " << i;
+      }
+      previous = value;
+    }
+    EXPECT_EQ(previous, target);
+  }
+}
+
+}  // namespace
+}  // namespace pfap
