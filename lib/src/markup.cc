@@ -14,8 +14,8 @@ bool valid(const PfapEventHeader& h) {
 }
 
 bool valid(const PfapFap& f) {
-  return pfap::is_valid(pfap::Fap{f.index, f.amplitude, f.transition_ms,
-                                  static_cast<pfap::Curve>(f.curve)});
+  return pfap::is_valid(
+      pfap::Fap{f.index, f.amplitude, f.transition_ms, static_cast<pfap::Curve>(f.curve)});
 }
 
 void put16(uint8_t* p, uint16_t v) {

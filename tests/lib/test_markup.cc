@@ -1,10 +1,10 @@
 // The application/x-pfap event layout (pfap/markup.h): bytes written by hand, round trips and
 // refusal of bad events.
-#include "pfap/markup.h"
-
 #include <gtest/gtest.h>
 
 #include <vector>
+
+#include "pfap/markup.h"
 
 namespace {
 
@@ -17,7 +17,10 @@ const Bytes kPhonemeEvent = {0x01, 0x0B, 0x2A, 0x3C, 0x00, 0x64, 0x00, 0x02,
                              0x30, 0x01, 0x00, 0x00, 0xFF, 0xFF, 0xB1, 0xE0};
 const PfapEventHeader kHeader{PFAP_EVENT_PHONEME,
                               PFAP_FLAG_STRESS | PFAP_FLAG_WORD_BEGIN | PFAP_FLAG_SENTENCE_START,
-                              42, 60, 100, 2};
+                              42,
+                              60,
+                              100,
+                              2};
 const PfapFap kFaps[] = {{69, 3, 2000, 40}, {48, 1, 0, -20000}};
 
 TEST(Markup, WriteGivesTheDocumentedBytes) {
@@ -67,17 +70,33 @@ TEST(Markup, BadEventsAreRefused) {
       {"empty", {}},
       {"header_only_cut", Bytes(kPhonemeEvent.begin(), kPhonemeEvent.begin() + 7)},
       {"fap_cut", Bytes(kPhonemeEvent.begin(), kPhonemeEvent.end() - 1)},
-      {"byte_too_many", [] { Bytes b = kPhonemeEvent; b.push_back(0); return b; }()},
+      {"byte_too_many",
+       [] {
+         Bytes b = kPhonemeEvent;
+         b.push_back(0);
+         return b;
+       }()},
       {"kind_0", with(0, 0)},
       {"kind_4", with(0, 4)},
       {"unknown_flag", with(1, 0x20)},
-      {"duration_4096", [&] { Bytes b = with(4, 0x10); b[5] = 0x00; return b; }()},
+      {"duration_4096",
+       [&] {
+         Bytes b = with(4, 0x10);
+         b[5] = 0x00;
+         return b;
+       }()},
       {"fap_index_2", with(8, 2)},
       {"fap_index_75", with(8, 75)},
       {"curve_0", with(9, 0)},
       {"curve_4", with(9, 4)},
-      {"transition_16384", [&] { Bytes b = with(10, 0x40); b[11] = 0x00; return b; }()},
-      {"amplitude_2529601", [&] {  // 0x00269941
+      {"transition_16384",
+       [&] {
+         Bytes b = with(10, 0x40);
+         b[11] = 0x00;
+         return b;
+       }()},
+      {"amplitude_2529601",
+       [&] {  // 0x00269941
          Bytes b = with(12, 0x00);
          b[13] = 0x26, b[14] = 0x99, b[15] = 0x41;
          return b;

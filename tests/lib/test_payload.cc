@@ -4,8 +4,8 @@
 
 #include <cstdint>
 #include <fstream>
-#include <sstream>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 

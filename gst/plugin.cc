@@ -1,0 +1,16 @@
+// The pfap plugin: RTP payloading of PFAP streams (draft-ietf-avt-rtp-pfap-00).
+#include <gst/gst.h>
+
+#include "gstrtppfapdepay.h"
+#include "gstrtppfappay.h"
+
+static gboolean plugin_init(GstPlugin* plugin) {
+  gboolean ok = TRUE;
+  ok &= GST_ELEMENT_REGISTER(rtppfappay, plugin);
+  ok &= GST_ELEMENT_REGISTER(rtppfapdepay, plugin);
+  return ok;
+}
+
+GST_PLUGIN_DEFINE(GST_VERSION_MAJOR, GST_VERSION_MINOR, pfap,
+                  "RTP payloading of phoneme and facial animation parameter (PFAP) streams",
+                  plugin_init, VERSION, "LGPL", GST_PACKAGE_NAME, GST_PACKAGE_ORIGIN)

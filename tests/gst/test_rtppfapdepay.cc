@@ -1,0 +1,487 @@
+// rtppfapdepay: hand-built PFAP RTP packets in, x-pfap phoneme buffers out, read back with
+// pfap::testing::read_event.
+#include <gst/check/gstharness.h>
+#include <gst/rtp/gstrtpbuffer.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "pfap/packetizer.h"
+#include "pfap/payload.h"
+#include "pfap_buffers.h"
+
+namespace pfap {
+namespace {
+
+using Bytes = std::vector<uint8_t>;
+using testing::Event;
+using testing::read_event;
+
+constexpr const char* kCaps =
+    "application/x-rtp,media=application,clock-rate=44100,encoding-name=PFAP,payload=96";
+constexpr guint32 kSsrc = 0x5eed;
+
+Bytes encode(const Packet& packet) {
+  Bytes out(encoded_size(packet));
+  EXPECT_EQ(encode_payload(packet, out), EncodeStatus::kOk);
+  return out;
+}
+
+// An RTP packet whose PTS is `pts` and whose timestamp is `pts` on a `clock_rate` clock.
+GstBuffer* rtp_packet(const Bytes& payload, guint16 seqnum, GstClockTime pts, bool marker = false,
+                      uint32_t clock_rate = kDefaultClockRate) {
+  GstBuffer* buffer = gst_rtp_buffer_new_allocate(static_cast<guint>(payload.size()), 0, 0);
+  GstRTPBuffer rtp = GST_RTP_BUFFER_INIT;
+  EXPECT_TRUE(gst_rtp_buffer_map(buffer, GST_MAP_WRITE, &rtp));
+  gst_rtp_buffer_set_payload_type(&rtp, 96);
+  gst_rtp_buffer_set_ssrc(&rtp, kSsrc);
+  gst_rtp_buffer_set_seq(&rtp, seqnum);
+  gst_rtp_buffer_set_timestamp(&rtp, rtp_ticks(static_cast<int64_t>(pts), clock_rate));
+  gst_rtp_buffer_set_marker(&rtp, marker);
+  std::copy(payload.begin(), payload.end(),
+            static_cast<uint8_t*>(gst_rtp_buffer_get_payload(&rtp)));
+  gst_rtp_buffer_unmap(&rtp);
+  GST_BUFFER_PTS(buffer) = pts;
+  return buffer;
+}
+
+Event phoneme_event(const Phoneme& p, std::vector<Fap> faps, uint8_t flags, GstClockTime pts,
+                    bool discont = false) {
+  return {PFAP_EVENT_PHONEME,
+          flags,
+          p,
+          std::move(faps),
+          pts,
+          static_cast<GstClockTime>(p.duration_ms) * GST_MSECOND,
+          discont};
+}
+
+// Every buffer the element has output so far.
+std::vector<Event> pull_all(GstHarness* h) {
+  std::vector<Event> events;
+  while (GstBuffer* buffer = gst_harness_try_pull(h)) {
+    events.push_back(read_event(buffer));
+    gst_buffer_unref(buffer);
+  }
+  return events;
+}
+
+std::vector<Event> push(GstHarness* h, GstBuffer* packet) {
+  EXPECT_EQ(gst_harness_push(h, packet), GST_FLOW_OK);
+  return pull_all(h);
+}
+
+guint64 stat(GstHarness* h, const char* field) {
+  GstStructure* stats = nullptr;
+  g_object_get(h->element, "stats", &stats, nullptr);
+  guint64 value = G_MAXUINT64;
+  EXPECT_TRUE(gst_structure_get_uint64(stats, field, &value)) << "no stats field " << field;
+  gst_structure_free(stats);
+  return value;
+}
+
+// The warnings on `bus`, as "message | debug".
+std::vector<std::string> pop_warnings(GstBus* bus) {
+  std::vector<std::string> warnings;
+  while (GstMessage* message = gst_bus_pop_filtered(bus, GST_MESSAGE_WARNING)) {
+    GError* error = nullptr;
+    gchar* debug = nullptr;
+    gst_message_parse_warning(message, &error, &debug);
+    EXPECT_TRUE(g_error_matches(error, GST_STREAM_ERROR, GST_STREAM_ERROR_DECODE));
+    warnings.push_back(std::string(error->message) + " | " + (debug ? debug : ""));
+    g_error_free(error);
+    g_free(debug);
+    gst_message_unref(message);
+  }
+  return warnings;
+}
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+// A one-phoneme packet (80 ms) to follow bad ones with.
+const Phoneme kGood{.symbol = 5, .duration_ms = 80, .f0 = 50};
+Bytes good_payload() {
+  Packet p;
+  p.add_phoneme(kGood, {});
+  return encode(p);
+}
+
+class RtpPfapDepayTest : public ::testing::Test {
+ protected:
+  RtpPfapDepayTest() : h_(gst_harness_new("rtppfapdepay")) {}
+  ~RtpPfapDepayTest() override {
+    if (bus_) {
+      gst_bus_set_flushing(bus_, TRUE);  // its messages hold the element
+      gst_object_unref(bus_);
+    }
+    gst_harness_teardown(h_);
+  }
+  void SetUp() override { gst_harness_set_src_caps_str(h_, kCaps); }
+
+  // The element's messages, which the harness alone would drop.
+  GstBus* watch_bus() {
+    bus_ = gst_bus_new();
+    gst_element_set_bus(h_->element, bus_);
+    return bus_;
+  }
+
+  GstHarness* h_;
+  GstBus* bus_ = nullptr;
+};
+
+TEST_F(RtpPfapDepayTest, EachPhonemeBecomesABufferWithItsFapsAndTime) {
+  const Phoneme a{.symbol = 42, .duration_ms = 100, .f0 = 60, .stress = true, .word_begin = true};
+  const Phoneme b{.symbol = 7, .duration_ms = 80, .f0 = 255};
+  const Phoneme c{.symbol = 9, .duration_ms = 4095, .f0 = 1, .end_of_text = true};
+  const std::vector<Fap> faps_a = {{69, 40, 2000, Curve::kSpline},
+                                   {70, -kMaxAmplitude, kMaxTransitionMs, Curve::kTriangle}};
+  const std::vector<Fap> faps_c = {{19, -1, 1, Curve::kLinear}};
+  Packet packet;
+  packet.add_phoneme(a, faps_a);
+  packet.add_phoneme(b, {});
+  packet.add_phoneme(c, faps_c);
+
+  const GstClockTime t = 3 * GST_SECOND;
+  const std::vector<Event> expected = {
+      phoneme_event(a, faps_a, PFAP_FLAG_STRESS | PFAP_FLAG_WORD_BEGIN | PFAP_FLAG_SENTENCE_START,
+                    t),
+      phoneme_event(b, {}, 0, t + 100 * GST_MSECOND),
+      phoneme_event(c, faps_c, PFAP_FLAG_END_OF_TEXT, t + 180 * GST_MSECOND),
+  };
+  EXPECT_EQ(push(h_, rtp_packet(encode(packet), 1, t, /*marker=*/true)), expected);
+  EXPECT_EQ(stat(h_, "packets"), 1u);
+  EXPECT_EQ(stat(h_, "phonemes"), 3u);
+  EXPECT_EQ(stat(h_, "faps"), 3u);
+}
+
+TEST_F(RtpPfapDepayTest, SentenceStartComesOnlyFromTheMarkerBitOnTheFirstPhoneme) {
+  const Phoneme p{.symbol = 1, .duration_ms = 10};
+  Packet packet;
+  packet.add_phoneme(p, {});
+  packet.add_phoneme(p, {});
+  const std::vector<Event> without_marker = push(h_, rtp_packet(encode(packet), 1, 0));
+  ASSERT_EQ(without_marker.size(), 2u);
+  EXPECT_EQ(without_marker[0].flags, 0);
+  EXPECT_EQ(without_marker[1].flags, 0);
+
+  const std::vector<Event> with_marker =
+      push(h_, rtp_packet(encode(packet), 2, GST_SECOND, /*marker=*/true));
+  ASSERT_EQ(with_marker.size(), 2u);
+  EXPECT_EQ(with_marker[0].flags, PFAP_FLAG_SENTENCE_START);
+  EXPECT_EQ(with_marker[1].flags, 0);
+}
+
+struct BadPacket {
+  const char* name;
+  DecodeStatus status;
+  const char* field;  // its stats field, spelled out: the names are API
+  Bytes payload;
+};
+
+// Payloads from tests/lib/test_payload.cc, at least one per class of bad payload.
+std::vector<BadPacket> bad_packets() {
+  const Bytes end = {0x00, 0x00, 0x00, 0x02};  // phoneme, IB=10 (end of packet)
+  const auto cat = [](std::initializer_list<Bytes> parts) {
+    Bytes out;
+    for (const Bytes& part : parts) out.insert(out.end(), part.begin(), part.end());
+    return out;
+  };
+  // A FAP descriptor (ind 3, a=100, T=0) with `last` as its last byte (C and IB).
+  const auto fap = [](uint8_t last) { return Bytes{0x06, 0x00, 0x01, 0x90, 0x00, last}; };
+  return {
+      {"empty_payload", DecodeStatus::kTruncated, "malformed-truncated", {}},
+      {"phoneme_cut_short", DecodeStatus::kTruncated, "malformed-truncated", {0x00, 0x00, 0x00}},
+      {"reserved_type_10", DecodeStatus::kReservedRecoveryType, "malformed-reserved-recovery-type",
+       cat({{0x40}, end})},
+      {"reserved_ib_in_packet_descriptor", DecodeStatus::kReservedInfoBits,
+       "malformed-reserved-info-bits", cat({{0x03}, end})},
+      {"dynamic_recovery_with_pp_000", DecodeStatus::kMissingCoverage, "malformed-missing-coverage",
+       cat({{0x20}, fap(0x07), end})},
+      {"fap_index_2", DecodeStatus::kFapIndexOutOfRange, "malformed-fap-index-out-of-range",
+       cat({{0x01}, {0x04, 0x00, 0x01, 0x90, 0x00, 0x04}, end})},
+      {"amplitude_2529601", DecodeStatus::kAmplitudeOutOfRange, "malformed-amplitude-out-of-range",
+       cat({{0x01}, {0x06, 0x9A, 0x65, 0x04, 0x00, 0x04}, end})},
+      {"curve_0", DecodeStatus::kCurveZero, "malformed-curve-zero", cat({{0x01}, fap(0x00), end})},
+      {"ends_with_fap", DecodeStatus::kMissingFinalPhoneme, "malformed-missing-final-phoneme",
+       cat({{0x01}, fap(0x04)})},
+      {"bytes_after_end_of_packet", DecodeStatus::kTrailingBytes, "malformed-trailing-bytes",
+       cat({{0x00}, end, {0x00}})},
+      {"complete_recovery_announcing_phoneme", DecodeStatus::kDataInCompleteRecovery,
+       "malformed-data-in-complete-recovery", cat({{0x80}, end})},
+      {"recovery_list_never_ends", DecodeStatus::kUnterminatedRecovery,
+       "malformed-unterminated-recovery", cat({{0x24}, fap(0x04), fap(0x04)})},
+      {"nothing_at_all", DecodeStatus::kEmptyPacket, "malformed-empty-packet", {0x02}},
+  };
+}
+
+TEST(RtpPfapDepayBadPackets, TableCoversEveryClassWithPayloadsOfThatClass) {
+  std::set<DecodeStatus> classes;
+  std::set<std::string> fields;
+  for (const BadPacket& bad : bad_packets()) {
+    SCOPED_TRACE(bad.name);
+    Packet packet;
+    EXPECT_EQ(decode_payload(bad.payload, packet).status, bad.status);
+    classes.insert(bad.status);
+    fields.insert(bad.field);
+  }
+  EXPECT_EQ(classes.size(), static_cast<size_t>(kDecodeStatusCount - 1));
+  EXPECT_EQ(classes.count(DecodeStatus::kOk), 0u);
+  EXPECT_EQ(fields.size(), classes.size());
+}
+
+TEST_F(RtpPfapDepayTest, EachMalformedClassIsDroppedAndCountedWhileTheNextPacketDecodes) {
+  const std::vector<BadPacket> bad_list = bad_packets();
+  std::map<std::string, guint64> expected_counts;
+  for (const BadPacket& bad : bad_list) expected_counts[bad.field] = 0;
+
+  guint16 seqnum = 100;
+  GstClockTime t = GST_SECOND;
+  for (size_t i = 0; i < bad_list.size(); ++i) {
+    const BadPacket& bad = bad_list[i];
+    SCOPED_TRACE(bad.name);
+    EXPECT_TRUE(push(h_, rtp_packet(bad.payload, seqnum++, t, true)).empty());
+    t += GST_SECOND;
+    const std::vector<Event> expected = {phoneme_event(kGood, {}, 0, t)};
+    EXPECT_EQ(push(h_, rtp_packet(good_payload(), seqnum++, t)), expected);
+    t += GST_SECOND;
+
+    ++expected_counts[bad.field];
+    for (const auto& [field, count] : expected_counts)
+      EXPECT_EQ(stat(h_, field.c_str()), count) << field;
+    EXPECT_EQ(stat(h_, "malformed"), i + 1);
+    EXPECT_EQ(stat(h_, "packets"), 2 * (i + 1));
+    EXPECT_EQ(stat(h_, "phonemes"), i + 1);
+    EXPECT_EQ(stat(h_, "lost"), 0u);
+  }
+}
+
+TEST_F(RtpPfapDepayTest, MalformedPacketPostsAWarningNamingTheErrorAndItsOffset) {
+  GstBus* bus = watch_bus();
+  const Bytes trailing = {0x00, 0x00, 0x00, 0x00, 0x02, 0xFF};  // trailing bytes at byte 5
+  push(h_, rtp_packet(trailing, 1, 0));
+  const std::vector<std::string> warnings = pop_warnings(bus);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_TRUE(contains(warnings[0], to_string(DecodeStatus::kTrailingBytes))) << warnings[0];
+  EXPECT_TRUE(contains(warnings[0], "at byte 5")) << warnings[0];
+}
+
+TEST_F(RtpPfapDepayTest, WarningsAreLimitedToPowersOfTwoOfTheMalformedCount) {
+  GstBus* bus = watch_bus();
+  for (guint16 seqnum = 0; seqnum < 100; ++seqnum) push(h_, rtp_packet({0x02}, seqnum, 0));
+  const std::vector<std::string> warnings = pop_warnings(bus);
+  ASSERT_EQ(warnings.size(), 7u);  // the 1st, 2nd, 4th, ..., 64th
+  EXPECT_TRUE(contains(warnings.back(), "64 malformed packets so far")) << warnings.back();
+  EXPECT_EQ(stat(h_, "malformed"), 100u);
+  EXPECT_EQ(stat(h_, "malformed-empty-packet"), 100u);
+}
+
+// Only a payload over 393 KB can hold this many FAPs; x-pfap counts them in 16 bits.
+TEST_F(RtpPfapDepayTest, PhonemeWithMoreFapsThanXPfapHoldsDropsThePacketWithAWarning) {
+  GstBus* bus = watch_bus();
+  Packet huge;
+  huge.add_phoneme(kGood, std::vector<Fap>(G_MAXUINT16 + 1, Fap{3, 1, 0, Curve::kLinear}));
+  EXPECT_TRUE(push(h_, rtp_packet(encode(huge), 1, 0)).empty());
+  const std::vector<std::string> warnings = pop_warnings(bus);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_TRUE(contains(warnings[0], "65536 FAPs")) << warnings[0];
+
+  const std::vector<Event> expected = {phoneme_event(kGood, {}, 0, GST_SECOND)};
+  EXPECT_EQ(push(h_, rtp_packet(good_payload(), 2, GST_SECOND)), expected);
+}
+
+TEST_F(RtpPfapDepayTest, SequenceGapMarksTheNextOutputDiscontAndCountsTheLostPackets) {
+  EXPECT_FALSE(push(h_, rtp_packet(good_payload(), 100, 0)).at(0).discont);
+  EXPECT_FALSE(push(h_, rtp_packet(good_payload(), 101, GST_SECOND)).at(0).discont);
+
+  EXPECT_TRUE(push(h_, rtp_packet(good_payload(), 105, 2 * GST_SECOND)).at(0).discont);
+  EXPECT_EQ(stat(h_, "lost"), 3u);
+  EXPECT_FALSE(push(h_, rtp_packet(good_payload(), 106, 3 * GST_SECOND)).at(0).discont);
+
+  // A gap before a malformed packet: the DISCONT waits for the next buffer out.
+  EXPECT_TRUE(push(h_, rtp_packet({0x02}, 110, 4 * GST_SECOND)).empty());
+  EXPECT_TRUE(push(h_, rtp_packet(good_payload(), 111, 5 * GST_SECOND)).at(0).discont);
+  EXPECT_EQ(stat(h_, "lost"), 6u);
+}
+
+TEST_F(RtpPfapDepayTest, LostPacketsAreCountedAcrossTheSequenceNumberWrap) {
+  push(h_, rtp_packet(good_payload(), 65534, 0));
+  EXPECT_TRUE(push(h_, rtp_packet(good_payload(), 2, GST_SECOND)).at(0).discont);
+  EXPECT_EQ(stat(h_, "lost"), 3u);  // 65535, 0 and 1
+}
+
+TEST_F(RtpPfapDepayTest, OnlyForwardJumpsCountAsLoss) {
+  push(h_, rtp_packet(good_payload(), 20000, 0));
+  EXPECT_TRUE(push(h_, rtp_packet(good_payload(), 40000, GST_SECOND)).at(0).discont);
+  EXPECT_EQ(stat(h_, "lost"), 19999u);
+  // Further back than max-reorder (100): the base class takes it for a restarted sender.
+  EXPECT_TRUE(push(h_, rtp_packet(good_payload(), 30000, 2 * GST_SECOND)).at(0).discont);
+  EXPECT_EQ(stat(h_, "lost"), 19999u);
+  // Another sender's sequence numbers say nothing about this one's losses.
+  GstBuffer* other_sender = rtp_packet(good_payload(), 31000, 3 * GST_SECOND);
+  GstRTPBuffer rtp = GST_RTP_BUFFER_INIT;
+  ASSERT_TRUE(gst_rtp_buffer_map(other_sender, GST_MAP_WRITE, &rtp));
+  gst_rtp_buffer_set_ssrc(&rtp, kSsrc + 1);
+  gst_rtp_buffer_unmap(&rtp);
+  EXPECT_TRUE(push(h_, other_sender).at(0).discont);
+  EXPECT_EQ(stat(h_, "lost"), 19999u);
+}
+
+TEST_F(RtpPfapDepayTest, RecoveryIsCountedButNotOutputYet) {
+  // Complete recovery, one entry: FAP 3 = 100 (test_payload.cc "complete_recovery").
+  EXPECT_TRUE(push(h_, rtp_packet({0xA2, 0x06, 0x00, 0x01, 0x90, 0x00, 0x07}, 1, 0)).empty());
+  // Dynamic recovery over 4 packets with two entries, then a phoneme.
+  Packet dynamic;
+  dynamic.recovery_kind = RecoveryKind::kDynamic;
+  dynamic.covered_packets = 4;
+  dynamic.recovery = {{48, -20000, 0, Curve::kLinear}, {74, 5, 300, Curve::kTriangle}};
+  dynamic.add_phoneme(kGood, {});
+  const std::vector<Event> expected = {phoneme_event(kGood, {}, 0, GST_SECOND)};
+  EXPECT_EQ(push(h_, rtp_packet(encode(dynamic), 2, GST_SECOND)), expected);
+
+  EXPECT_EQ(stat(h_, "complete-recoveries"), 1u);
+  EXPECT_EQ(stat(h_, "recovery-entries"), 3u);
+  EXPECT_EQ(stat(h_, "recovered"), 0u);
+  EXPECT_EQ(stat(h_, "malformed"), 0u);
+  EXPECT_EQ(stat(h_, "packets"), 2u);
+}
+
+TEST_F(RtpPfapDepayTest, StreamStartOnTheSourceSideIsSparse) {
+  push(h_, rtp_packet(good_payload(), 1, 0));
+  GstEvent* upstream = gst_pad_get_sticky_event(h_->srcpad, GST_EVENT_STREAM_START, 0);
+  GstEvent* downstream = gst_pad_get_sticky_event(h_->sinkpad, GST_EVENT_STREAM_START, 0);
+  ASSERT_NE(downstream, nullptr);
+  GstStreamFlags flags = GST_STREAM_FLAG_NONE;
+  gst_event_parse_stream_flags(downstream, &flags);
+  EXPECT_TRUE(flags & GST_STREAM_FLAG_SPARSE);
+  const gchar* upstream_id = nullptr;
+  const gchar* downstream_id = nullptr;
+  gst_event_parse_stream_start(upstream, &upstream_id);
+  gst_event_parse_stream_start(downstream, &downstream_id);
+  EXPECT_STREQ(downstream_id, upstream_id);  // the same stream, only marked
+  gst_event_unref(upstream);
+  gst_event_unref(downstream);
+}
+
+TEST_F(RtpPfapDepayTest, AlphabetIsPassedToTheSourceCaps) {
+  gst_harness_set_src_caps_str(h_, (std::string(kCaps) + ",alphabet=(string)sampa").c_str());
+  push(h_, rtp_packet(good_payload(), 1, 0));
+  GstCaps* caps = gst_pad_get_current_caps(h_->sinkpad);
+  ASSERT_NE(caps, nullptr);
+  const GstStructure* s = gst_caps_get_structure(caps, 0);
+  EXPECT_TRUE(gst_structure_has_name(s, "application/x-pfap"));
+  EXPECT_STREQ(gst_structure_get_string(s, "alphabet"), "sampa");
+  gst_caps_unref(caps);
+}
+
+// The error a refused caps event posts: the caps are stored when pushed and refused when the
+// next buffer brings them in.
+std::string refusal_of(const std::string& caps_string) {
+  GstHarness* h = gst_harness_new("rtppfapdepay");
+  GstBus* bus = gst_bus_new();
+  gst_element_set_bus(h->element, bus);
+  GstCaps* caps = gst_caps_from_string(caps_string.c_str());
+  gst_harness_push_event(h, gst_event_new_caps(caps));
+  gst_caps_unref(caps);
+  GstSegment segment;
+  gst_segment_init(&segment, GST_FORMAT_TIME);
+  gst_harness_push_event(h, gst_event_new_segment(&segment));
+  EXPECT_EQ(gst_harness_push(h, rtp_packet(good_payload(), 1, 0)), GST_FLOW_NOT_NEGOTIATED);
+  EXPECT_EQ(gst_harness_try_pull(h), nullptr);
+  std::string text = "(no error posted)";
+  if (GstMessage* message = gst_bus_pop_filtered(bus, GST_MESSAGE_ERROR)) {
+    GError* error = nullptr;
+    gst_message_parse_error(message, &error, nullptr);
+    text = error->message;
+    g_error_free(error);
+    gst_message_unref(message);
+  }
+  gst_bus_set_flushing(bus, TRUE);  // its messages hold the element
+  gst_object_unref(bus);
+  gst_harness_teardown(h);
+  return text;
+}
+
+TEST(RtpPfapDepayCaps, AlphabetThatIsNotAStringIsRefusedSayingSo) {
+  const std::string error = refusal_of(std::string(kCaps) + ",alphabet=(int)5");
+  EXPECT_TRUE(contains(error, "alphabet")) << error;
+}
+
+TEST(RtpPfapDepayCaps, CapsWithoutClockRateAreRefused) {
+  const std::string error =
+      refusal_of("application/x-rtp,media=application,encoding-name=PFAP,payload=96");
+  EXPECT_TRUE(contains(error, "clock-rate")) << error;
+}
+
+// The PTS comes from upstream, where rtpjitterbuffer makes it from the RTP timestamp at the
+// caps' clock rate; phoneme offsets within a packet are milliseconds whatever the rate.
+TEST(RtpPfapDepayClockRate, PtsAt90kHzFollowTheRtpTimestamps) {
+  GstHarness* h = gst_harness_new_parse("rtpjitterbuffer mode=none latency=0 ! rtppfapdepay");
+  gst_harness_set_src_caps_str(
+      h, "application/x-rtp,media=application,clock-rate=90000,encoding-name=PFAP,payload=96");
+  const Phoneme p{.symbol = 3, .duration_ms = 40};
+  Packet packet;
+  packet.add_phoneme(p, {});
+  packet.add_phoneme(p, {});
+  std::vector<Event> events;
+  for (guint16 i = 0; i < 3; ++i) {
+    const GstClockTime t = i * 500 * GST_MSECOND;
+    GstBuffer* buffer = rtp_packet(encode(packet), i, t, false, 90000);
+    GST_BUFFER_DTS(buffer) = t;  // arrival time, which the jitterbuffer reads
+    GST_BUFFER_PTS(buffer) = GST_CLOCK_TIME_NONE;
+    ASSERT_EQ(gst_harness_push(h, buffer), GST_FLOW_OK);
+  }
+  for (int i = 0; i < 6; ++i) {
+    GstBuffer* buffer = gst_harness_pull(h);
+    ASSERT_NE(buffer, nullptr);
+    events.push_back(read_event(buffer));
+    gst_buffer_unref(buffer);
+  }
+  for (size_t i = 0; i < events.size(); ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_EQ(events[i].pts, (i / 2) * 500 * GST_MSECOND + (i % 2) * 40 * GST_MSECOND);
+    EXPECT_EQ(events[i].duration, 40 * GST_MSECOND);
+  }
+  gst_harness_teardown(h);
+}
+
+TEST_F(RtpPfapDepayTest, EosPassesThrough) {
+  push(h_, rtp_packet(good_payload(), 1, 0));
+  EXPECT_TRUE(gst_harness_push_event(h_, gst_event_new_eos()));
+  bool saw_eos = false;
+  while (GstEvent* event = gst_harness_try_pull_event(h_)) {
+    saw_eos |= GST_EVENT_TYPE(event) == GST_EVENT_EOS;
+    gst_event_unref(event);
+  }
+  EXPECT_TRUE(saw_eos);
+}
+
+TEST_F(RtpPfapDepayTest, FlushForgetsTheSequenceNumberButKeepsTheCounters) {
+  push(h_, rtp_packet(good_payload(), 10, 0));
+  EXPECT_TRUE(gst_harness_push_event(h_, gst_event_new_flush_start()));
+  EXPECT_TRUE(gst_harness_push_event(h_, gst_event_new_flush_stop(TRUE)));
+  GstSegment segment;
+  gst_segment_init(&segment, GST_FORMAT_TIME);
+  EXPECT_TRUE(gst_harness_push_event(h_, gst_event_new_segment(&segment)));
+
+  const std::vector<Event> expected = {phoneme_event(kGood, {}, 0, GST_SECOND)};
+  EXPECT_EQ(push(h_, rtp_packet(good_payload(), 5000, GST_SECOND)), expected);
+  EXPECT_EQ(stat(h_, "lost"), 0u);
+  EXPECT_EQ(stat(h_, "packets"), 2u);
+}
+
+TEST_F(RtpPfapDepayTest, GoingFromReadyToPausedClearsTheCounters) {
+  push(h_, rtp_packet(good_payload(), 10, 0));
+  ASSERT_EQ(gst_element_set_state(h_->element, GST_STATE_READY), GST_STATE_CHANGE_SUCCESS);
+  EXPECT_EQ(stat(h_, "packets"), 1u);  // still readable once stopped
+  gst_harness_play(h_);
+  EXPECT_EQ(stat(h_, "packets"), 0u);
+}
+
+}  // namespace
+}  // namespace pfap
