@@ -1,0 +1,1067 @@
+// Integration tests: rtppfappay and rtppfapdepay in real pipelines.
+//
+//  - LoopbackUdp.PhonemesKeepLipSyncWithAudio: audio (L16) and PFAP sent through one rtpbin
+//    over UDP on 127.0.0.1 and received by another rtpbin; with rtpbin's RTCP sync each
+//    phoneme comes out within 1 ms of the audio that was sent with it.
+//  - RoundTrip.KeepsEveryField: seeded random sessions through pay ! depay, several MTUs.
+//  - Sdp.*: the payloader's caps as SDP (a=rtpmap, a=fmtp) and back into the depayloader.
+//  - GstInspect.*: what gst-inspect-1.0 shows of the elements and the plugin.
+//
+// The plugin comes from GST_PLUGIN_PATH, which meson sets to the build's gst/ directory.
+#include <gst/gst.h>
+#include <gst/rtp/gstrtpbuffer.h>
+#include <gst/sdp/gstsdpmessage.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+#include <memory>
+#include <mutex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <unordered_map>
+#include <vector>
+
+#include "pfap/markup.h"
+#include "pfap/model.h"
+#include "pfap_buffers.h"
+#include "random_markup.h"
+
+namespace {
+
+using pfap::testing::Event;
+using pfap::testing::RandomMarkup;
+using Clock = std::chrono::steady_clock;
+
+constexpr const char* kPay = "rtppfappay";
+constexpr const char* kDepay = "rtppfapdepay";
+
+// ---------------------------------------------------------------------------------------------
+// Small helpers
+
+std::string describe(const Event& e) {
+  std::ostringstream s;
+  s << "kind " << e.kind << " flags 0x" << std::hex << unsigned{e.flags} << std::dec << " symbol "
+    << unsigned{e.phoneme.symbol} << " " << e.phoneme.duration_ms << " ms f0 "
+    << unsigned{e.phoneme.f0} << " S" << e.phoneme.stress << " W" << e.phoneme.word_begin << " EOT"
+    << e.phoneme.end_of_text << " pts ";
+  if (GST_CLOCK_TIME_IS_VALID(e.pts)) {
+    s << e.pts;
+  } else {
+    s << "none";
+  }
+  s << " duration ";
+  if (GST_CLOCK_TIME_IS_VALID(e.duration)) {
+    s << e.duration;
+  } else {
+    s << "none";
+  }
+  s << " faps [";
+  for (const pfap::Fap& f : e.faps) {
+    s << " (" << unsigned{f.index} << " " << f.amplitude << " " << f.transition_ms << " "
+      << static_cast<unsigned>(f.curve) << ")";
+  }
+  s << " ]";
+  return s.str();
+}
+
+GstBuffer* make_buffer(const Event& e) {
+  return pfap::testing::phoneme_buffer(e.phoneme, e.faps, e.pts,
+                                       (e.flags & PFAP_FLAG_SENTENCE_START) != 0);
+}
+
+// A pipeline from a gst-launch description, set to NULL and released on destruction.
+class Pipeline {
+ public:
+  explicit Pipeline(const std::string& description) {
+    GError* error = nullptr;
+    GstElement* element = gst_parse_launch(description.c_str(), &error);
+    if (error != nullptr) {
+      error_ = std::string(error->message) + " in: " + description;
+      g_error_free(error);
+      if (element != nullptr) gst_object_unref(element);
+      return;
+    }
+    pipeline_ = element;
+    bus_ = gst_element_get_bus(pipeline_);
+  }
+  ~Pipeline() {
+    if (pipeline_ != nullptr) {
+      gst_element_set_state(pipeline_, GST_STATE_NULL);
+      gst_object_unref(bus_);
+      gst_object_unref(pipeline_);
+    }
+  }
+  Pipeline(const Pipeline&) = delete;
+  Pipeline& operator=(const Pipeline&) = delete;
+
+  bool ok() const { return pipeline_ != nullptr; }
+  const std::string& error() const { return error_; }
+  GstElement* get() const { return pipeline_; }
+
+  // The named element (the pipeline keeps it alive), or nullptr.
+  GstElement* by_name(const char* name) const {
+    GstElement* e = gst_bin_get_by_name(GST_BIN(pipeline_), name);
+    if (e != nullptr) gst_object_unref(e);
+    return e;
+  }
+
+  // Sets a state; a failure is returned as text ("" when fine).
+  std::string set_state(GstState state) {
+    if (gst_element_set_state(pipeline_, state) == GST_STATE_CHANGE_FAILURE) {
+      std::string text = std::string("cannot set state ") + gst_element_state_get_name(state);
+      const std::string bus_error = poll_error();
+      if (!bus_error.empty()) text += ": " + bus_error;
+      return text;
+    }
+    return "";
+  }
+
+  // The first error on the bus so far, without waiting ("" when none).
+  std::string poll_error() {
+    while (GstMessage* m = gst_bus_pop_filtered(bus_, GST_MESSAGE_ERROR)) {
+      std::string text = error_text(m);
+      gst_message_unref(m);
+      return text;
+    }
+    return "";
+  }
+
+  // Waits for EOS; returns "" or why it did not come (an error, or the timeout).
+  std::string wait_eos(std::chrono::milliseconds timeout) {
+    GstMessage* m = gst_bus_timed_pop_filtered(
+        bus_, static_cast<GstClockTime>(timeout.count()) * GST_MSECOND,
+        static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR));
+    if (m == nullptr) {
+      return "no EOS within " + std::to_string(timeout.count()) + " ms";
+    }
+    std::string text;
+    if (GST_MESSAGE_TYPE(m) == GST_MESSAGE_ERROR) text = error_text(m);
+    gst_message_unref(m);
+    return text;
+  }
+
+  // Warnings posted so far (counted, then dropped).
+  int count_warnings() {
+    int n = 0;
+    while (GstMessage* m = gst_bus_pop_filtered(bus_, GST_MESSAGE_WARNING)) {
+      ++n;
+      gst_message_unref(m);
+    }
+    return n;
+  }
+
+ private:
+  static std::string error_text(GstMessage* m) {
+    GError* error = nullptr;
+    gchar* debug = nullptr;
+    gst_message_parse_error(m, &error, &debug);
+    std::string text = std::string("error from ") + GST_OBJECT_NAME(GST_MESSAGE_SRC(m)) + ": " +
+                       (error != nullptr ? error->message : "?") + " (" +
+                       (debug != nullptr ? debug : "") + ")";
+    if (error != nullptr) g_error_free(error);
+    g_free(debug);
+    return text;
+  }
+
+  GstElement* pipeline_ = nullptr;
+  GstBus* bus_ = nullptr;
+  std::string error_;
+};
+
+GstFlowReturn push(GstElement* appsrc, GstBuffer* buffer) {
+  GstFlowReturn ret = GST_FLOW_ERROR;
+  g_signal_emit_by_name(appsrc, "push-buffer", buffer, &ret);
+  gst_buffer_unref(buffer);
+  return ret;
+}
+
+void end_of_stream(GstElement* appsrc) {
+  GstFlowReturn ret = GST_FLOW_ERROR;
+  g_signal_emit_by_name(appsrc, "end-of-stream", &ret);
+}
+
+// Every sample an appsink (emit-signals=false) holds now; the caller unrefs them.
+std::vector<GstSample*> pull_all(GstElement* appsink) {
+  std::vector<GstSample*> samples;
+  for (;;) {
+    GstSample* sample = nullptr;
+    g_signal_emit_by_name(appsink, "try-pull-sample", GstClockTime{0}, &sample);
+    if (sample == nullptr) break;
+    samples.push_back(sample);
+  }
+  return samples;
+}
+
+GstClockTime running_time(GstSample* sample) {
+  const GstSegment* segment = gst_sample_get_segment(sample);
+  GstBuffer* buffer = gst_sample_get_buffer(sample);
+  return gst_segment_to_running_time(segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
+}
+
+// Fails the test unless the plugin's elements can be made.
+::testing::AssertionResult plugin_available() {
+  for (const char* name : {kPay, kDepay}) {
+    GstElementFactory* factory = gst_element_factory_find(name);
+    if (factory == nullptr) {
+      const char* path = g_getenv("GST_PLUGIN_PATH");
+      return ::testing::AssertionFailure()
+             << "no element " << name
+             << "; GST_PLUGIN_PATH=" << (path != nullptr ? path : "(unset)")
+             << " should be the build's gst/ directory";
+    }
+    gst_object_unref(factory);
+  }
+  return ::testing::AssertionSuccess();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Round trip: appsrc ! rtppfappay ! rtppfapdepay ! appsink keeps every field.
+
+// A seeded session as a TTS engine gives it: contiguous phonemes, 0..5 FAPs each, sentences
+// that end with end of text and are followed by a pause and a sentence start, and a few gaps
+// inside sentences. Starts are at arbitrary nanoseconds after a pause or gap, so the PTS must
+// come back from the buffers' times, not from the 44.1 kHz RTP clock.
+std::vector<Event> random_session(uint32_t seed, int n_phonemes) {
+  RandomMarkup random(seed);
+  std::vector<Event> events;
+  GstClockTime t = GST_SECOND + static_cast<GstClockTime>(random.uniform(0, 999'999'999));
+  bool sentence_start = true;
+  for (int i = 0; i < n_phonemes; ++i) {
+    Event e;
+    e.phoneme = random.phoneme();
+    e.phoneme.end_of_text = i + 1 == n_phonemes || random.chance(0.06);
+    const int n_faps = random.uniform(0, 5);
+    for (int k = 0; k < n_faps; ++k) e.faps.push_back(random.fap());
+    e.flags = pfap::testing::phoneme_flags(e.phoneme, sentence_start);
+    e.pts = t;
+    e.duration = e.phoneme.duration_ms * GST_MSECOND;
+    events.push_back(e);
+    t += e.duration;
+    sentence_start = e.phoneme.end_of_text;
+    if (sentence_start) {
+      // The pause after a sentence.
+      t += static_cast<GstClockTime>(random.uniform(1, 1500)) * GST_MSECOND +
+           static_cast<GstClockTime>(random.uniform(0, 999'999));
+    } else if (random.chance(0.03)) {
+      // A gap inside a sentence: at least 1 ms, so it is never taken for contiguous.
+      t += static_cast<GstClockTime>(random.uniform(1, 300)) * GST_MSECOND +
+           static_cast<GstClockTime>(random.uniform(0, 999'999));
+    }
+  }
+  return events;
+}
+
+TEST(RoundTrip, KeepsEveryField) {
+  ASSERT_TRUE(plugin_available());
+  struct Config {
+    unsigned mtu;
+    unsigned max_delay_ms;
+    unsigned clock_rate;  // fixed by a capsfilter between the elements; 0: none
+  };
+  // mtu 48 leaves a 36-byte payload: a phoneme with 5 FAPs (35 bytes) only just fits, so
+  // some packets are oversized (and warned about). 1400 is the default; max-delay 0 sends a
+  // packet per phoneme, 5000 lets packets fill up to the MTU; a 90 kHz RTP clock.
+  for (const Config c :
+       {Config{48, 100, 0}, Config{100, 100, 0}, Config{576, 100, 0}, Config{1400, 100, 0},
+        Config{1400, 0, 0}, Config{1400, 5000, 0}, Config{576, 100, 90000}}) {
+    for (const uint32_t seed : {1u, 2u, 3u, 4u, 5u}) {
+      SCOPED_TRACE("mtu " + std::to_string(c.mtu) + ", max-delay " +
+                   std::to_string(c.max_delay_ms) + ", clock-rate " + std::to_string(c.clock_rate) +
+                   ", seed " + std::to_string(seed));
+      const std::vector<Event> sent = random_session(seed, 300);
+
+      const std::string rate =
+          c.clock_rate == 0 ? ""
+                            : " ! application/x-rtp,clock-rate=" + std::to_string(c.clock_rate);
+      Pipeline p("appsrc name=src format=time caps=application/x-pfap ! rtppfappay mtu=" +
+                 std::to_string(c.mtu) + " max-delay=" + std::to_string(c.max_delay_ms) + rate +
+                 " ! rtppfapdepay ! appsink name=sink sync=false emit-signals=false "
+                 "wait-on-eos=false");
+      ASSERT_TRUE(p.ok()) << p.error();
+      ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+      GstElement* src = p.by_name("src");
+      for (const Event& e : sent) ASSERT_EQ(push(src, make_buffer(e)), GST_FLOW_OK);
+      end_of_stream(src);
+      ASSERT_EQ(p.wait_eos(std::chrono::seconds(20)), "");
+
+      std::vector<Event> got;
+      for (GstSample* sample : pull_all(p.by_name("sink"))) {
+        Event e = pfap::testing::read_event(gst_sample_get_buffer(sample));
+        e.discont = false;
+        got.push_back(e);
+        gst_sample_unref(sample);
+      }
+      const size_t n = std::min(got.size(), sent.size());
+      for (size_t i = 0; i < n; ++i) {
+        if (!(got[i] == sent[i])) {
+          ADD_FAILURE() << "event " << i << " of " << sent.size() << " differs\n  sent "
+                        << describe(sent[i]) << "\n  got  " << describe(got[i]);
+          break;
+        }
+      }
+      EXPECT_EQ(got.size(), sent.size()) << "events out, after " << n << " compared";
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// SDP: the payloader's caps as an SDP media, and back.
+
+TEST(Sdp, PayloaderCapsGiveFmtpAndBackIntoDepayloader) {
+  ASSERT_TRUE(plugin_available());
+  Event e;
+  e.phoneme = {42, 80, 60, true, true, true};
+  e.faps = {{69, 40, 2000, pfap::Curve::kSpline}};
+  e.flags = pfap::testing::phoneme_flags(e.phoneme, true);
+  e.pts = 0;
+  e.duration = 80 * GST_MSECOND;
+
+  // 1. The payloader's output caps and one packet.
+  Pipeline pay(
+      "appsrc name=src format=time caps=\"application/x-pfap,alphabet=(string)x-sampa\" "
+      "! rtppfappay pt=96 ! appsink name=sink sync=false emit-signals=false wait-on-eos=false");
+  ASSERT_TRUE(pay.ok()) << pay.error();
+  ASSERT_EQ(pay.set_state(GST_STATE_PLAYING), "");
+  ASSERT_EQ(push(pay.by_name("src"), make_buffer(e)), GST_FLOW_OK);
+  end_of_stream(pay.by_name("src"));
+  ASSERT_EQ(pay.wait_eos(std::chrono::seconds(10)), "");
+  std::vector<GstSample*> packets = pull_all(pay.by_name("sink"));
+  ASSERT_EQ(packets.size(), 1u);
+  GstCaps* rtp_caps = gst_caps_ref(gst_sample_get_caps(packets[0]));
+  GstBuffer* packet = gst_buffer_ref(gst_sample_get_buffer(packets[0]));
+  gst_sample_unref(packets[0]);
+  gchar* caps_text = gst_caps_to_string(rtp_caps);
+  SCOPED_TRACE(std::string("payloader caps: ") + caps_text);
+  g_free(caps_text);
+
+  // 2. Caps to SDP.
+  GstSDPMedia* media = nullptr;
+  ASSERT_EQ(gst_sdp_media_new(&media), GST_SDP_OK);
+  ASSERT_EQ(gst_sdp_media_set_media_from_caps(rtp_caps, media), GST_SDP_OK);
+  gst_sdp_media_set_port_info(media, 5004, 1);
+  gst_sdp_media_set_proto(media, "RTP/AVP");
+  gchar* text = gst_sdp_media_as_text(media);
+  const std::string sdp = text;
+  g_free(text);
+  SCOPED_TRACE("SDP media:\n" + sdp);
+  EXPECT_STREQ(gst_sdp_media_get_media(media), "application");
+  ASSERT_EQ(gst_sdp_media_formats_len(media), 1u);
+  EXPECT_STREQ(gst_sdp_media_get_format(media, 0), "96");
+  EXPECT_STREQ(gst_sdp_media_get_attribute_val(media, "rtpmap"), "96 PFAP/44100");
+  EXPECT_STREQ(gst_sdp_media_get_attribute_val(media, "fmtp"), "96 alphabet=x-sampa");
+  EXPECT_NE(sdp.find("a=rtpmap:96 PFAP/44100\r\n"), std::string::npos);
+  EXPECT_NE(sdp.find("a=fmtp:96 alphabet=x-sampa\r\n"), std::string::npos);
+
+  // 3. SDP back to caps, as a receiver (rtspsrc, webrtcbin) makes them: the SDP library
+  // names the structure application/x-unknown and the receiver renames it.
+  GstCaps* caps = gst_sdp_media_get_caps_from_media(media, 96);
+  ASSERT_NE(caps, nullptr);
+  ASSERT_EQ(gst_sdp_media_attributes_to_caps(media, caps), GST_SDP_OK);
+  gst_structure_set_name(gst_caps_get_structure(caps, 0), "application/x-rtp");
+  gchar* back_text = gst_caps_to_string(caps);
+  const std::string back = back_text;
+  g_free(back_text);
+  SCOPED_TRACE("caps from SDP: " + back);
+  const GstStructure* s = gst_caps_get_structure(caps, 0);
+  EXPECT_STREQ(gst_structure_get_string(s, "encoding-name"), "PFAP");
+  EXPECT_STREQ(gst_structure_get_string(s, "alphabet"), "x-sampa");
+  gint rate = 0;
+  EXPECT_TRUE(gst_structure_get_int(s, "clock-rate", &rate));
+  EXPECT_EQ(rate, 44100);
+
+  // 4. Those caps into the depayloader, with the packet from step 1.
+  gchar* depay_caps = gst_caps_to_string(caps);
+  Pipeline depay(
+      std::string("appsrc name=src format=time caps=\"") + depay_caps +
+      "\" ! rtppfapdepay ! appsink name=sink sync=false emit-signals=false wait-on-eos=false");
+  g_free(depay_caps);
+  ASSERT_TRUE(depay.ok()) << depay.error();
+  ASSERT_EQ(depay.set_state(GST_STATE_PLAYING), "");
+  EXPECT_EQ(push(depay.by_name("src"), packet), GST_FLOW_OK);
+  end_of_stream(depay.by_name("src"));
+  ASSERT_EQ(depay.wait_eos(std::chrono::seconds(10)), "");
+  std::vector<GstSample*> out = pull_all(depay.by_name("sink"));
+  ASSERT_EQ(out.size(), 1u);
+  Event got = pfap::testing::read_event(gst_sample_get_buffer(out[0]));
+  got.discont = false;
+  EXPECT_EQ(got, e) << "sent " << describe(e) << "\ngot  " << describe(got);
+  // The alphabet reaches the depayloader's output caps too.
+  EXPECT_STREQ(
+      gst_structure_get_string(gst_caps_get_structure(gst_sample_get_caps(out[0]), 0), "alphabet"),
+      "x-sampa");
+  for (GstSample* sample : out) gst_sample_unref(sample);
+
+  gst_caps_unref(caps);
+  gst_sdp_media_free(media);
+  gst_caps_unref(rtp_caps);
+}
+
+// ---------------------------------------------------------------------------------------------
+// gst-inspect-1.0
+
+struct Inspect {
+  int exit_status = -1;
+  std::string out;
+  std::string err;
+};
+
+// Runs gst-inspect-1.0 with the test's environment (GST_PLUGIN_PATH, GST_REGISTRY_1_0).
+Inspect gst_inspect(const char* what) {
+  Inspect result;
+  gchar* argv[] = {const_cast<gchar*>("gst-inspect-1.0"), const_cast<gchar*>(what), nullptr};
+  gchar* out = nullptr;
+  gchar* err = nullptr;
+  gint status = 0;
+  GError* error = nullptr;
+  if (!g_spawn_sync(nullptr, argv, nullptr, G_SPAWN_SEARCH_PATH, nullptr, nullptr, &out, &err,
+                    &status, &error)) {
+    result.err = std::string("cannot run gst-inspect-1.0: ") + error->message;
+    g_error_free(error);
+    return result;
+  }
+  result.out = out != nullptr ? out : "";
+  result.err = err != nullptr ? err : "";
+  g_free(out);
+  g_free(err);
+  result.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+std::string trim(const std::string& s) {
+  const size_t b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return "";
+  const size_t e = s.find_last_not_of(" \t");
+  return s.substr(b, e - b + 1);
+}
+
+// The value of a "  Key   value" line in the factory details, or "" when there is none.
+std::string detail(const std::vector<std::string>& lines, const std::string& key) {
+  for (const std::string& line : lines) {
+    if (line.rfind("  " + key + " ", 0) == 0) return trim(line.substr(key.size() + 2));
+  }
+  return "";
+}
+
+// The lines of a pad template block ("  SINK template: 'sink'" up to the next blank line).
+std::string template_block(const std::vector<std::string>& lines, const std::string& header) {
+  std::string block;
+  bool in = false;
+  for (const std::string& line : lines) {
+    if (line == header) {
+      in = true;
+      continue;
+    }
+    if (in && trim(line).empty()) break;
+    if (in) block += line + "\n";
+  }
+  return block;
+}
+
+// The blurb gst-inspect gives for a property ("  name   : blurb"), or "" when it has none.
+std::string property_blurb(const std::vector<std::string>& lines, const std::string& name) {
+  for (const std::string& line : lines) {
+    if (line.rfind("  " + name, 0) != 0) continue;
+    const std::string rest = line.substr(2 + name.size());
+    const size_t colon = rest.find(':');
+    if (colon == std::string::npos || !trim(rest.substr(0, colon)).empty()) continue;
+    return trim(rest.substr(colon + 1));
+  }
+  return "";
+}
+
+void check_element_inspect(const char* name, const char* own_property) {
+  SCOPED_TRACE(name);
+  GstElementFactory* factory = gst_element_factory_find(name);
+  ASSERT_NE(factory, nullptr);
+  const std::string long_name =
+      gst_element_factory_get_metadata(factory, GST_ELEMENT_METADATA_LONGNAME);
+  const std::string klass = gst_element_factory_get_metadata(factory, GST_ELEMENT_METADATA_KLASS);
+
+  const Inspect r = gst_inspect(name);
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const std::vector<std::string> lines = lines_of(r.out);
+  SCOPED_TRACE("gst-inspect-1.0 " + std::string(name) + ":\n" + r.out);
+
+  EXPECT_FALSE(long_name.empty());
+  EXPECT_EQ(detail(lines, "Long-name"), long_name);
+  EXPECT_FALSE(klass.empty());
+  EXPECT_EQ(detail(lines, "Klass"), klass);
+  EXPECT_NE(klass.find(std::string_view(name).ends_with("depay") ? "Depayloader" : "Payloader"),
+            std::string::npos);
+  EXPECT_EQ(detail(lines, "Name"), "pfap") << "plugin name";
+
+  // Both pad templates, each with the structures and fields of its caps.
+  const GList* templates = gst_element_factory_get_static_pad_templates(factory);
+  int sinks = 0, srcs = 0;
+  for (const GList* l = templates; l != nullptr; l = l->next) {
+    auto* t = static_cast<GstStaticPadTemplate*>(l->data);
+    const bool sink = t->direction == GST_PAD_SINK;
+    (sink ? sinks : srcs)++;
+    const std::string header =
+        std::string("  ") + (sink ? "SINK" : "SRC") + " template: '" + t->name_template + "'";
+    const std::string block = template_block(lines, header);
+    ASSERT_FALSE(block.empty()) << "no block " << header;
+    EXPECT_NE(block.find("Capabilities:"), std::string::npos) << header;
+    GstCaps* caps = gst_static_caps_get(&t->static_caps);
+    for (guint i = 0; i < gst_caps_get_size(caps); ++i) {
+      const GstStructure* s = gst_caps_get_structure(caps, i);
+      EXPECT_NE(block.find(std::string("      ") + gst_structure_get_name(s) + "\n"),
+                std::string::npos)
+          << header << " lacks " << gst_structure_get_name(s);
+      for (int f = 0; f < gst_structure_n_fields(s); ++f) {
+        const std::string field = gst_structure_nth_field_name(s, f);
+        const gchar* value = gst_structure_get_string(s, field.c_str());
+        const std::string shown = value != nullptr ? field + ": " + value : field + ": ";
+        EXPECT_NE(block.find(shown), std::string::npos) << header << " lacks " << shown;
+      }
+    }
+    gst_caps_unref(caps);
+  }
+  EXPECT_EQ(sinks, 1);
+  EXPECT_EQ(srcs, 1);
+  if (std::string_view(name) == kPay) {
+    EXPECT_NE(template_block(lines, "  SINK template: 'sink'").find("application/x-pfap"),
+              std::string::npos);
+    EXPECT_NE(template_block(lines, "  SRC template: 'src'").find("encoding-name: PFAP"),
+              std::string::npos);
+  } else {
+    EXPECT_NE(template_block(lines, "  SINK template: 'sink'").find("encoding-name: PFAP"),
+              std::string::npos);
+    EXPECT_NE(template_block(lines, "  SRC template: 'src'").find("application/x-pfap"),
+              std::string::npos);
+  }
+
+  // Every property the element adds to its base class, with its blurb.
+  GstElement* element = gst_element_factory_create(factory, nullptr);
+  ASSERT_NE(element, nullptr);
+  const GType type = G_OBJECT_TYPE(element);
+  guint n_specs = 0;
+  GParamSpec** specs = g_object_class_list_properties(G_OBJECT_GET_CLASS(element), &n_specs);
+  bool found_own = false;
+  for (guint i = 0; i < n_specs; ++i) {
+    if (specs[i]->owner_type != type) continue;
+    const std::string prop = g_param_spec_get_name(specs[i]);
+    found_own |= prop == own_property;
+    const gchar* blurb = g_param_spec_get_blurb(specs[i]);
+    EXPECT_TRUE(blurb != nullptr && *blurb != '\0') << prop << " has no blurb";
+    const std::string shown = property_blurb(lines, prop);
+    EXPECT_FALSE(shown.empty()) << "gst-inspect shows no blurb for " << prop;
+    if (blurb != nullptr) {
+      EXPECT_EQ(shown, blurb) << prop;
+    }
+  }
+  EXPECT_TRUE(found_own) << name << " has no property " << own_property << " of its own";
+  g_free(specs);
+  gst_object_unref(element);
+  gst_object_unref(factory);
+}
+
+TEST(GstInspect, Payloader) {
+  ASSERT_TRUE(plugin_available());
+  check_element_inspect(kPay, "max-delay");
+}
+
+TEST(GstInspect, Depayloader) {
+  ASSERT_TRUE(plugin_available());
+  check_element_inspect(kDepay, "stats");
+}
+
+TEST(GstInspect, PluginListsBothElements) {
+  ASSERT_TRUE(plugin_available());
+  const Inspect r = gst_inspect("pfap");
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  SCOPED_TRACE("gst-inspect-1.0 pfap:\n" + r.out);
+  const std::vector<std::string> lines = lines_of(r.out);
+  EXPECT_EQ(detail(lines, "Name"), "pfap");
+  for (const char* name : {kPay, kDepay}) {
+    GstElementFactory* factory = gst_element_factory_find(name);
+    ASSERT_NE(factory, nullptr);
+    const std::string line =
+        std::string("  ") + name + ": " +
+        gst_element_factory_get_metadata(factory, GST_ELEMENT_METADATA_LONGNAME);
+    gst_object_unref(factory);
+    EXPECT_NE(std::find(lines.begin(), lines.end(), line), lines.end()) << "no line: " << line;
+  }
+  EXPECT_NE(r.out.find("2 features:"), std::string::npos);
+  EXPECT_NE(r.out.find("+-- 2 elements"), std::string::npos);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Loopback UDP through rtpbin, audio beside PFAP: lip sync within 1 ms.
+//
+// Sender: audiotestsrc (live, white noise) ! audioconvert ! rtpL16pay and a live appsrc of
+// x-pfap phonemes ! rtppfappay, sessions 0 and 1 of one rtpbin, RTP and RTCP to the receiver
+// by udpsink. Receiver: udpsrc ! rtpbin (sessions 0 and 1, RTCP receiver reports back to the
+// sender) ! rtpL16depay ! appsink and rtppfapdepay ! appsink. Every socket is on 127.0.0.1
+// and bound to a free port (port=0, read back in READY).
+//
+// How it is measured. For every item the test knows the running time at which the sender
+// sent it (T) and the running time at which the receiver outputs it (R):
+//  - a phoneme: T is its PTS at the sender's appsrc (running time, segment from 0; the
+//    appsrc pushes each phoneme when the clock reaches it); the receiver finds it again by
+//    its number (symbol + 256 * f0);
+//  - audio: the sender's L16 samples are recorded at rtpL16pay's sink pad with their running
+//    times; audiotestsrc makes white noise, so each received buffer is found again in that
+//    recording by its bytes, which gives T for its first sample.
+// R is the running time (appsink segment) of the depayloaded buffer. The offset R - T is how
+// a stream is mapped from the sender's timeline to the receiver's. For the phoneme sent at T
+// and the audio sample sent at T, |R_p - R_a| = |offset_p(T) - offset_a(T)|, with offset_a
+// from the received audio buffer that holds the sample sent at T. The test requires <= 1 ms
+// for every phoneme once sync is in place, and that there are at least 10 such phonemes.
+//
+// What maps the two streams consistently is rtpbin's RTCP sync (rtcp-sync=always, the
+// default): from the sender reports of both sessions (same CNAME) it sets the receiving
+// jitterbuffers' ts-offset. A phoneme counts once both jitterbuffers have handed rtpbin at
+// least two sender reports (counted in a handle-sync handler connected after rtpbin's, which
+// applies the sync). Before that the PFAP stream is off by ~300 ms: its timeline starts at
+// its first packet (the first phoneme, at 300 ms) and the audio's at 0. That also makes the
+// first correction far above rtpbin's min-ts-offset (4 ms), so it is applied.
+//
+// The receiving rtpbin runs with buffer-mode=none: timestamps from the RTP timestamps alone,
+// no estimate of the sender's clock skew from arrival times. Both pipelines share one clock,
+// so there is no skew to estimate; in the default (slave) mode the estimate settles over the
+// jitterbuffer's 2 s window, and rtpbin ignores ts-offset changes below min-ts-offset (4 ms),
+// which measured as up to 16 ms of difference in the first 2 s and a lasting 1.4 ms after
+// (with min-ts-offset=0 slave mode settles to +-25 us after ~2.3 s). Those are rtpbin's
+// tolerances, not the payload format's; with buffer-mode=none the measured difference is
+// within +-25 us (the 44.1 kHz RTP tick is 22.7 us) from the first sync on.
+//
+// Settings that only make the test fast: RTCP every ~100 ms instead of every 5 s
+// (rtcp-min-interval and rtcp-fraction of the internal sessions). PFAP_TEST_VERBOSE=1 prints
+// the per-phoneme table.
+
+constexpr int kAudioRate = 44100;
+constexpr size_t kAudioKeyBytes = 8;  // 4 samples of white noise identify a position
+constexpr GstClockTime kTolerance = GST_MSECOND;
+
+struct SentAudio {
+  std::mutex mutex;
+  std::vector<uint8_t> bytes;  // every sample sent, S16BE mono, in order
+  struct Chunk {
+    size_t first_sample;
+    GstClockTime running_time;
+  };
+  std::vector<Chunk> chunks;  // where each sent buffer starts
+
+  // The sender running time of sample j.
+  GstClockTime time_of(size_t j) const {
+    auto it = std::upper_bound(chunks.begin(), chunks.end(), j,
+                               [](size_t v, const Chunk& c) { return v < c.first_sample; });
+    const Chunk& c = *(it - 1);
+    return c.running_time + gst_util_uint64_scale_round(j - c.first_sample, GST_SECOND, kAudioRate);
+  }
+};
+
+GstPadProbeReturn record_sent_audio(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
+  auto* sent = static_cast<SentAudio*>(data);
+  GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+  GstEvent* segment_event = gst_pad_get_sticky_event(pad, GST_EVENT_SEGMENT, 0);
+  if (segment_event == nullptr || !GST_BUFFER_PTS_IS_VALID(buffer)) {
+    if (segment_event != nullptr) gst_event_unref(segment_event);
+    return GST_PAD_PROBE_OK;
+  }
+  const GstSegment* segment = nullptr;
+  gst_event_parse_segment(segment_event, &segment);
+  const GstClockTime rt =
+      gst_segment_to_running_time(segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
+  gst_event_unref(segment_event);
+  GstMapInfo map;
+  gst_buffer_map(buffer, &map, GST_MAP_READ);
+  {
+    std::lock_guard lock(sent->mutex);
+    sent->chunks.push_back({sent->bytes.size() / 2, rt});
+    sent->bytes.insert(sent->bytes.end(), map.data, map.data + map.size);
+  }
+  gst_buffer_unmap(buffer, &map);
+  return GST_PAD_PROBE_OK;
+}
+
+struct Received {
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::atomic<int> syncs[2] = {0, 0};  // handle-sync calls per session (0 audio, 1 PFAP)
+
+  struct Audio {
+    GstClockTime running_time;
+    std::vector<uint8_t> bytes;
+  };
+  std::vector<Audio> audio;
+  struct Phoneme {
+    Event event;
+    GstClockTime running_time;
+    int syncs;  // the fewer of the two sessions' sync counts when it arrived
+  };
+  std::vector<Phoneme> phonemes;
+  std::vector<std::string> link_errors;
+};
+
+GstFlowReturn on_audio(GstElement* sink, gpointer data) {
+  auto* r = static_cast<Received*>(data);
+  GstSample* sample = nullptr;
+  g_signal_emit_by_name(sink, "pull-sample", &sample);
+  if (sample == nullptr) return GST_FLOW_EOS;
+  GstMapInfo map;
+  GstBuffer* buffer = gst_sample_get_buffer(sample);
+  gst_buffer_map(buffer, &map, GST_MAP_READ);
+  Received::Audio a{running_time(sample), std::vector<uint8_t>(map.data, map.data + map.size)};
+  gst_buffer_unmap(buffer, &map);
+  gst_sample_unref(sample);
+  {
+    std::lock_guard lock(r->mutex);
+    r->audio.push_back(std::move(a));
+  }
+  r->changed.notify_all();
+  return GST_FLOW_OK;
+}
+
+GstFlowReturn on_phoneme(GstElement* sink, gpointer data) {
+  auto* r = static_cast<Received*>(data);
+  GstSample* sample = nullptr;
+  g_signal_emit_by_name(sink, "pull-sample", &sample);
+  if (sample == nullptr) return GST_FLOW_EOS;
+  const int syncs = std::min(r->syncs[0].load(), r->syncs[1].load());
+  Received::Phoneme p{pfap::testing::read_event(gst_sample_get_buffer(sample)),
+                      running_time(sample), syncs};
+  gst_sample_unref(sample);
+  {
+    std::lock_guard lock(r->mutex);
+    r->phonemes.push_back(std::move(p));
+  }
+  r->changed.notify_all();
+  return GST_FLOW_OK;
+}
+
+void on_handle_sync(GstElement*, GstStructure*, gpointer data) {
+  static_cast<std::atomic<int>*>(data)->fetch_add(1);
+}
+
+void on_new_jitterbuffer(GstElement*, GstElement* jitterbuffer, guint session, guint,
+                         gpointer data) {
+  auto* r = static_cast<Received*>(data);
+  if (session > 1) return;
+  // After rtpbin's own handler, which applies the sync.
+  g_signal_connect_after(jitterbuffer, "handle-sync", G_CALLBACK(on_handle_sync),
+                         &r->syncs[session]);
+}
+
+struct ReceiverLinks {
+  GstElement* audio_depay;
+  GstElement* pfap_depay;
+  Received* received;
+};
+
+void on_rtpbin_pad(GstElement*, GstPad* pad, gpointer data) {
+  auto* links = static_cast<ReceiverLinks*>(data);
+  gchar* name = gst_pad_get_name(pad);
+  const std::string pad_name = name;
+  g_free(name);
+  GstElement* depay = nullptr;
+  if (pad_name.rfind("recv_rtp_src_0_", 0) == 0) depay = links->audio_depay;
+  if (pad_name.rfind("recv_rtp_src_1_", 0) == 0) depay = links->pfap_depay;
+  if (depay == nullptr) return;
+  GstPad* sink = gst_element_get_static_pad(depay, "sink");
+  const GstPadLinkReturn ret = gst_pad_link(pad, sink);
+  gst_object_unref(sink);
+  if (ret != GST_PAD_LINK_OK) {
+    std::lock_guard lock(links->received->mutex);
+    links->received->link_errors.push_back("cannot link " + pad_name + ": " +
+                                           gst_pad_link_get_name(ret));
+  }
+}
+
+// RTCP every ~100 ms so that sync comes within the test's few seconds.
+void fast_rtcp(GstElement* rtpbin) {
+  for (guint id : {0u, 1u}) {
+    GObject* session = nullptr;
+    g_signal_emit_by_name(rtpbin, "get-internal-session", id, &session);
+    if (session == nullptr) continue;
+    g_object_set(session, "rtcp-min-interval", guint64{100 * GST_MSECOND}, "rtcp-fraction",
+                 200000.0, nullptr);
+    g_object_unref(session);
+  }
+}
+
+guint bound_port(GstElement* udpsrc) {
+  gint port = 0;
+  g_object_get(udpsrc, "port", &port, nullptr);
+  return static_cast<guint>(port);
+}
+
+// The phonemes the sender sends: sentences of contiguous phonemes with pauses between them,
+// from 300 ms (plus a fraction of a ms) for about 4 s. Each is numbered by symbol + 256 * f0.
+std::vector<Event> live_phonemes() {
+  RandomMarkup random(7);
+  std::vector<Event> events;
+  GstClockTime t = 300 * GST_MSECOND + 123'456;
+  bool sentence_start = true;
+  int in_sentence = 0;
+  for (int i = 0; t < 4300 * GST_MSECOND; ++i) {
+    Event e;
+    e.phoneme.symbol = static_cast<uint8_t>(i & 0xff);
+    e.phoneme.f0 = static_cast<uint8_t>(i >> 8);
+    e.phoneme.duration_ms = static_cast<uint16_t>(random.uniform(40, 150));
+    e.phoneme.stress = random.chance(0.3);
+    e.phoneme.word_begin = random.chance(0.3);
+    e.phoneme.end_of_text = ++in_sentence >= random.uniform(6, 14);
+    const int n_faps = random.uniform(0, 2);
+    for (int k = 0; k < n_faps; ++k) e.faps.push_back(random.fap());
+    e.flags = pfap::testing::phoneme_flags(e.phoneme, sentence_start);
+    e.pts = t;
+    e.duration = e.phoneme.duration_ms * GST_MSECOND;
+    t += e.duration;
+    sentence_start = e.phoneme.end_of_text;
+    if (sentence_start) {
+      in_sentence = 0;
+      t += static_cast<GstClockTime>(random.uniform(100, 300)) * GST_MSECOND;
+    }
+    events.push_back(e);
+  }
+  events.back().phoneme.end_of_text = true;
+  events.back().flags |= PFAP_FLAG_END_OF_TEXT;
+  return events;
+}
+
+int index_of(const Event& e) { return e.phoneme.symbol + 256 * e.phoneme.f0; }
+
+// The sender's side of the phoneme stream: pushes each phoneme when the pipeline's running
+// time reaches its start, as a live TTS source would.
+void push_live(GstElement* appsrc, GstClock* clock, GstClockTime base_time,
+               const std::vector<Event>& events, const std::atomic<bool>& stop) {
+  for (const Event& e : events) {
+    for (;;) {
+      if (stop) return;
+      const GstClockTime now = gst_clock_get_time(clock);
+      if (now >= base_time + e.pts) break;
+      const GstClockTime wait = std::min<GstClockTime>(base_time + e.pts - now, 20 * GST_MSECOND);
+      std::this_thread::sleep_for(std::chrono::nanoseconds(wait));
+    }
+    if (push(appsrc, make_buffer(e)) != GST_FLOW_OK) return;
+  }
+}
+
+TEST(LoopbackUdp, PhonemesKeepLipSyncWithAudio) {
+  ASSERT_TRUE(plugin_available());
+  const std::vector<Event> sent = live_phonemes();
+  const Event& last = sent.back();
+  // What the pipelines' callbacks write to outlives the pipelines.
+  SentAudio sent_audio;
+  Received received;
+  ReceiverLinks links{nullptr, nullptr, &received};
+
+  Pipeline receiver(
+      "rtpbin name=rtpbin buffer-mode=none "
+      "udpsrc name=audio_rtp address=127.0.0.1 port=0 caps=\"application/x-rtp,media=audio,"
+      "clock-rate=44100,encoding-name=L16,channels=1,payload=96\" ! rtpbin.recv_rtp_sink_0 "
+      "udpsrc name=audio_rtcp address=127.0.0.1 port=0 ! rtpbin.recv_rtcp_sink_0 "
+      "rtpbin.send_rtcp_src_0 ! udpsink name=audio_rr host=127.0.0.1 sync=false async=false "
+      "udpsrc name=pfap_rtp address=127.0.0.1 port=0 caps=\"application/x-rtp,"
+      "media=application,clock-rate=44100,encoding-name=PFAP,payload=97,"
+      "alphabet=(string)x-sampa\" ! rtpbin.recv_rtp_sink_1 "
+      "udpsrc name=pfap_rtcp address=127.0.0.1 port=0 ! rtpbin.recv_rtcp_sink_1 "
+      "rtpbin.send_rtcp_src_1 ! udpsink name=pfap_rr host=127.0.0.1 sync=false async=false "
+      "rtpL16depay name=audio_depay ! appsink name=audio_sink sync=false emit-signals=true "
+      "rtppfapdepay name=pfap_depay ! appsink name=pfap_sink sync=false emit-signals=true");
+  ASSERT_TRUE(receiver.ok()) << receiver.error();
+  Pipeline sender(
+      "rtpbin name=rtpbin "
+      "sdes=\"application/x-rtp-source-sdes,cname=(string)pfap-test-sender\" "
+      "audiotestsrc is-live=true wave=white-noise samplesperbuffer=441 "
+      "! audio/x-raw,rate=44100,channels=1 ! audioconvert "
+      "! rtpL16pay name=audio_pay pt=96 ! rtpbin.send_rtp_sink_0 "
+      "rtpbin.send_rtp_src_0 ! udpsink name=audio_rtp host=127.0.0.1 async=false "
+      "rtpbin.send_rtcp_src_0 ! udpsink name=audio_rtcp host=127.0.0.1 sync=false async=false "
+      "udpsrc name=audio_rr address=127.0.0.1 port=0 ! rtpbin.recv_rtcp_sink_0 "
+      "appsrc name=pfap_src is-live=true format=time "
+      "caps=\"application/x-pfap,alphabet=(string)x-sampa\" "
+      "! rtppfappay pt=97 ! rtpbin.send_rtp_sink_1 "
+      "rtpbin.send_rtp_src_1 ! udpsink name=pfap_rtp host=127.0.0.1 async=false "
+      "rtpbin.send_rtcp_src_1 ! udpsink name=pfap_rtcp host=127.0.0.1 sync=false async=false "
+      "udpsrc name=pfap_rr address=127.0.0.1 port=0 ! rtpbin.recv_rtcp_sink_1");
+  ASSERT_TRUE(sender.ok()) << sender.error();
+
+  links.audio_depay = receiver.by_name("audio_depay");
+  links.pfap_depay = receiver.by_name("pfap_depay");
+  GstElement* receiver_rtpbin = receiver.by_name("rtpbin");
+  g_signal_connect(receiver_rtpbin, "pad-added", G_CALLBACK(on_rtpbin_pad), &links);
+  g_signal_connect(receiver_rtpbin, "new-jitterbuffer", G_CALLBACK(on_new_jitterbuffer), &received);
+  g_signal_connect(receiver.by_name("audio_sink"), "new-sample", G_CALLBACK(on_audio), &received);
+  g_signal_connect(receiver.by_name("pfap_sink"), "new-sample", G_CALLBACK(on_phoneme), &received);
+  GstPad* pay_sink = gst_element_get_static_pad(sender.by_name("audio_pay"), "sink");
+  gst_pad_add_probe(pay_sink, GST_PAD_PROBE_TYPE_BUFFER, record_sent_audio, &sent_audio, nullptr);
+  gst_object_unref(pay_sink);
+
+  // Every socket is bound to a free port of 127.0.0.1 (port=0) in READY; each sink is then
+  // pointed at the port its peer got.
+  ASSERT_EQ(receiver.set_state(GST_STATE_READY), "");
+  ASSERT_EQ(sender.set_state(GST_STATE_READY), "");
+  for (const char* name : {"audio_rtp", "audio_rtcp", "pfap_rtp", "pfap_rtcp"}) {
+    const guint port = bound_port(receiver.by_name(name));
+    ASSERT_NE(port, 0u) << name;
+    g_object_set(sender.by_name(name), "port", port, nullptr);
+  }
+  for (const char* name : {"audio_rr", "pfap_rr"}) {
+    const guint port = bound_port(sender.by_name(name));
+    ASSERT_NE(port, 0u) << name;
+    g_object_set(receiver.by_name(name), "port", port, nullptr);
+  }
+  fast_rtcp(sender.by_name("rtpbin"));
+  fast_rtcp(receiver_rtpbin);
+
+  ASSERT_EQ(receiver.set_state(GST_STATE_PLAYING), "");
+  ASSERT_EQ(sender.set_state(GST_STATE_PLAYING), "");
+  // A live pipeline has its clock and base time once it is PLAYING.
+  GstState state = GST_STATE_NULL;
+  const GstStateChangeReturn ret =
+      gst_element_get_state(sender.get(), &state, nullptr, 10 * GST_SECOND);
+  ASSERT_TRUE(ret != GST_STATE_CHANGE_FAILURE && ret != GST_STATE_CHANGE_ASYNC &&
+              state == GST_STATE_PLAYING)
+      << "sender did not reach PLAYING within 10 s: " << sender.poll_error();
+  std::unique_ptr<GstClock, decltype(&gst_object_unref)> clock(
+      gst_pipeline_get_clock(GST_PIPELINE(sender.get())), &gst_object_unref);
+  ASSERT_NE(clock, nullptr);
+  const GstClockTime base_time = gst_element_get_base_time(sender.get());
+
+  std::atomic<bool> stop{false};
+  std::thread pusher(push_live, sender.by_name("pfap_src"), clock.get(), base_time, std::cref(sent),
+                     std::cref(stop));
+
+  // Until every phoneme is out and the audio reaches past the last one (or a deadline).
+  const GstClockTime audio_needed = last.pts + last.duration + 100 * GST_MSECOND;
+  const auto deadline =
+      Clock::now() + std::chrono::nanoseconds(audio_needed) + std::chrono::seconds(15);
+  std::string failure;
+  {
+    std::unique_lock lock(received.mutex);
+    for (;;) {
+      const bool all_phonemes =
+          !received.phonemes.empty() && index_of(received.phonemes.back().event) == index_of(last);
+      bool enough_audio = false;
+      if (!received.audio.empty()) {
+        // The sender's audio starts at running time 0, so the audio received so far reaches
+        // sender time (samples / rate): enough once that is past the last phoneme.
+        size_t samples = 0;
+        for (const Received::Audio& a : received.audio) samples += a.bytes.size() / 2;
+        enough_audio = gst_util_uint64_scale(samples, GST_SECOND, kAudioRate) > audio_needed;
+      }
+      if (all_phonemes && enough_audio) break;
+      if (!received.link_errors.empty()) {
+        failure = received.link_errors.front();
+        break;
+      }
+      lock.unlock();
+      failure = sender.poll_error();
+      if (failure.empty()) failure = receiver.poll_error();
+      lock.lock();
+      if (!failure.empty()) break;
+      if (Clock::now() > deadline) {
+        std::ostringstream s;
+        s << "timed out: " << received.phonemes.size() << " of " << sent.size() << " phonemes and "
+          << received.audio.size() << " audio buffers received; sync counts audio "
+          << received.syncs[0] << ", PFAP " << received.syncs[1];
+        failure = s.str();
+        break;
+      }
+      received.changed.wait_for(lock, std::chrono::milliseconds(50));
+    }
+  }
+  stop = true;
+  pusher.join();
+  sender.set_state(GST_STATE_NULL);
+  receiver.set_state(GST_STATE_NULL);
+  ASSERT_EQ(failure, "");
+
+  // Every phoneme arrives once, in order, with its fields (times are the receiver's).
+  ASSERT_EQ(received.phonemes.size(), sent.size());
+  for (size_t i = 0; i < sent.size(); ++i) {
+    Event got = received.phonemes[i].event;
+    got.discont = false;
+    got.pts = sent[i].pts;
+    ASSERT_EQ(got, sent[i]) << "phoneme " << i << "\n  sent " << describe(sent[i]) << "\n  got  "
+                            << describe(received.phonemes[i].event);
+  }
+
+  // Where each received audio buffer was in the sent audio: a map from 4-sample keys to
+  // their position, then a check of the whole buffer's bytes.
+  std::unordered_map<uint64_t, int64_t> positions;  // -1: key not unique
+  const std::vector<uint8_t>& bytes = sent_audio.bytes;
+  for (size_t j = 0; j + kAudioKeyBytes / 2 <= bytes.size() / 2; ++j) {
+    uint64_t key;
+    std::memcpy(&key, &bytes[2 * j], sizeof key);
+    auto [it, fresh] = positions.emplace(key, static_cast<int64_t>(j));
+    if (!fresh) it->second = -1;
+  }
+  struct AudioOffset {
+    GstClockTime sent;        // sender running time of the buffer's first sample
+    GstClockTimeDiff offset;  // receiver running time - sender running time
+  };
+  std::vector<AudioOffset> audio_offsets;
+  size_t unmatched = 0;
+  for (const Received::Audio& a : received.audio) {
+    if (a.bytes.size() < kAudioKeyBytes || !GST_CLOCK_TIME_IS_VALID(a.running_time)) continue;
+    uint64_t key;
+    std::memcpy(&key, a.bytes.data(), sizeof key);
+    auto it = positions.find(key);
+    const bool found = it != positions.end() && it->second >= 0 &&
+                       2 * static_cast<size_t>(it->second) + a.bytes.size() <= bytes.size() &&
+                       std::memcmp(&bytes[2 * it->second], a.bytes.data(), a.bytes.size()) == 0;
+    if (!found) {
+      ++unmatched;
+      continue;
+    }
+    const GstClockTime t = sent_audio.time_of(static_cast<size_t>(it->second));
+    audio_offsets.push_back({t, GST_CLOCK_DIFF(t, a.running_time)});
+  }
+  ASSERT_GT(audio_offsets.size(), received.audio.size() / 2)
+      << unmatched << " of " << received.audio.size()
+      << " received audio buffers not found in the sent audio";
+  std::sort(audio_offsets.begin(), audio_offsets.end(),
+            [](const AudioOffset& a, const AudioOffset& b) { return a.sent < b.sent; });
+
+  // Phoneme by phoneme: its offset against the offset of the audio sent at the same time.
+  std::ostringstream table;
+  table << "index  sent_ms  offset_pfap_us  offset_audio_us  diff_us  syncs\n";
+  int compared = 0;
+  int out_of_tolerance = 0;
+  GstClockTimeDiff worst = 0;
+  for (size_t i = 0; i < sent.size(); ++i) {
+    const Received::Phoneme& p = received.phonemes[i];
+    const GstClockTime t = sent[i].pts;
+    auto it = std::upper_bound(audio_offsets.begin(), audio_offsets.end(), t,
+                               [](GstClockTime v, const AudioOffset& a) { return v < a.sent; });
+    if (it == audio_offsets.begin()) continue;
+    const AudioOffset& a = *(it - 1);
+    if (t - a.sent > 50 * GST_MSECOND) continue;  // no audio received around T
+    const GstClockTimeDiff offset_p = GST_CLOCK_DIFF(t, p.running_time);
+    const GstClockTimeDiff diff = offset_p - a.offset;
+    table << i << "  " << t / GST_MSECOND << "  " << offset_p / 1000 << "  " << a.offset / 1000
+          << "  " << diff / 1000 << "  " << p.syncs << "\n";
+    if (p.syncs < 2) continue;
+    ++compared;
+    if (std::abs(diff) > static_cast<GstClockTimeDiff>(kTolerance)) ++out_of_tolerance;
+    if (std::abs(diff) > std::abs(worst)) worst = diff;
+  }
+  SCOPED_TRACE("per phoneme (syncs < 2: before RTCP sync, not counted):\n" + table.str());
+  EXPECT_GE(compared, 10) << "too few phonemes after RTCP sync";
+  EXPECT_EQ(out_of_tolerance, 0) << "worst |R_p - R_a| " << worst / 1000 << " us over " << compared
+                                 << " phonemes";
+  if (const char* verbose = g_getenv("PFAP_TEST_VERBOSE"); verbose != nullptr) {
+    std::cout << table.str() << "worst " << worst << " ns over " << compared << "\n";
+  }
+}
+
+}  // namespace
