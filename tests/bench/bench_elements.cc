@@ -8,7 +8,7 @@
 // what a payloader that parses nothing costs in the same pipeline. The runs alternate
 // (pfap, rtpgst, rtpgst, pfap, ...) and each is timed from PLAYING to EOS: process CPU time
 // (every thread: the application pushing into appsrc, and the streaming thread) and wall
-// time. Printed: each run, then the medians, items/s and the ratio pfap/rtpgst.
+// time. Printed: each run, then the medians, items/s and the ratio to rtpgst.
 //
 // Run: meson test -C build --benchmark --verbose elements
 //  or: GST_PLUGIN_PATH=build/gst build/tests/bench/bench_elements [N [repetitions]]
@@ -207,37 +207,46 @@ int main(int argc, char** argv) {
   std::printf("%d phoneme events, %zu bytes (%.1f bytes each), %d repetitions, alternating\n", n,
               bytes, static_cast<double>(bytes) / n, repetitions);
 
+  // The reference last: ratios are to it. max-delay=0 makes one packet per phoneme, as
+  // rtpgstpay does, so that row compares the cost per packet.
+  struct Variant {
+    const char* name;
+    const char* payloader;
+    const char* depayloader;
+    const std::vector<GstBuffer*>& buffers;
+    std::vector<double> cpu, wall;
+    long packets = 0;
+  };
+  std::vector<Variant> variants = {
+      {"rtppfappay ! rtppfapdepay", "rtppfappay", "rtppfapdepay", pfap, {}, {}},
+      {"  (max-delay=0)", "rtppfappay max-delay=0", "rtppfapdepay", pfap, {}, {}},
+      {"rtpgstpay ! rtpgstdepay", "rtpgstpay", "rtpgstdepay", plain, {}, {}},
+  };
   // Warm-up: the registry, plugin loading and first allocations are not measured.
-  run("rtppfappay", "rtppfapdepay", pfap);
-  run("rtpgstpay", "rtpgstdepay", plain);
-
-  std::vector<double> pfap_cpu, pfap_wall, gst_cpu, gst_wall;
-  std::pair<long, long> packets;
+  for (Variant& v : variants) run(v.payloader, v.depayloader, v.buffers);
   for (int r = 0; r < repetitions; ++r) {
-    const bool pfap_first = r % 2 == 0;
-    Timing a{}, b{};
-    if (pfap_first) a = run("rtppfappay", "rtppfapdepay", pfap);
-    b = run("rtpgstpay", "rtpgstdepay", plain);
-    if (!pfap_first) a = run("rtppfappay", "rtppfapdepay", pfap);
-    pfap_cpu.push_back(a.cpu);
-    pfap_wall.push_back(a.wall);
-    gst_cpu.push_back(b.cpu);
-    gst_wall.push_back(b.wall);
-    std::printf("run %d: pfap cpu %.4f s wall %.4f s | rtpgst cpu %.4f s wall %.4f s\n", r + 1,
-                a.cpu, a.wall, b.cpu, b.wall);
-    if (r == 0) packets = {a.packets, b.packets};
+    std::printf("run %d:", r + 1);
+    // Rotate the order so that no variant always runs first or last.
+    for (size_t k = 0; k < variants.size(); ++k) {
+      Variant& v = variants[(k + static_cast<size_t>(r)) % variants.size()];
+      const Timing t = run(v.payloader, v.depayloader, v.buffers);
+      v.cpu.push_back(t.cpu);
+      v.wall.push_back(t.wall);
+      v.packets = t.packets;
+      std::printf(" | %s cpu %.4f s", v.payloader, t.cpu);
+    }
+    std::printf("\n");
   }
 
-  const double pc = median(pfap_cpu), pw = median(pfap_wall);
-  const double gc = median(gst_cpu), gw = median(gst_wall);
+  const Variant& reference = variants.back();
+  const double rc = median(reference.cpu);
   std::printf(
-      "\nmedian of %d               CPU time   items/s (CPU)   wall time   items/s (wall)\n",
+      "\nmedian of %d               CPU time   items/s (CPU)   RTP packets   vs rtpgst (items/s)\n",
       repetitions);
-  std::printf("rtppfappay ! rtppfapdepay %8.4f s %13.0f %11.4f s %14.0f\n", pc, n / pc, pw, n / pw);
-  std::printf("rtpgstpay ! rtpgstdepay   %8.4f s %13.0f %11.4f s %14.0f\n", gc, n / gc, gw, n / gw);
-  std::printf("RTP packets: pfap %ld, rtpgst %ld\n", packets.first, packets.second);
-  std::printf("ratio pfap/rtpgst: items/s (CPU) %.3f, CPU time %.3f; items/s (wall) %.3f\n",
-              gc / pc, pc / gc, gw / pw);
+  for (const Variant& v : variants) {
+    const double c = median(v.cpu);
+    std::printf("%-25s %8.4f s %13.0f %13ld %12.3f\n", v.name, c, n / c, v.packets, rc / c);
+  }
 
   for (GstBuffer* b : pfap) gst_buffer_unref(b);
   for (GstBuffer* b : plain) gst_buffer_unref(b);
