@@ -35,8 +35,8 @@
 #include <span>
 #include <vector>
 
-#include "pfap/markup.h"
 #include "pfap/payload.h"
+#include "pfapbuffer.h"
 
 GST_DEBUG_CATEGORY_STATIC(rtp_pfap_depay_debug);
 #define GST_CAT_DEFAULT rtp_pfap_depay_debug
@@ -115,9 +115,8 @@ struct _GstRtpPfapDepay {
   GstRTPBaseDepayload parent;
 
   // C++ members: constructed in init, destroyed in finalize.
-  pfap::Packet packet;           // reused, so decoding stops allocating
-  std::vector<PfapFap> records;  // one phoneme's FAPs for pfap_markup_write, reused
-  std::vector<uint8_t> markup;   // one phoneme's x-pfap bytes, reused
+  pfap::Packet packet;      // reused, so decoding stops allocating
+  pfap::MarkupEvent event;  // one phoneme's event, reused
   SeqnumTracker seqnums;
   Stats stats;  // under the object lock: the stats property is read from any thread
 };
@@ -222,24 +221,12 @@ static void drop_malformed(GstRtpPfapDepay* self, pfap::DecodeResult result, gui
 // Phoneme i of the decoded packet as an x-pfap buffer, or NULL when it does not fit one
 // (more FAPs than its 16-bit count holds).
 static GstBuffer* phoneme_buffer(GstRtpPfapDepay* self, size_t i, bool sentence_start) {
-  const pfap::Phoneme& p = self->packet.phonemes[i].phoneme;
   const std::span<const pfap::Fap> faps = self->packet.faps_of(i);
-  if (faps.size() > G_MAXUINT16) return nullptr;
-  self->records.clear();
-  for (const pfap::Fap& f : faps) {
-    self->records.push_back({f.index, static_cast<uint8_t>(f.curve), f.transition_ms, f.amplitude});
-  }
-  const auto flags = static_cast<uint8_t>((p.stress ? PFAP_FLAG_STRESS : 0) |
-                                          (p.word_begin ? PFAP_FLAG_WORD_BEGIN : 0) |
-                                          (p.end_of_text ? PFAP_FLAG_END_OF_TEXT : 0) |
-                                          (sentence_start ? PFAP_FLAG_SENTENCE_START : 0));
-  const PfapEventHeader header{
-      PFAP_EVENT_PHONEME, flags, p.symbol, p.f0, p.duration_ms, static_cast<uint16_t>(faps.size())};
-  self->markup.resize(pfap_markup_size(header.n_faps));
-  if (pfap_markup_write(&header, self->records.data(), self->markup.data(), self->markup.size())) {
-    return nullptr;
-  }
-  return gst_buffer_new_memdup(self->markup.data(), self->markup.size());
+  pfap::MarkupEvent& event = self->event;
+  event.phoneme = self->packet.phonemes[i].phoneme;
+  event.sentence_start = sentence_start;
+  event.faps.assign(faps.begin(), faps.end());
+  return pfap_buffer_new(event);
 }
 
 static GstBuffer* gst_rtp_pfap_depay_process_rtp_packet(GstRTPBaseDepayload* depay,
@@ -347,8 +334,7 @@ static void gst_rtp_pfap_depay_init(GstRtpPfapDepay* self) {
   // gets clock-rate=1 instead, before we can say anything.
   GST_PAD_SET_ACCEPT_INTERSECT(GST_RTP_BASE_DEPAYLOAD_SINKPAD(self));
   new (&self->packet) pfap::Packet();
-  new (&self->records) std::vector<PfapFap>();
-  new (&self->markup) std::vector<uint8_t>();
+  new (&self->event) pfap::MarkupEvent();
   new (&self->seqnums) SeqnumTracker();
   new (&self->stats) Stats();
 }
@@ -356,8 +342,7 @@ static void gst_rtp_pfap_depay_init(GstRtpPfapDepay* self) {
 static void gst_rtp_pfap_depay_finalize(GObject* object) {
   GstRtpPfapDepay* self = GST_RTP_PFAP_DEPAY(object);
   std::destroy_at(&self->packet);
-  std::destroy_at(&self->records);
-  std::destroy_at(&self->markup);
+  std::destroy_at(&self->event);
   G_OBJECT_CLASS(gst_rtp_pfap_depay_parent_class)->finalize(object);
 }
 

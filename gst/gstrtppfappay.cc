@@ -40,9 +40,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "pfap/markup.h"
 #include "pfap/packetizer.h"
 #include "pfap/payload.h"
+#include "pfapbuffer.h"
 
 GST_DEBUG_CATEGORY_STATIC(rtppfappay_debug);
 #define GST_CAT_DEFAULT rtppfappay_debug
@@ -62,7 +62,7 @@ struct Stream {
   uint32_t clock_rate = pfap::kDefaultClockRate;
   GstClockTime next_start = GST_CLOCK_TIME_NONE;  // where a phoneme without PTS starts
   // Reused for every buffer so that steady streaming does not allocate.
-  std::vector<pfap::Fap> faps;
+  pfap::MarkupEvent event;
   std::vector<pfap::PlannedPacket> planned;
 };
 
@@ -174,27 +174,12 @@ static GstFlowReturn drain(GstRtpPfapPay* self) {
   return push_planned(self);
 }
 
-// Reads one x-pfap event into `header` and `faps`; false when it is malformed.
-static bool read_event(GstBuffer* buffer, PfapEventHeader& header, std::vector<pfap::Fap>& faps) {
-  GstMapInfo map;
-  if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) return false;
-  const bool ok = pfap_markup_read_header(map.data, map.size, &header) == 0;
-  faps.clear();
-  for (unsigned i = 0; ok && i < header.n_faps; ++i) {
-    PfapFap f;
-    pfap_markup_read_fap(map.data, i, &f);
-    faps.push_back({f.index, f.amplitude, f.transition_ms, static_cast<pfap::Curve>(f.curve)});
-  }
-  gst_buffer_unmap(buffer, &map);
-  return ok;
-}
-
 static GstFlowReturn gst_rtp_pfap_pay_handle_buffer(GstRTPBasePayload* payload, GstBuffer* buffer) {
   GstRtpPfapPay* self = GST_RTP_PFAP_PAY(payload);
   Stream& stream = *self->stream;
   GstClockTime start = GST_BUFFER_PTS(buffer);
-  PfapEventHeader header;
-  const bool ok = read_event(buffer, header, stream.faps);
+  pfap::MarkupEvent& event = stream.event;
+  const bool ok = pfap_buffer_read(buffer, event);
   if (!ok) {
     GST_ELEMENT_WARNING(self, STREAM, DECODE, ("Dropped a malformed PFAP event."),
                         ("%" G_GSIZE_FORMAT " bytes at %" GST_TIME_FORMAT
@@ -203,8 +188,8 @@ static GstFlowReturn gst_rtp_pfap_pay_handle_buffer(GstRTPBasePayload* payload, 
   }
   gst_buffer_unref(buffer);
   if (!ok) return GST_FLOW_OK;
-  if (header.kind != PFAP_EVENT_PHONEME) {
-    GST_DEBUG_OBJECT(self, "dropping state event (kind %u) at %" GST_TIME_FORMAT, header.kind,
+  if (event.kind != PFAP_EVENT_PHONEME) {
+    GST_DEBUG_OBJECT(self, "dropping state event (kind %d) at %" GST_TIME_FORMAT, event.kind,
                      GST_TIME_ARGS(start));
     return GST_FLOW_OK;
   }
@@ -212,20 +197,12 @@ static GstFlowReturn gst_rtp_pfap_pay_handle_buffer(GstRTPBasePayload* payload, 
   if (!GST_CLOCK_TIME_IS_VALID(start)) {
     start = GST_CLOCK_TIME_IS_VALID(stream.next_start) ? stream.next_start : payload->segment.start;
   }
-  stream.next_start = start + header.duration_ms * GST_MSECOND;
+  stream.next_start = start + event.phoneme.duration_ms * GST_MSECOND;
 
-  pfap::TimedPhoneme phoneme;
-  phoneme.start_ns = static_cast<int64_t>(start);
-  phoneme.phoneme = {header.symbol,
-                     header.duration_ms,
-                     header.f0,
-                     (header.flags & PFAP_FLAG_STRESS) != 0,
-                     (header.flags & PFAP_FLAG_WORD_BEGIN) != 0,
-                     (header.flags & PFAP_FLAG_END_OF_TEXT) != 0};
-  phoneme.sentence_start = (header.flags & PFAP_FLAG_SENTENCE_START) != 0;
-
+  const pfap::TimedPhoneme phoneme{static_cast<int64_t>(start), event.phoneme,
+                                   event.sentence_start};
   update_config(self);
-  stream.packetizer.push(phoneme, stream.faps, stream.planned);
+  stream.packetizer.push(phoneme, event.faps, stream.planned);
   return push_planned(self);
 }
 

@@ -1,5 +1,8 @@
+// application/x-pfap events: the byte layout of pfap/markup.h, read and written for the C API
+// and for pfap::MarkupEvent alike.
 #include "pfap/markup.h"
 
+#include "pfap/markup_event.h"
 #include "pfap/model.h"
 
 namespace {
@@ -13,9 +16,8 @@ bool valid(const PfapEventHeader& h) {
          (h.flags & ~kKnownFlags) == 0 && h.duration_ms <= pfap::kMaxPhonemeDurationMs;
 }
 
-bool valid(const PfapFap& f) {
-  return pfap::is_valid(
-      pfap::Fap{f.index, f.amplitude, f.transition_ms, static_cast<pfap::Curve>(f.curve)});
+pfap::Fap to_fap(const PfapFap& f) {
+  return {f.index, f.amplitude, f.transition_ms, static_cast<pfap::Curve>(f.curve)};
 }
 
 void put16(uint8_t* p, uint16_t v) {
@@ -24,6 +26,24 @@ void put16(uint8_t* p, uint16_t v) {
 }
 
 uint16_t get16(const uint8_t* p) { return static_cast<uint16_t>(p[0] << 8 | p[1]); }
+
+void write_header(const PfapEventHeader& h, uint8_t* out) {
+  out[0] = h.kind;
+  out[1] = h.flags;
+  out[2] = h.symbol;
+  out[3] = h.f0;
+  put16(out + 4, h.duration_ms);
+  put16(out + 6, h.n_faps);
+}
+
+void write_fap(const pfap::Fap& f, uint8_t* out) {
+  const auto amplitude = static_cast<uint32_t>(f.amplitude);
+  out[0] = f.index;
+  out[1] = static_cast<uint8_t>(f.curve);
+  put16(out + 2, f.transition_ms);
+  put16(out + 4, static_cast<uint16_t>(amplitude >> 16));
+  put16(out + 6, static_cast<uint16_t>(amplitude));
+}
 
 }  // namespace
 
@@ -37,34 +57,23 @@ int pfap_markup_write(const PfapEventHeader* header, const PfapFap* faps, uint8_
                       size_t size) {
   if (!valid(*header) || size != pfap_markup_size(header->n_faps)) return -1;
   for (unsigned i = 0; i < header->n_faps; ++i) {
-    if (!valid(faps[i])) return -1;
+    if (!pfap::is_valid(to_fap(faps[i]))) return -1;
   }
-  out[0] = header->kind;
-  out[1] = header->flags;
-  out[2] = header->symbol;
-  out[3] = header->f0;
-  put16(out + 4, header->duration_ms);
-  put16(out + 6, header->n_faps);
-  uint8_t* p = out + PFAP_MARKUP_HEADER_SIZE;
-  for (unsigned i = 0; i < header->n_faps; ++i, p += PFAP_MARKUP_FAP_SIZE) {
-    const uint32_t amplitude = static_cast<uint32_t>(faps[i].amplitude);
-    p[0] = faps[i].index;
-    p[1] = faps[i].curve;
-    put16(p + 2, faps[i].transition_ms);
-    put16(p + 4, static_cast<uint16_t>(amplitude >> 16));
-    put16(p + 6, static_cast<uint16_t>(amplitude));
+  write_header(*header, out);
+  for (unsigned i = 0; i < header->n_faps; ++i) {
+    write_fap(to_fap(faps[i]), out + pfap_markup_size(i));
   }
   return 0;
 }
 
 int pfap_markup_read_header(const uint8_t* data, size_t size, PfapEventHeader* header) {
   if (size < PFAP_MARKUP_HEADER_SIZE) return -1;
-  PfapEventHeader h{data[0], data[1], data[2], data[3], get16(data + 4), get16(data + 6)};
+  const PfapEventHeader h{data[0], data[1], data[2], data[3], get16(data + 4), get16(data + 6)};
   if (!valid(h) || size != pfap_markup_size(h.n_faps)) return -1;
   for (unsigned i = 0; i < h.n_faps; ++i) {
     PfapFap fap;
     pfap_markup_read_fap(data, i, &fap);
-    if (!valid(fap)) return -1;
+    if (!pfap::is_valid(to_fap(fap))) return -1;
   }
   *header = h;
   return 0;
@@ -79,3 +88,58 @@ void pfap_markup_read_fap(const uint8_t* data, unsigned i, PfapFap* fap) {
 }
 
 }  // extern "C"
+
+namespace pfap {
+
+size_t markup_size(const MarkupEvent& event) {
+  return pfap_markup_size(static_cast<unsigned>(event.faps.size()));
+}
+
+bool write_markup(const MarkupEvent& event, std::span<uint8_t> out) {
+  if (event.faps.size() > UINT16_MAX || out.size() != markup_size(event)) return false;
+  const Phoneme& p = event.phoneme;
+  const bool phoneme = event.kind == PFAP_EVENT_PHONEME;
+  const PfapEventHeader header{
+      static_cast<uint8_t>(event.kind),
+      static_cast<uint8_t>((p.stress ? PFAP_FLAG_STRESS : 0) |
+                           (p.word_begin ? PFAP_FLAG_WORD_BEGIN : 0) |
+                           (p.end_of_text ? PFAP_FLAG_END_OF_TEXT : 0) |
+                           (event.sentence_start ? PFAP_FLAG_SENTENCE_START : 0) |
+                           (event.uncertain ? PFAP_FLAG_UNCERTAIN : 0)),
+      phoneme ? p.symbol : uint8_t{0},
+      phoneme ? p.f0 : uint8_t{0},
+      phoneme ? p.duration_ms : uint16_t{0},
+      static_cast<uint16_t>(event.faps.size())};
+  if (!valid(header)) return false;
+  for (const Fap& f : event.faps) {
+    if (!is_valid(f)) return false;
+  }
+  write_header(header, out.data());
+  for (size_t i = 0; i < event.faps.size(); ++i) {
+    write_fap(event.faps[i], out.data() + pfap_markup_size(static_cast<unsigned>(i)));
+  }
+  return true;
+}
+
+bool read_markup(std::span<const uint8_t> bytes, MarkupEvent& out) {
+  PfapEventHeader h;
+  if (pfap_markup_read_header(bytes.data(), bytes.size(), &h) != 0) return false;
+  out.kind = static_cast<PfapEventKind>(h.kind);
+  out.phoneme = {h.symbol,
+                 h.duration_ms,
+                 h.f0,
+                 (h.flags & PFAP_FLAG_STRESS) != 0,
+                 (h.flags & PFAP_FLAG_WORD_BEGIN) != 0,
+                 (h.flags & PFAP_FLAG_END_OF_TEXT) != 0};
+  out.sentence_start = (h.flags & PFAP_FLAG_SENTENCE_START) != 0;
+  out.uncertain = (h.flags & PFAP_FLAG_UNCERTAIN) != 0;
+  out.faps.resize(h.n_faps);
+  for (unsigned i = 0; i < h.n_faps; ++i) {
+    PfapFap f;
+    pfap_markup_read_fap(bytes.data(), i, &f);
+    out.faps[i] = to_fap(f);
+  }
+  return true;
+}
+
+}  // namespace pfap

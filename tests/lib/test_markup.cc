@@ -5,6 +5,8 @@
 #include <vector>
 
 #include "pfap/markup.h"
+#include "pfap/markup_event.h"
+#include "random_markup.h"
 
 namespace {
 
@@ -119,3 +121,58 @@ TEST(Markup, WriteRefusesOutOfRangeValuesAndWrongSize) {
 }
 
 }  // namespace
+
+namespace pfap {
+namespace {
+
+TEST(MarkupEvent, WritesTheSameBytesAsTheCApi) {
+  MarkupEvent event;
+  event.phoneme = {42, 100, 60, true, true, false};
+  event.sentence_start = true;
+  event.faps = {{69, 40, 2000, Curve::kSpline}, {48, -20000, 0, Curve::kLinear}};
+  Bytes out(markup_size(event));
+  ASSERT_TRUE(write_markup(event, out));
+  EXPECT_EQ(out, kPhonemeEvent);
+  MarkupEvent back;
+  ASSERT_TRUE(read_markup(out, back));
+  EXPECT_EQ(back, event);
+}
+
+TEST(MarkupEvent, RandomEventsOfEveryKindRoundTrip) {
+  pfap::testing::RandomMarkup random(7);
+  for (int n = 0; n < 2000; ++n) {
+    MarkupEvent event;
+    event.kind = static_cast<PfapEventKind>(random.uniform(1, 3));
+    if (event.kind == PFAP_EVENT_PHONEME) {
+      event.phoneme = random.phoneme();
+      event.phoneme.end_of_text = random.chance(0.2);
+      event.sentence_start = random.chance(0.2);
+    }
+    event.uncertain = random.chance(0.2);
+    for (int i = random.uniform(0, 80); i > 0; --i) event.faps.push_back(random.fap());
+    Bytes out(markup_size(event));
+    ASSERT_TRUE(write_markup(event, out)) << n;
+    MarkupEvent back;
+    ASSERT_TRUE(read_markup(out, back)) << n;
+    ASSERT_EQ(back, event) << n;
+  }
+}
+
+TEST(MarkupEvent, InvalidEventsAndWrongSizesAreRefused) {
+  MarkupEvent event;
+  event.faps = {{2, 0, 0, Curve::kLinear}};
+  Bytes out(markup_size(event));
+  EXPECT_FALSE(write_markup(event, out));
+  event.faps = {};
+  event.phoneme.duration_ms = 4096;
+  out.resize(markup_size(event));
+  EXPECT_FALSE(write_markup(event, out));
+  event.phoneme.duration_ms = 1;
+  Bytes wrong(markup_size(event) + 1);
+  EXPECT_FALSE(write_markup(event, wrong));
+  MarkupEvent back;
+  EXPECT_FALSE(read_markup(Bytes{0x01, 0, 0, 0}, back));
+}
+
+}  // namespace
+}  // namespace pfap

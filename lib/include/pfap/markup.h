@@ -48,8 +48,8 @@ typedef enum {
 } PfapEventFlags;
 
 typedef struct {
-  uint8_t kind;         /* PfapEventKind */
-  uint8_t flags;        /* PfapEventFlags */
+  uint8_t kind;  /* PfapEventKind */
+  uint8_t flags; /* PfapEventFlags */
   uint8_t symbol;
   uint8_t f0;           /* units of 2 Hz */
   uint16_t duration_ms; /* 0..4095 */
