@@ -1,34 +1,23 @@
 #include "pfap/fap_state.h"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 
 namespace pfap {
-namespace {
-
-// How far along the way from the start amplitude to the target the curve is at progress
-// u in [0, 1]: 0 is the start amplitude, 1 the target.
-double curve_share(Curve curve, double u) {
-  switch (curve) {
-    case Curve::kTriangle:
-      return 1.0 - std::abs(2.0 * u - 1.0);
-    case Curve::kSpline:
-      return u * u * (3.0 - 2.0 * u);
-    case Curve::kLinear:
-      break;
-  }
-  return u;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 void FapState::apply(const Fap& fap, int64_t start_ns) {
   assert(is_valid(fap));
   // Whatever the track has reached at `start` covers all three starting amplitudes of the
   // draft: 0 before any bookmark, the settled value after one, the curve's value during one.
   const auto from = static_cast<int32_t>(std::lround(amplitude(fap.index, start_ns)));
+  // A triangle is an excursion: the FAP keeps holding what it held before.
+  const int32_t settled =
+      fap.curve == Curve::kTriangle ? tracks_[fap.index].settled : fap.amplitude;
   tracks_[fap.index] = Track{.from = from,
                              .target = fap.amplitude,
+                             .settled = settled,
                              .start_ns = start_ns,
                              .duration_ns = int64_t{fap.transition_ms} * kNsPerMs,
                              .curve = fap.curve};
@@ -40,17 +29,43 @@ double FapState::amplitude(int index, int64_t time_ns) const {
   if (time_ns < track.start_ns) return track.from;
   const int64_t elapsed_ns = time_ns - track.start_ns;
   // Comparing first keeps T = 0 (a jump) away from a division by zero.
-  const double u = elapsed_ns >= track.duration_ns
-                       ? 1.0
-                       : static_cast<double>(elapsed_ns) / static_cast<double>(track.duration_ns);
-  const double way = static_cast<double>(track.target) - track.from;
-  return track.from + way * curve_share(track.curve, u);
+  if (elapsed_ns >= track.duration_ns) return track.settled;
+  const double u = static_cast<double>(elapsed_ns) / static_cast<double>(track.duration_ns);
+  const double from = track.from, target = track.target;
+  switch (track.curve) {
+    case Curve::kTriangle:
+      // Up to the target over the first half, back to the held value over the second.
+      return u < 0.5 ? from + (target - from) * 2.0 * u
+                     : target + (track.settled - target) * (2.0 * u - 1.0);
+    case Curve::kSpline:
+      return from + (target - from) * u * u * (3.0 - 2.0 * u);
+    case Curve::kLinear:
+      break;
+  }
+  return from + (target - from) * u;
 }
 
 int32_t FapState::settled(int index) const {
   assert(index >= kMinFapIndex && index <= kMaxFapIndex);
+  return tracks_[index].settled;
+}
+
+bool FapState::at_rest(int index, int64_t time_ns) const {
+  assert(index >= kMinFapIndex && index <= kMaxFapIndex);
   const Track& track = tracks_[index];
-  return track.curve == Curve::kTriangle ? track.from : track.target;
+  return time_ns - track.start_ns >= track.duration_ns;
+}
+
+Fap FapState::recovery_entry(int index, int64_t time_ns) const {
+  const Track& track = tracks_[index];
+  const auto fap_index = static_cast<uint8_t>(index);
+  if (at_rest(index, time_ns) || track.curve == Curve::kTriangle) {
+    return {fap_index, settled(index), 0, Curve::kLinear};
+  }
+  // Before the start the whole transition is still to come.
+  const int64_t left_ns = track.start_ns + track.duration_ns - std::max(time_ns, track.start_ns);
+  const auto left_ms = static_cast<uint16_t>((left_ns + kNsPerMs - 1) / kNsPerMs);
+  return {fap_index, track.target, left_ms, track.curve};
 }
 
 void FapState::reset() { tracks_.fill(Track{}); }

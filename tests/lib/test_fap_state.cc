@@ -198,6 +198,55 @@ TEST(FapState, ZeroTransitionJumpsAtItsStart) {
   }
 }
 
+// A triangle interrupting a transition goes back to what the FAP held, the previous
+// target, not to the value it happened to reach: settled values depend only on the order of
+// bookmarks, which is what makes recovery exact.
+TEST(FapState, TriangleInterruptingATransitionReturnsToThePreviousTarget) {
+  FapState state;
+  state.apply(make_fap(3, 1000, 1000, Curve::kLinear), kStart);  // 500 at T/2
+  state.apply(make_fap(3, 2000, 400, Curve::kTriangle), kStart + 500 * kMs);
+  EXPECT_DOUBLE_EQ(state.amplitude(3, kStart + 500 * kMs), 500);   // starts where it is
+  EXPECT_DOUBLE_EQ(state.amplitude(3, kStart + 700 * kMs), 2000);  // the peak at T/2
+  EXPECT_DOUBLE_EQ(state.amplitude(3, kStart + 800 * kMs), 1500);  // halfway back
+  EXPECT_DOUBLE_EQ(state.amplitude(3, kStart + 900 * kMs), 1000);  // back at the target
+  EXPECT_DOUBLE_EQ(state.amplitude(3, kStart + 5000 * kMs), 1000);
+  EXPECT_EQ(state.settled(3), 1000);
+}
+
+TEST(FapState, TriangleOnARunningTriangleKeepsTheHeldValue) {
+  FapState state;
+  jump_to(state, 3, 100, 0);
+  state.apply(make_fap(3, 900, 1000, Curve::kTriangle), kStart);
+  state.apply(make_fap(3, -500, 1000, Curve::kTriangle), kStart + 300 * kMs);
+  EXPECT_EQ(state.settled(3), 100);
+  EXPECT_DOUBLE_EQ(state.amplitude(3, kStart + 1300 * kMs), 100);
+}
+
+TEST(FapState, AtRestOnceTheTransitionIsOver) {
+  FapState state;
+  EXPECT_TRUE(state.at_rest(3, 0));
+  state.apply(make_fap(3, 100, 200, Curve::kSpline), kStart);
+  EXPECT_FALSE(state.at_rest(3, kStart));
+  EXPECT_FALSE(state.at_rest(3, kStart + 199 * kMs));
+  EXPECT_TRUE(state.at_rest(3, kStart + 200 * kMs));
+}
+
+TEST(FapState, RecoveryEntryRestoresTheSettledValue) {
+  FapState state;
+  state.apply(make_fap(3, 100, 1000, Curve::kSpline), kStart);
+  // Running: the target and the time left, rounded up to whole ms.
+  EXPECT_EQ(state.recovery_entry(3, kStart + 400 * kMs + 1), make_fap(3, 100, 600, Curve::kSpline));
+  // Not started yet: all of it.
+  EXPECT_EQ(state.recovery_entry(3, kStart - kMs), make_fap(3, 100, 1000, Curve::kSpline));
+  // Over: the settled value at once.
+  EXPECT_EQ(state.recovery_entry(3, kStart + 1000 * kMs), make_fap(3, 100, 0, Curve::kLinear));
+  // A running triangle: the held value at once, its excursion left out.
+  state.apply(make_fap(3, 900, 1000, Curve::kTriangle), kStart + 2000 * kMs);
+  EXPECT_EQ(state.recovery_entry(3, kStart + 2100 * kMs), make_fap(3, 100, 0, Curve::kLinear));
+  // A FAP never bookmarked: 0.
+  EXPECT_EQ(state.recovery_entry(4, kStart), make_fap(4, 0, 0, Curve::kLinear));
+}
+
 TEST(FapState, ZeroTransitionTriangleLeavesNoTrace) {
   FapState state;
   jump_to(state, 3, 100, 0);

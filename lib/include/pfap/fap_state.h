@@ -1,12 +1,16 @@
 // The amplitude of every FAP over time at a receiver (draft section 5).
 //
 // A bookmark's FAP starts from the amplitude actually reached at its start time (0 before
-// any bookmark, the previous target once its transition is over, the value on the curve
-// while it runs), rounded to a whole FAP unit, and moves to its target over T:
-//   C=1 linear:   v(t) = s + (a - s) * u                      u = (t - start) / T in [0, 1]
-//   C=2 triangle: v(t) = s + (a - s) * (1 - |2u - 1|)          back at s when u = 1
-//   C=3 spline:   v(t) = s + (a - s) * u^2 * (3 - 2u)          cubic Hermite, zero slope at ends
-// T = 0 jumps at once (a triangle with T = 0 leaves no trace). docs/format.md has the reasons.
+// any bookmark, the previous settled value once its transition is over, the value on the
+// curve while it runs), rounded to a whole FAP unit, and moves to its target over T:
+//   C=1 linear:   v(t) = s + (a - s) * u                 u = (t - start) / T in [0, 1]
+//   C=2 triangle: v(t) = s + (a - s) * 2u                 for u < 1/2, then
+//                 v(t) = a + (p - a) * (2u - 1)           back to p, what the FAP held before
+//   C=3 spline:   v(t) = s + (a - s) * u^2 * (3 - 2u)     cubic Hermite, zero slope at ends
+// The settled value is a for C=1 and C=3, p for C=2: a triangle is an excursion that leaves
+// what the FAP holds unchanged, so settled values depend only on the order of bookmarks,
+// never on their timing. T = 0 jumps at once (a triangle with T = 0 leaves no trace).
+// docs/format.md has the reasons.
 #pragma once
 
 #include <array>
@@ -24,8 +28,15 @@ class FapState {
   // The amplitude of FAP `index` at `time_ns`, for times at or after the start of the last
   // bookmark applied to it (earlier times give that bookmark's starting amplitude).
   double amplitude(int index, int64_t time_ns) const;
-  // What FAP `index` holds once its transition is over.
+  // What FAP `index` holds once its transition is over (a triangle's p).
   int32_t settled(int index) const;
+  // Whether FAP `index` has no transition running at `time_ns`.
+  bool at_rest(int index, int64_t time_ns) const;
+  // The recovery entry that brings a receiver to this FAP's settled value from `time_ns` on:
+  // the target and the time left (rounded up) of a linear or spline transition still
+  // running, else the settled value at once. A running triangle's excursion is left out:
+  // recovery restores state, and the triangle's state is the value it returns to.
+  Fap recovery_entry(int index, int64_t time_ns) const;
   // Every FAP back to 0 with no transition running, as after construction.
   void reset();
 
@@ -33,6 +44,8 @@ class FapState {
   struct Track {
     int32_t from = 0;  // amplitude when the transition started
     int32_t target = 0;
+    int32_t settled = 0;  // held once the transition is over: the target, or for a
+                          // triangle what the FAP held before it
     int64_t start_ns = 0;
     int64_t duration_ns = 0;
     Curve curve = Curve::kLinear;

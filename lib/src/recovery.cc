@@ -1,0 +1,131 @@
+#include "pfap/recovery.h"
+
+#include <algorithm>
+#include <array>
+#include <cassert>
+#include <cstdlib>
+
+namespace pfap {
+namespace {
+
+// Entries for the FAPs the packets bookmarked whose effect is not over at `time_ns`, one
+// per FAP index in index order, written from the sender's state.
+void entries_for(std::span<const std::vector<RecoverySender::Bookmark>> packets,
+                 const FapState& state, int64_t time_ns, std::vector<Fap>& out) {
+  // A triangle that is over changed nothing a FAP holds (FapState): the draft leaves it out.
+  std::array<bool, kFapCount> in_effect{};
+  for (const auto& packet : packets) {
+    for (const RecoverySender::Bookmark& b : packet) {
+      const bool over = time_ns - b.start_ns >= int64_t{b.fap.transition_ms} * kNsPerMs;
+      in_effect[b.fap.index] |= b.fap.curve != Curve::kTriangle || !over;
+    }
+  }
+  out.clear();
+  for (int index = kMinFapIndex; index <= kMaxFapIndex; ++index) {
+    if (in_effect[index]) out.push_back(state.recovery_entry(index, time_ns));
+  }
+}
+
+}  // namespace
+
+RecoverySender::RecoverySender(unsigned depth) : depth_(depth) {
+  assert(depth == 0 || is_valid_coverage(depth));
+}
+
+void RecoverySender::add_dynamic(Packet& packet, int64_t time_ns, size_t room) const {
+  if (depth_ == 0) return;
+  std::vector<Fap> entries;
+  // The deepest coverage whose entries fit; a shallower one covers a subset of the packets,
+  // so its entries are never more.
+  for (int step = static_cast<int>(std::size(kCoverageSteps)) - 1; step >= 0; --step) {
+    const unsigned coverage = kCoverageSteps[step];
+    if (coverage > depth_) continue;
+    const size_t covered = std::min<size_t>(coverage, window_.size());
+    entries_for(std::span(window_).last(covered), state_, time_ns, entries);
+    if (entries.size() * kFapDescriptorBytes <= room) {
+      packet.recovery_kind = RecoveryKind::kDynamic;
+      packet.covered_packets = static_cast<uint8_t>(coverage);
+      packet.recovery = std::move(entries);
+      return;
+    }
+  }
+}
+
+void RecoverySender::make_complete(Packet& out, int64_t time_ns, size_t room) const {
+  out.clear();
+  out.recovery_kind = RecoveryKind::kComplete;
+  for (int index = kMinFapIndex; index <= kMaxFapIndex; ++index) {
+    const Fap entry = state_.recovery_entry(index, time_ns);
+    if (entry.amplitude != 0) out.recovery.push_back(entry);
+  }
+  const size_t fits = (room - std::min(room, kPacketDescriptorBytes)) / kFapDescriptorBytes;
+  if (out.recovery.size() > fits) {
+    std::stable_sort(out.recovery.begin(), out.recovery.end(), [](const Fap& a, const Fap& b) {
+      return std::abs(a.amplitude) > std::abs(b.amplitude);
+    });
+    out.recovery.resize(fits);
+  }
+}
+
+void RecoverySender::sent(const Packet& packet, int64_t time_ns) {
+  std::vector<Bookmark> bookmarks;
+  int64_t start_ns = time_ns;
+  for (size_t i = 0; i < packet.phonemes.size(); ++i) {
+    for (const Fap& fap : packet.faps_of(i)) {
+      bookmarks.push_back({fap, start_ns});
+      state_.apply(fap, start_ns);
+    }
+    start_ns += int64_t{packet.phonemes[i].phoneme.duration_ms} * kNsPerMs;
+  }
+  if (depth_ == 0) return;
+  if (window_.size() == depth_) window_.erase(window_.begin());
+  window_.push_back(std::move(bookmarks));
+}
+
+void RecoverySender::reset() {
+  window_.clear();
+  state_.reset();
+}
+
+ReceiveResult RecoveryReceiver::receive(const Packet& packet, uint16_t seqnum, int64_t time_ns) {
+  ReceiveResult result;
+  if (last_seqnum_) result.lost = static_cast<uint16_t>(seqnum - *last_seqnum_ - 1);
+  last_seqnum_ = seqnum;
+
+  if (packet.recovery_kind == RecoveryKind::kComplete) {
+    state_.reset();
+    for (const Fap& entry : packet.recovery) state_.apply(entry, time_ns);
+    whole_ = true;
+    result.recovery = ReceiveResult::Recovery::kComplete;
+  } else if (result.lost > 0) {
+    // Recovery information is applied only after a loss, so nothing is applied twice.
+    if (packet.recovery_kind == RecoveryKind::kDynamic && packet.covered_packets >= result.lost) {
+      for (const Fap& entry : packet.recovery) state_.apply(entry, time_ns);
+      result.recovery = ReceiveResult::Recovery::kRecovered;
+    } else {
+      result.request_complete = whole_;  // once per loss that breaks the state
+      whole_ = false;
+    }
+  } else if (!whole_ && !requested_) {
+    result.request_complete = true;  // joined mid-stream
+  }
+  requested_ |= result.request_complete;
+  if (whole_) requested_ = false;
+
+  int64_t start_ns = time_ns;
+  for (size_t i = 0; i < packet.phonemes.size(); ++i) {
+    for (const Fap& fap : packet.faps_of(i)) state_.apply(fap, start_ns);
+    start_ns += int64_t{packet.phonemes[i].phoneme.duration_ms} * kNsPerMs;
+  }
+  result.state_whole = whole_;
+  return result;
+}
+
+void RecoveryReceiver::reset(bool joined_mid_stream) {
+  state_.reset();
+  last_seqnum_.reset();
+  whole_ = !joined_mid_stream;
+  requested_ = false;
+}
+
+}  // namespace pfap
