@@ -1,6 +1,8 @@
 // The pfap plugin: RTP payloading of PFAP streams (draft-ietf-avt-rtp-pfap-00).
 #include <gst/gst.h>
 
+#include "gstpfapparse.h"
+#include "gstpfaptextenc.h"
 #include "gstrtppfapdepay.h"
 #include "gstrtppfappay.h"
 
@@ -8,9 +10,11 @@ static gboolean plugin_init(GstPlugin* plugin) {
   gboolean ok = TRUE;
   ok &= GST_ELEMENT_REGISTER(rtppfappay, plugin);
   ok &= GST_ELEMENT_REGISTER(rtppfapdepay, plugin);
+  ok &= GST_ELEMENT_REGISTER(pfapparse, plugin);
+  ok &= GST_ELEMENT_REGISTER(pfaptextenc, plugin);
   return ok;
 }
 
 GST_PLUGIN_DEFINE(GST_VERSION_MAJOR, GST_VERSION_MINOR, pfap,
-                  "RTP payloading of phoneme and facial animation parameter (PFAP) streams",
+                  "Phoneme and facial animation parameter (PFAP) streams: RTP payloading and text markup",
                   plugin_init, VERSION, "LGPL", GST_PACKAGE_NAME, GST_PACKAGE_ORIGIN)

@@ -581,14 +581,15 @@ TEST(GstInspect, Depayloader) {
   check_element_inspect(kDepay, "stats");
 }
 
-TEST(GstInspect, PluginListsBothElements) {
+TEST(GstInspect, PluginListsAllElements) {
   ASSERT_TRUE(plugin_available());
   const Inspect r = gst_inspect("pfap");
   ASSERT_EQ(r.exit_status, 0) << r.err;
   SCOPED_TRACE("gst-inspect-1.0 pfap:\n" + r.out);
   const std::vector<std::string> lines = lines_of(r.out);
   EXPECT_EQ(detail(lines, "Name"), "pfap");
-  for (const char* name : {kPay, kDepay}) {
+  for (const char* name : {kPay, kDepay, "pfapparse", "pfaptextenc"}) {
+    SCOPED_TRACE(name);
     GstElementFactory* factory = gst_element_factory_find(name);
     ASSERT_NE(factory, nullptr);
     const std::string line =
@@ -597,8 +598,8 @@ TEST(GstInspect, PluginListsBothElements) {
     gst_object_unref(factory);
     EXPECT_NE(std::find(lines.begin(), lines.end(), line), lines.end()) << "no line: " << line;
   }
-  EXPECT_NE(r.out.find("2 features:"), std::string::npos);
-  EXPECT_NE(r.out.find("+-- 2 elements"), std::string::npos);
+  EXPECT_NE(r.out.find("4 features:"), std::string::npos);
+  EXPECT_NE(r.out.find("+-- 4 elements"), std::string::npos);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -1,0 +1,426 @@
+// The example pipelines stay on one line, to be copied.
+// clang-format off
+/**
+ * SECTION:element-pfapparse
+ * @title: pfapparse
+ * @see_also: pfaptextenc, rtppfappay
+ *
+ * Reads the .pfap text format (docs/text-format.md: UTF-8, one phoneme or FAP state event per
+ * line) and outputs one application/x-pfap buffer per event, laid out as pfap/markup.h
+ * describes. A buffer's PTS is the time on its line, counted from the start of the stream;
+ * a phoneme's DURATION is its duration, a state event has none. The first phoneme and the
+ * one after an end of text (flag E) have the SENTENCE_START flag; the first buffer after a
+ * start or flush is DISCONT. The output is a TIME segment from 0, so a sink with sync=true
+ * plays the events in real time. Upstream segments and gaps are dropped: the times come from
+ * the text.
+ *
+ * The input may come in any chunks (filesrc's 4096-byte blocks, or a byte at a time); lines
+ * end at '\n' or "\r\n", and a last line without one is read at EOS. Blank and comment
+ * lines give nothing.
+ *
+ * A bad line (a field that does not parse, time going back, bad bookmarks, invalid UTF-8,
+ * more than 65536 bytes, or a time past about 292 years) is an
+ * error naming its line, its column (in bytes, from 1) and what is wrong; with
+ * #GstPfapParse:skip-bad-lines it is a warning instead, and the lines after it are read as
+ * usual. Input that arrives from sources without caps (filesrc, fdsrc) is taken as .pfap
+ * text; caps, when given, must be text/x-raw,format=utf8 or text/plain.
+ *
+ * Seeking is not supported: the text must be read from its start, as times and sentence
+ * starts depend on the lines before. A flush starts the text anew: the next line is line 1,
+ * may be earlier than the lines before, and its phoneme starts a sentence.
+ *
+ * ## Example pipelines
+ * |[
+ * gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfapparse ! rtppfappay ! udpsink host=127.0.0.1 port=5004
+ * ]| Sends the phonemes and FAPs of hello.pfap as PFAP RTP packets to port 5004, in real time.
+ * |[
+ * cat docs/examples/hello.pfap | gst-launch-1.0 fdsrc ! pfapparse skip-bad-lines=true ! fakesink dump=true
+ * ]| Reads .pfap text from standard input, warns about bad lines and dumps each event.
+ */
+// clang-format on
+#include "gstpfapparse.h"
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "pfap/model.h"
+#include "pfap/text.h"
+#include "pfapbuffer.h"
+
+GST_DEBUG_CATEGORY_STATIC(pfapparse_debug);
+#define GST_CAT_DEFAULT pfapparse_debug
+
+namespace {
+
+// Far above any real line (a state listing every FAP is about 2 KiB); bounds the memory a
+// stream without line ends takes, and the FAPs of one event to what x-pfap holds.
+constexpr size_t kMaxLineBytes = 64 * 1024;
+
+enum { PROP_0, PROP_SKIP_BAD_LINES, PROP_ALPHABET };
+
+// What the streaming thread keeps between buffers. GObject runs no C++ constructors, so it
+// lives behind a pointer made in init and deleted in finalize.
+struct Stream {
+  pfap::TextReader reader;
+  std::string tail;         // the start of a line whose end has not come yet
+  uint64_t line = 1;        // the number of the line being read, from 1
+  bool skipping = false;    // dropping the rest of an over-long line
+  bool need_events = true;  // stream-start, caps or segment still to send
+  bool discont = true;
+};
+
+}  // namespace
+
+struct _GstPfapParse {
+  GstElement parent;
+  GstPad* sinkpad;
+  GstPad* srcpad;
+  gboolean skip_bad_lines;  // under the object lock
+  gchar* alphabet;          // under the object lock; NULL when unset
+  Stream* stream;
+};
+
+// No caps from filesrc and fdsrc: the template only matters to sources that send caps.
+static GstStaticPadTemplate sink_template =
+    GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS,
+                            GST_STATIC_CAPS("text/x-raw, format = (string) utf8; text/plain"));
+
+static GstStaticPadTemplate src_template =
+    GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
+
+G_DEFINE_TYPE(GstPfapParse, gst_pfap_parse, GST_TYPE_ELEMENT)
+GST_ELEMENT_REGISTER_DEFINE(pfapparse, "pfapparse", GST_RANK_NONE, GST_TYPE_PFAP_PARSE)
+
+// Back to the start of a stream (READY to PAUSED, FLUSH_STOP).
+static void reset(GstPfapParse* self) {
+  Stream& s = *self->stream;
+  s.reader.reset();
+  s.tail.clear();
+  s.line = 1;
+  s.skipping = false;
+  s.need_events = true;
+  s.discont = true;
+}
+
+// Phonemes come only while someone speaks: sparse tells queues, muxers and aggregators
+// downstream not to wait for our data.
+static GstEvent* make_sparse(GstEvent* event) {
+  event = gst_event_make_writable(event);
+  GstStreamFlags flags;
+  gst_event_parse_stream_flags(event, &flags);
+  gst_event_set_stream_flags(event, static_cast<GstStreamFlags>(flags | GST_STREAM_FLAG_SPARSE));
+  return event;
+}
+
+// The sticky events a buffer or EOS needs before it: upstream's stream-start was forwarded
+// if there was one; caps stay across a flush, the segment does not.
+static void send_events(GstPfapParse* self) {
+  Stream& s = *self->stream;
+  if (!s.need_events) return;
+  s.need_events = false;
+  if (GstEvent* start = gst_pad_get_sticky_event(self->srcpad, GST_EVENT_STREAM_START, 0)) {
+    gst_event_unref(start);
+  } else {
+    gchar* id = gst_pad_create_stream_id(self->srcpad, GST_ELEMENT(self), nullptr);
+    gst_pad_push_event(self->srcpad, make_sparse(gst_event_new_stream_start(id)));
+    g_free(id);
+  }
+  if (!gst_pad_has_current_caps(self->srcpad)) {
+    GstCaps* caps = gst_static_pad_template_get_caps(&src_template);
+    GST_OBJECT_LOCK(self);
+    if (self->alphabet != nullptr) {
+      caps = gst_caps_make_writable(caps);
+      gst_caps_set_simple(caps, "alphabet", G_TYPE_STRING, self->alphabet, nullptr);
+    }
+    GST_OBJECT_UNLOCK(self);
+    gst_pad_push_event(self->srcpad, gst_event_new_caps(caps));
+    gst_caps_unref(caps);
+  }
+  GstSegment segment;
+  gst_segment_init(&segment, GST_FORMAT_TIME);
+  gst_pad_push_event(self->srcpad, gst_event_new_segment(&segment));
+}
+
+// A line that cannot be read: an error, or with skip-bad-lines a warning and reading goes on.
+// `column` is a byte offset in the line.
+static GstFlowReturn bad_line(GstPfapParse* self, size_t column, const std::string& what) {
+  GST_OBJECT_LOCK(self);
+  const bool skip = self->skip_bad_lines;
+  GST_OBJECT_UNLOCK(self);
+  const uint64_t line = self->stream->line;
+  if (skip) {
+    GST_ELEMENT_WARNING(self, STREAM, DECODE,
+                        ("Skipped .pfap line %" G_GUINT64_FORMAT ", column %zu: %s", line,
+                         column + 1, what.c_str()),
+                        (nullptr));
+    return GST_FLOW_OK;
+  }
+  GST_ELEMENT_ERROR(
+      self, STREAM, DECODE,
+      ("Bad .pfap line %" G_GUINT64_FORMAT ", column %zu: %s", line, column + 1, what.c_str()),
+      ("set skip-bad-lines to warn and go on"));
+  return GST_FLOW_ERROR;
+}
+
+static GstFlowReturn push_event(GstPfapParse* self, const pfap::TextEvent& event) {
+  Stream& s = *self->stream;
+  GstBuffer* buffer = pfap_buffer_new(event.event);
+  if (buffer == nullptr) {
+    // TextReader gives values within range, and kMaxLineBytes bounds the FAPs: a bug.
+    GST_ELEMENT_ERROR(self, STREAM, FAILED, (nullptr),
+                      ("line %" G_GUINT64_FORMAT " gives an event x-pfap cannot hold", s.line));
+    return GST_FLOW_ERROR;
+  }
+  GST_BUFFER_PTS(buffer) = event.time_ms * GST_MSECOND;
+  if (event.event.kind == PFAP_EVENT_PHONEME) {
+    GST_BUFFER_DURATION(buffer) = event.event.phoneme.duration_ms * GST_MSECOND;
+  }
+  if (s.discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
+  s.discont = false;
+  send_events(self);
+  GST_LOG_OBJECT(self, "line %" G_GUINT64_FORMAT ": event kind %d at %" GST_TIME_FORMAT, s.line,
+                 event.event.kind, GST_TIME_ARGS(GST_BUFFER_PTS(buffer)));
+  return gst_pad_push(self->srcpad, buffer);
+}
+
+// Reads one whole line, without its '\n' (TextReader drops the '\r' of a "\r\n").
+static GstFlowReturn read_line(GstPfapParse* self, std::string_view line) {
+  const gchar* valid_end = nullptr;
+  if (!g_utf8_validate(line.data(), static_cast<gssize>(line.size()), &valid_end)) {
+    return bad_line(self, static_cast<size_t>(valid_end - line.data()), "not UTF-8");
+  }
+  pfap::TextEvent event;
+  bool has_event = false;
+  const pfap::TextResult result = self->stream->reader.read_line(line, event, has_event);
+  if (!result.ok()) {
+    std::string what = pfap::to_string(result.status);
+    if (result.status == pfap::TextStatus::kBadBookmark) {
+      what.append(": ").append(pfap::to_string(result.bookmark));
+    }
+    return bad_line(self, result.column, what);
+  }
+  if (!has_event) return GST_FLOW_OK;
+  return push_event(self, event);
+}
+
+// Splits `data` into lines, completing the tail kept from the chunks before and keeping the
+// new incomplete one.
+static GstFlowReturn read_chunk(GstPfapParse* self, std::string_view data) {
+  Stream& s = *self->stream;
+  while (!data.empty()) {
+    const size_t end = data.find('\n');
+    const std::string_view piece = data.substr(0, end);
+    GstFlowReturn ret = GST_FLOW_OK;
+    if (s.skipping) {
+      // Nothing: the line was reported when it grew too long.
+    } else if (s.tail.size() + piece.size() > kMaxLineBytes) {
+      s.tail.clear();
+      s.skipping = true;
+      ret =
+          bad_line(self, kMaxLineBytes, "longer than " + std::to_string(kMaxLineBytes) + " bytes");
+    } else if (end == std::string_view::npos) {
+      s.tail.append(piece);
+    } else if (s.tail.empty()) {
+      ret = read_line(self, piece);  // whole in this chunk: no copy
+    } else {
+      s.tail.append(piece);
+      ret = read_line(self, s.tail);
+      s.tail.clear();
+    }
+    if (ret != GST_FLOW_OK || end == std::string_view::npos) return ret;
+    ++s.line;
+    s.skipping = false;
+    data.remove_prefix(end + 1);
+  }
+  return GST_FLOW_OK;
+}
+
+static GstFlowReturn gst_pfap_parse_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
+  GstPfapParse* self = GST_PFAP_PARSE(parent);
+  GstMapInfo map;
+  if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) {
+    gst_buffer_unref(buffer);
+    GST_ELEMENT_ERROR(self, RESOURCE, READ, (nullptr), ("cannot map the input buffer"));
+    return GST_FLOW_ERROR;
+  }
+  const GstFlowReturn ret = read_chunk(self, {reinterpret_cast<const char*>(map.data), map.size});
+  gst_buffer_unmap(buffer, &map);
+  gst_buffer_unref(buffer);
+  return ret;
+}
+
+static gboolean gst_pfap_parse_sink_event(GstPad* pad, GstObject* parent, GstEvent* event) {
+  GstPfapParse* self = GST_PFAP_PARSE(parent);
+  Stream& s = *self->stream;
+  switch (GST_EVENT_TYPE(event)) {
+    case GST_EVENT_STREAM_START:
+      return gst_pad_push_event(self->srcpad, make_sparse(event));
+    // Text caps and upstream times say nothing about the output: our caps and segment go
+    // before the first buffer.
+    case GST_EVENT_CAPS:
+    case GST_EVENT_SEGMENT:
+    case GST_EVENT_GAP:
+      gst_event_unref(event);
+      return TRUE;
+    case GST_EVENT_EOS:
+      // The last line may have no line end.
+      if (!s.skipping && !s.tail.empty()) {
+        const GstFlowReturn ret = read_line(self, s.tail);
+        s.tail.clear();
+        // The error is posted; the stream did not end well.
+        if (ret == GST_FLOW_ERROR) {
+          gst_event_unref(event);
+          return FALSE;
+        }
+      }
+      send_events(self);
+      break;
+    case GST_EVENT_FLUSH_STOP:
+      reset(self);
+      break;
+    default:
+      break;
+  }
+  return gst_pad_event_default(pad, parent, event);
+}
+
+// Seeking would need the lines before the target (times and sentence starts depend on
+// them), so it is refused rather than passed to a source that might accept it.
+static gboolean gst_pfap_parse_src_event(GstPad* pad, GstObject* parent, GstEvent* event) {
+  if (GST_EVENT_TYPE(event) == GST_EVENT_SEEK) {
+    gst_event_unref(event);
+    return FALSE;
+  }
+  return gst_pad_event_default(pad, parent, event);
+}
+
+static gboolean gst_pfap_parse_src_query(GstPad* pad, GstObject* parent, GstQuery* query) {
+  if (GST_QUERY_TYPE(query) == GST_QUERY_SEEKING) {
+    GstFormat format;
+    gst_query_parse_seeking(query, &format, nullptr, nullptr, nullptr);
+    gst_query_set_seeking(query, format, FALSE, -1, -1);
+    return TRUE;
+  }
+  return gst_pad_query_default(pad, parent, query);
+}
+
+static GstStateChangeReturn gst_pfap_parse_change_state(GstElement* element,
+                                                        GstStateChange transition) {
+  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) reset(GST_PFAP_PARSE(element));
+  return GST_ELEMENT_CLASS(gst_pfap_parse_parent_class)->change_state(element, transition);
+}
+
+static void gst_pfap_parse_set_property(GObject* object, guint prop_id, const GValue* value,
+                                        GParamSpec* pspec) {
+  GstPfapParse* self = GST_PFAP_PARSE(object);
+  switch (prop_id) {
+    case PROP_SKIP_BAD_LINES:
+      GST_OBJECT_LOCK(self);
+      self->skip_bad_lines = g_value_get_boolean(value);
+      GST_OBJECT_UNLOCK(self);
+      break;
+    case PROP_ALPHABET:
+      GST_OBJECT_LOCK(self);
+      g_free(self->alphabet);
+      self->alphabet = g_value_dup_string(value);
+      GST_OBJECT_UNLOCK(self);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
+}
+
+static void gst_pfap_parse_get_property(GObject* object, guint prop_id, GValue* value,
+                                        GParamSpec* pspec) {
+  GstPfapParse* self = GST_PFAP_PARSE(object);
+  switch (prop_id) {
+    case PROP_SKIP_BAD_LINES:
+      GST_OBJECT_LOCK(self);
+      g_value_set_boolean(value, self->skip_bad_lines);
+      GST_OBJECT_UNLOCK(self);
+      break;
+    case PROP_ALPHABET:
+      GST_OBJECT_LOCK(self);
+      g_value_set_string(value, self->alphabet);
+      GST_OBJECT_UNLOCK(self);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
+}
+
+static void gst_pfap_parse_finalize(GObject* object) {
+  delete GST_PFAP_PARSE(object)->stream;
+  g_free(GST_PFAP_PARSE(object)->alphabet);
+  G_OBJECT_CLASS(gst_pfap_parse_parent_class)->finalize(object);
+}
+
+static void gst_pfap_parse_class_init(GstPfapParseClass* klass) {
+  GObjectClass* gobject_class = G_OBJECT_CLASS(klass);
+  GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
+
+  GST_DEBUG_CATEGORY_INIT(pfapparse_debug, "pfapparse", 0, "PFAP text parser");
+
+  gobject_class->set_property = gst_pfap_parse_set_property;
+  gobject_class->get_property = gst_pfap_parse_get_property;
+  gobject_class->finalize = gst_pfap_parse_finalize;
+
+  /**
+   * GstPfapParse:skip-bad-lines:
+   *
+   * What a bad line does: FALSE (the default) posts an error and stops the stream; TRUE
+   * posts a warning naming the line and what is wrong with it, drops the line and reads on.
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_SKIP_BAD_LINES,
+      g_param_spec_boolean("skip-bad-lines", "Skip bad lines",
+                           "Warn about a bad line and go on, instead of an error", FALSE,
+                           static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                    GST_PARAM_MUTABLE_PLAYING)));
+
+  /**
+   * GstPfapParse:alphabet:
+   *
+   * The name of the phoneme alphabet the file's symbol numbers come from (a .pfap file holds
+   * numbers only). Set, it becomes the `alphabet` field of the output caps, which
+   * rtppfappay carries to the SDP as an fmtp parameter.
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_ALPHABET,
+      g_param_spec_string("alphabet", "Phoneme alphabet",
+                          "Name of the phoneme alphabet of the symbol numbers, for the caps "
+                          "and SDP (unset: none)",
+                          nullptr,
+                          static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                   GST_PARAM_MUTABLE_READY)));
+
+  gst_element_class_add_static_pad_template(element_class, &sink_template);
+  gst_element_class_add_static_pad_template(element_class, &src_template);
+  gst_element_class_set_static_metadata(
+      element_class, "PFAP text parser", "Codec/Parser/Text",
+      "Reads phonemes and facial animation parameters (PFAP) from .pfap text as "
+      "application/x-pfap events",
+      "gst-pfap developers");
+
+  element_class->change_state = gst_pfap_parse_change_state;
+}
+
+static void gst_pfap_parse_init(GstPfapParse* self) {
+  self->sinkpad = gst_pad_new_from_static_template(&sink_template, "sink");
+  gst_pad_set_chain_function(self->sinkpad, gst_pfap_parse_chain);
+  gst_pad_set_event_function(self->sinkpad, gst_pfap_parse_sink_event);
+  gst_element_add_pad(GST_ELEMENT(self), self->sinkpad);
+
+  self->srcpad = gst_pad_new_from_static_template(&src_template, "src");
+  gst_pad_use_fixed_caps(self->srcpad);
+  gst_pad_set_event_function(self->srcpad, gst_pfap_parse_src_event);
+  gst_pad_set_query_function(self->srcpad, gst_pfap_parse_src_query);
+  gst_element_add_pad(GST_ELEMENT(self), self->srcpad);
+
+  self->skip_bad_lines = FALSE;
+  self->alphabet = nullptr;
+  self->stream = new Stream{};
+}

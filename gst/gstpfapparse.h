@@ -1,0 +1,12 @@
+#pragma once
+
+#include <gst/gst.h>
+
+G_BEGIN_DECLS
+
+#define GST_TYPE_PFAP_PARSE (gst_pfap_parse_get_type())
+G_DECLARE_FINAL_TYPE(GstPfapParse, gst_pfap_parse, GST, PFAP_PARSE, GstElement)
+
+GST_ELEMENT_REGISTER_DECLARE(pfapparse);
+
+G_END_DECLS

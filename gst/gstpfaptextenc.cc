@@ -1,0 +1,228 @@
+// The example pipeline stays on one line, to be copied.
+// clang-format off
+/**
+ * SECTION:element-pfaptextenc
+ * @title: pfaptextenc
+ * @see_also: pfapparse, rtppfapdepay
+ *
+ * Writes a phoneme / facial animation parameter (PFAP) stream as .pfap text, the format
+ * pfapparse reads (pfap/text.h): each application/x-pfap buffer becomes one output buffer
+ * holding its canonical line and a newline, with the input's PTS and duration. Written to a
+ * file, the lines read back with pfapparse as the same phonemes, FAPs and state events.
+ *
+ * A line's time is the event's running time less the first event's, in ms rounded to the
+ * nearest: a received stream starts at 0, and a new segment does not move the origin. A
+ * flush, or going from READY to PAUSED, starts again: the next event is at 0.
+ *
+ * An event without a PTS starts where the previous one ended (a phoneme lasts its duration,
+ * a state event none), the first one where the segment begins. An event earlier than the
+ * one before it is written at that one's time, with a warning: the format wants times that
+ * never go back. A malformed buffer is dropped with a warning and the stream goes on.
+ *
+ * The format has no flag for an event the receiver is unsure of (its FAP state may be
+ * incomplete after a loss): such a line ends with the comment `# uncertain`, which readers
+ * skip. Sentence starts are not written either: the format implies them at the first
+ * phoneme and after each end of text.
+ *
+ * ## Example pipeline
+ * |[
+ * gst-launch-1.0 udpsrc port=5004 caps="application/x-rtp,media=application,clock-rate=44100,encoding-name=PFAP" ! rtpjitterbuffer ! rtppfapdepay ! pfaptextenc ! filesink location=received.pfap
+ * ]| Receives a PFAP stream on UDP port 5004 and writes it to received.pfap, which
+ * `filesrc location=received.pfap ! pfapparse` reads back.
+ */
+// clang-format on
+#include "gstpfaptextenc.h"
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "pfap/model.h"
+#include "pfap/text.h"
+#include "pfapbuffer.h"
+
+GST_DEBUG_CATEGORY_STATIC(pfaptextenc_debug);
+#define GST_CAT_DEFAULT pfaptextenc_debug
+
+namespace {
+
+// What the streaming thread keeps between buffers. GObject runs no C++ constructors, so it
+// lives behind a pointer made in init and deleted in finalize.
+struct Stream {
+  Stream() { gst_segment_init(&segment, GST_FORMAT_TIME); }
+
+  GstSegment segment;
+  std::optional<int64_t> origin_ns;  // the first event's running time: line time 0
+  int64_t last_ns = 0;               // the previous event's running time, once there is one
+  int64_t end_ns = 0;                // where the previous event ended
+  // Reused for every buffer so that steady streaming does not allocate.
+  pfap::TextEvent text;
+  std::string line;
+};
+
+// The running time of `pts`, negative before the segment start; none without a PTS.
+std::optional<int64_t> running_time(const GstSegment& segment, GstClockTime pts) {
+  guint64 time = 0;
+  switch (gst_segment_to_running_time_full(&segment, GST_FORMAT_TIME, pts, &time)) {
+    case 1:
+      return static_cast<int64_t>(time);
+    case -1:
+      return -static_cast<int64_t>(time);
+    default:
+      return std::nullopt;
+  }
+}
+
+}  // namespace
+
+struct _GstPfapTextEnc {
+  GstElement parent;
+  GstPad* sinkpad;
+  GstPad* srcpad;
+  Stream* stream;
+};
+
+static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
+    "sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
+
+static GstStaticPadTemplate src_template = GST_STATIC_PAD_TEMPLATE(
+    "src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS("text/x-raw, format = (string) utf8"));
+
+G_DEFINE_TYPE(GstPfapTextEnc, gst_pfap_text_enc, GST_TYPE_ELEMENT)
+GST_ELEMENT_REGISTER_DEFINE(pfaptextenc, "pfaptextenc", GST_RANK_NONE, GST_TYPE_PFAP_TEXT_ENC)
+
+// Forgets the segment and the time origin (FLUSH_STOP, READY to PAUSED).
+static void reset(GstPfapTextEnc* self) {
+  gst_segment_init(&self->stream->segment, GST_FORMAT_TIME);
+  self->stream->origin_ns.reset();
+}
+
+// The line time of the event just read, whose buffer has `pts`.
+static int64_t line_time_ms(GstPfapTextEnc* self, GstClockTime pts) {
+  Stream& s = *self->stream;
+  int64_t time = 0;
+  if (const std::optional<int64_t> t = running_time(s.segment, pts)) {
+    time = *t;
+  } else {
+    // Phonemes follow one another, so a source that leaves the PTS out means the previous
+    // event's end; a first event is where the segment begins, whose running time is base.
+    time = s.origin_ns ? s.end_ns : static_cast<int64_t>(s.segment.base);
+  }
+  if (!s.origin_ns) {
+    s.origin_ns = time;
+  } else if (time < s.last_ns) {
+    GST_ELEMENT_WARNING(self, STREAM, FORMAT,
+                        ("A PFAP event is earlier than the one before it; written at that "
+                         "one's time."),
+                        ("PTS %" GST_TIME_FORMAT ", running time %" GST_STIME_FORMAT
+                         " is before %" GST_STIME_FORMAT,
+                         GST_TIME_ARGS(pts), GST_STIME_ARGS(time), GST_STIME_ARGS(s.last_ns)));
+    time = s.last_ns;
+  }
+  const pfap::MarkupEvent& event = s.text.event;
+  s.last_ns = time;
+  s.end_ns =
+      time + (event.kind == PFAP_EVENT_PHONEME ? event.phoneme.duration_ms * pfap::kNsPerMs : 0);
+  return (time - *s.origin_ns + pfap::kNsPerMs / 2) / pfap::kNsPerMs;
+}
+
+static GstFlowReturn gst_pfap_text_enc_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
+  GstPfapTextEnc* self = GST_PFAP_TEXT_ENC(parent);
+  Stream& s = *self->stream;
+  if (!pfap_buffer_read(buffer, s.text.event)) {
+    GST_ELEMENT_WARNING(self, STREAM, DECODE, ("Dropped a malformed PFAP event."),
+                        ("%" G_GSIZE_FORMAT " bytes at %" GST_TIME_FORMAT
+                         " are not a valid application/x-pfap event",
+                         gst_buffer_get_size(buffer), GST_TIME_ARGS(GST_BUFFER_PTS(buffer))));
+    gst_buffer_unref(buffer);
+    return GST_FLOW_OK;
+  }
+
+  s.text.time_ms = line_time_ms(self, GST_BUFFER_PTS(buffer));
+  s.line.clear();
+  pfap::format_text_line(s.text, s.line);
+  // The format has no flag for it; a comment tells the reader and pfapparse skips it.
+  if (s.text.event.uncertain) s.line += " # uncertain";
+  GST_LOG_OBJECT(self, "%s", s.line.c_str());
+  s.line += '\n';
+
+  GstBuffer* out = gst_buffer_new_memdup(s.line.data(), s.line.size());
+  GST_BUFFER_PTS(out) = GST_BUFFER_PTS(buffer);
+  GST_BUFFER_DURATION(out) = GST_BUFFER_DURATION(buffer);
+  if (GST_BUFFER_IS_DISCONT(buffer)) GST_BUFFER_FLAG_SET(out, GST_BUFFER_FLAG_DISCONT);
+  gst_buffer_unref(buffer);
+  return gst_pad_push(self->srcpad, out);
+}
+
+static gboolean gst_pfap_text_enc_sink_event(GstPad* pad, GstObject* parent, GstEvent* event) {
+  GstPfapTextEnc* self = GST_PFAP_TEXT_ENC(parent);
+  switch (GST_EVENT_TYPE(event)) {
+    case GST_EVENT_CAPS: {
+      // Whatever the input caps say (an alphabet), the text is the same.
+      gst_event_unref(event);
+      GstCaps* caps = gst_static_pad_template_get_caps(&src_template);
+      const gboolean ok = gst_pad_set_caps(self->srcpad, caps);
+      gst_caps_unref(caps);
+      return ok;
+    }
+    case GST_EVENT_SEGMENT: {
+      GstSegment segment;
+      gst_event_copy_segment(event, &segment);
+      if (segment.format != GST_FORMAT_TIME) {
+        GST_ELEMENT_ERROR(
+            self, STREAM, FORMAT, (nullptr),
+            ("%s segment: x-pfap streams have TIME segments", gst_format_get_name(segment.format)));
+        gst_event_unref(event);
+        return FALSE;
+      }
+      self->stream->segment = segment;
+      break;
+    }
+    case GST_EVENT_FLUSH_STOP:
+      reset(self);
+      break;
+    default:
+      break;
+  }
+  return gst_pad_event_default(pad, parent, event);
+}
+
+static GstStateChangeReturn gst_pfap_text_enc_change_state(GstElement* element,
+                                                           GstStateChange transition) {
+  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) reset(GST_PFAP_TEXT_ENC(element));
+  return GST_ELEMENT_CLASS(gst_pfap_text_enc_parent_class)->change_state(element, transition);
+}
+
+static void gst_pfap_text_enc_finalize(GObject* object) {
+  delete GST_PFAP_TEXT_ENC(object)->stream;
+  G_OBJECT_CLASS(gst_pfap_text_enc_parent_class)->finalize(object);
+}
+
+static void gst_pfap_text_enc_class_init(GstPfapTextEncClass* klass) {
+  GObjectClass* gobject_class = G_OBJECT_CLASS(klass);
+  GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
+
+  GST_DEBUG_CATEGORY_INIT(pfaptextenc_debug, "pfaptextenc", 0, "PFAP text writer");
+
+  gobject_class->finalize = gst_pfap_text_enc_finalize;
+
+  gst_element_class_add_static_pad_template(element_class, &sink_template);
+  gst_element_class_add_static_pad_template(element_class, &src_template);
+  gst_element_class_set_static_metadata(
+      element_class, "PFAP text encoder", "Codec/Encoder/Text",
+      "Writes phoneme and facial animation parameter (PFAP) streams as .pfap text, one line "
+      "per event",
+      "gst-pfap developers");
+
+  element_class->change_state = gst_pfap_text_enc_change_state;
+}
+
+static void gst_pfap_text_enc_init(GstPfapTextEnc* self) {
+  self->stream = new Stream{};
+  self->sinkpad = gst_pad_new_from_static_template(&sink_template, "sink");
+  gst_pad_set_chain_function(self->sinkpad, gst_pfap_text_enc_chain);
+  gst_pad_set_event_function(self->sinkpad, gst_pfap_text_enc_sink_event);
+  gst_element_add_pad(GST_ELEMENT(self), self->sinkpad);
+  self->srcpad = gst_pad_new_from_static_template(&src_template, "src");
+  gst_element_add_pad(GST_ELEMENT(self), self->srcpad);
+}

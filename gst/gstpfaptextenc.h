@@ -1,0 +1,12 @@
+#pragma once
+
+#include <gst/gst.h>
+
+G_BEGIN_DECLS
+
+#define GST_TYPE_PFAP_TEXT_ENC (gst_pfap_text_enc_get_type())
+G_DECLARE_FINAL_TYPE(GstPfapTextEnc, gst_pfap_text_enc, GST, PFAP_TEXT_ENC, GstElement)
+
+GST_ELEMENT_REGISTER_DECLARE(pfaptextenc);
+
+G_END_DECLS

@@ -1,0 +1,864 @@
+// What users run, end to end: the sample sessions in docs/examples/, tools/pfap-loopback, the
+// RTSP server example and the commands of docs/elements.md, "Text markup: sending and
+// receiving a session".
+//  - ExampleFiles.*: every docs/examples/*.pfap parses without a warning, reads back the same
+//    through pfapparse ! pfaptextenc, and is described in docs/examples/README.md.
+//  - Loopback.*: pfap-loopback returns every round-trip sample (all files without comments
+//    or state lines) byte for byte, at several MTUs, and reports bad input.
+//  - Rtsp.ServesAudioAndPhonemes: pfap-rtsp-server as a subprocess and an rtspsrc client: the
+//    SDP and the caps carry the alphabet, audio arrives, every phoneme arrives.
+//  - DocumentedLines.*: each command block of that docs section, run as written but with free
+//    ports, the source tree's docs/examples/ and temporary output files.
+//
+// meson passes PFAP_SOURCE_DIR, PFAP_LOOPBACK and PFAP_RTSP_SERVER, and GST_PLUGIN_PATH in the
+// environment (the subprocesses inherit it). Everything is on 127.0.0.1, on port 0 or on free
+// ports found by binding port 0; every wait is bounded.
+#include <arpa/inet.h>
+#include <gst/gst.h>
+#include <gst/sdp/gstsdpmessage.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <csignal>
+#include <cstdint>
+#include <cstdlib>
+#include <map>
+#include <mutex>
+#include <regex>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using namespace std::chrono_literals;
+
+constexpr const char* kSection = "## Text markup: sending and receiving a session";
+constexpr const char* kAlphabet = "x-pfap-arpabet";
+// rtpbin and rtspsrc time phonemes from arrival times and RTCP; they may move a line by a ms
+// or two on a loaded machine.
+constexpr int64_t kLiveToleranceMs = 20;
+
+// ---------------------------------------------------------------------------------------------
+// Files
+
+std::string source_path(const std::string& relative) {
+  return std::string(PFAP_SOURCE_DIR) + "/" + relative;
+}
+
+std::string read_file(const std::string& path) {
+  gchar* contents = nullptr;
+  gsize length = 0;
+  if (!g_file_get_contents(path.c_str(), &contents, &length, nullptr)) return "<cannot read>";
+  std::string text(contents, length);
+  g_free(contents);
+  return text;
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  size_t start = 0;
+  while (start < text.size()) {
+    size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    lines.push_back(text.substr(start, end - start));
+    start = end + 1;
+  }
+  return lines;
+}
+
+// The lines that carry an event (not blank, not comment-only), each with its '\n'.
+std::string event_lines(const std::string& text) {
+  std::string out;
+  for (const std::string& line : lines_of(text)) {
+    const size_t first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line[first] == '#') continue;
+    out += line + "\n";
+  }
+  return out;
+}
+
+size_t count_events(const std::string& text) { return lines_of(event_lines(text)).size(); }
+
+std::string base_name(const std::string& path) { return path.substr(path.rfind('/') + 1); }
+
+// docs/examples/*.pfap, full paths, sorted.
+std::vector<std::string> example_files() {
+  std::vector<std::string> files;
+  const std::string dir = source_path("docs/examples");
+  GDir* d = g_dir_open(dir.c_str(), 0, nullptr);
+  if (d == nullptr) return files;
+  while (const gchar* name = g_dir_read_name(d)) {
+    if (g_str_has_suffix(name, ".pfap")) files.push_back(dir + "/" + name);
+  }
+  g_dir_close(d);
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// A round-trip sample: canonical lines only, so no comments and no state lines (rtppfappay
+// does not send state events yet).
+bool is_round_trip_sample(const std::string& text) {
+  return text.find('#') == std::string::npos && text.find(" state ") == std::string::npos;
+}
+
+std::vector<std::string> round_trip_samples() {
+  std::vector<std::string> samples;
+  for (const std::string& file : example_files()) {
+    if (is_round_trip_sample(read_file(file))) samples.push_back(file);
+  }
+  return samples;
+}
+
+// A directory removed with its files on destruction.
+class TempDir {
+ public:
+  TempDir() {
+    gchar* path = g_dir_make_tmp("pfap-examples-XXXXXX", nullptr);
+    path_ = path != nullptr ? path : "";
+    g_free(path);
+  }
+  ~TempDir() {
+    GDir* d = g_dir_open(path_.c_str(), 0, nullptr);
+    if (d != nullptr) {
+      while (const gchar* name = g_dir_read_name(d)) std::remove((path_ + "/" + name).c_str());
+      g_dir_close(d);
+    }
+    rmdir(path_.c_str());
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+
+ private:
+  std::string path_;
+};
+
+// Sessions compared line by line: the same events, times within `tolerance_ms`.
+::testing::AssertionResult same_session(const std::string& got, const std::string& want,
+                                        int64_t tolerance_ms) {
+  const std::vector<std::string> g = lines_of(got);
+  const std::vector<std::string> w = lines_of(want);
+  if (g.size() != w.size()) {
+    return ::testing::AssertionFailure() << g.size() << " lines, want " << w.size() << "; got:\n"
+                                         << got;
+  }
+  for (size_t i = 0; i < g.size(); ++i) {
+    const size_t gs = g[i].find(' ');
+    const size_t ws = w[i].find(' ');
+    if (gs == std::string::npos || ws == std::string::npos || g[i].substr(gs) != w[i].substr(ws) ||
+        std::llabs(std::atoll(g[i].c_str()) - std::atoll(w[i].c_str())) > tolerance_ms) {
+      return ::testing::AssertionFailure()
+             << "line " << i + 1 << ": got\n  " << g[i] << "\nwant\n  " << w[i];
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Processes and ports
+
+struct ProcessResult {
+  int status = -1;  // exit status, -1 when it did not exit normally
+  std::string out;
+  std::string err;
+};
+
+ProcessResult run(const std::vector<std::string>& args) {
+  std::vector<gchar*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<gchar*>(a.c_str()));
+  argv.push_back(nullptr);
+  ProcessResult r;
+  gchar* out = nullptr;
+  gchar* err = nullptr;
+  gint wait_status = 0;
+  GError* error = nullptr;
+  if (!g_spawn_sync(nullptr, argv.data(), nullptr, G_SPAWN_DEFAULT, nullptr, nullptr, &out, &err,
+                    &wait_status, &error)) {
+    r.err = std::string("cannot run ") + args[0] + ": " + error->message;
+    g_error_free(error);
+    return r;
+  }
+  r.out = out;
+  r.err = err;
+  g_free(out);
+  g_free(err);
+  r.status = WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : -1;
+  return r;
+}
+
+// UDP ports on 127.0.0.1 that were free a moment ago: each bound to port 0 by the system,
+// all held until the last is found (so they differ), then released for the pipelines.
+std::vector<int> free_udp_ports(size_t n) {
+  std::vector<int> sockets;
+  std::vector<int> ports;
+  for (size_t i = 0; i < n; ++i) {
+    const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    address.sin_port = 0;
+    socklen_t length = sizeof address;
+    if (fd < 0 || bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 ||
+        getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) != 0) {
+      ADD_FAILURE() << "cannot bind a UDP socket on 127.0.0.1";
+      if (fd >= 0) close(fd);
+      break;
+    }
+    sockets.push_back(fd);
+    ports.push_back(ntohs(address.sin_port));
+  }
+  for (int fd : sockets) close(fd);
+  return ports;
+}
+
+// pfap-rtsp-server FILE 0 as a subprocess: the URL it prints, SIGTERM on stop().
+class RtspServer {
+ public:
+  explicit RtspServer(const std::string& file) {
+    std::string program = PFAP_RTSP_SERVER;
+    std::string port = "0";
+    std::string path = file;
+    gchar* argv[] = {program.data(), path.data(), port.data(), nullptr};
+    gint out_fd = -1;
+    GError* error = nullptr;
+    if (!g_spawn_async_with_pipes(nullptr, argv, nullptr, G_SPAWN_DO_NOT_REAP_CHILD, nullptr,
+                                  nullptr, &pid_, nullptr, &out_fd, nullptr, &error)) {
+      ADD_FAILURE() << "cannot start " << program << ": " << error->message;
+      g_error_free(error);
+      return;
+    }
+    started_ = true;
+    // The first line of standard output is the URL.
+    const auto deadline = Clock::now() + 10s;
+    std::string line;
+    while (line.find('\n') == std::string::npos && Clock::now() < deadline) {
+      pollfd p{out_fd, POLLIN, 0};
+      if (poll(&p, 1, 100) <= 0) continue;
+      char chunk[256];
+      const ssize_t n = read(out_fd, chunk, sizeof chunk);
+      if (n <= 0) break;
+      line.append(chunk, static_cast<size_t>(n));
+    }
+    close(out_fd);
+    if (line.find('\n') != std::string::npos) url_ = line.substr(0, line.find('\n'));
+  }
+  ~RtspServer() { stop(); }
+  RtspServer(const RtspServer&) = delete;
+  RtspServer& operator=(const RtspServer&) = delete;
+
+  const std::string& url() const { return url_; }
+
+  // Sends SIGTERM and returns the exit status (-1 if it had to be killed or did not exit).
+  int stop() {
+    if (!started_) return status_;
+    started_ = false;
+    kill(pid_, SIGTERM);
+    int wait_status = 0;
+    const auto deadline = Clock::now() + 5s;
+    pid_t done = 0;
+    while ((done = waitpid(pid_, &wait_status, WNOHANG)) == 0 && Clock::now() < deadline) {
+      std::this_thread::sleep_for(10ms);
+    }
+    if (done == 0) {
+      kill(pid_, SIGKILL);
+      waitpid(pid_, &wait_status, 0);
+      return status_ = -1;
+    }
+    g_spawn_close_pid(pid_);
+    return status_ = WIFEXITED(wait_status) ? WEXITSTATUS(wait_status) : -1;
+  }
+
+ private:
+  GPid pid_ = 0;
+  bool started_ = false;
+  int status_ = -1;
+  std::string url_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Pipelines
+
+// A pipeline from a launch description, set to NULL and released on destruction.
+class Pipeline {
+ public:
+  explicit Pipeline(const std::string& description) {
+    GError* error = nullptr;
+    GstElement* element = gst_parse_launch(description.c_str(), &error);
+    if (error != nullptr) {
+      error_ = std::string(error->message) + " in: " + description;
+      g_error_free(error);
+      if (element != nullptr) gst_object_unref(element);
+      return;
+    }
+    pipeline_ = element;
+  }
+  ~Pipeline() {
+    if (pipeline_ == nullptr) return;
+    gst_element_set_state(pipeline_, GST_STATE_NULL);
+    gst_object_unref(pipeline_);
+  }
+  Pipeline(const Pipeline&) = delete;
+  Pipeline& operator=(const Pipeline&) = delete;
+
+  GstElement* get() const { return pipeline_; }
+  const std::string& error() const { return error_; }
+
+  // The first element made by `factory`, searched through bins (not a new reference).
+  GstElement* find(const char* factory) const {
+    GstElement* found = nullptr;
+    GstIterator* it = gst_bin_iterate_recurse(GST_BIN(pipeline_));
+    GValue item = G_VALUE_INIT;
+    while (found == nullptr && gst_iterator_next(it, &item) == GST_ITERATOR_OK) {
+      auto* element = GST_ELEMENT(g_value_get_object(&item));
+      GstElementFactory* f = gst_element_get_factory(element);
+      if (f != nullptr && std::string(GST_OBJECT_NAME(f)) == factory) found = element;
+      g_value_reset(&item);
+    }
+    g_value_unset(&item);
+    gst_iterator_free(it);
+    return found;
+  }
+
+  // Starts it: a live pipeline completes PLAYING only when data comes, so no waiting here.
+  ::testing::AssertionResult play() {
+    if (gst_element_set_state(pipeline_, GST_STATE_PLAYING) == GST_STATE_CHANGE_FAILURE) {
+      return ::testing::AssertionFailure() << "cannot start: " << bus_error();
+    }
+    return ::testing::AssertionSuccess();
+  }
+
+  // An error (or, with warnings, a warning) posted so far, or "".
+  std::string bus_error(bool warnings = false) {
+    GstBus* bus = gst_element_get_bus(pipeline_);
+    const auto types = static_cast<GstMessageType>(
+        GST_MESSAGE_ERROR | (warnings ? GST_MESSAGE_WARNING : GST_MESSAGE_UNKNOWN));
+    std::string text;
+    while (GstMessage* message = gst_bus_pop_filtered(bus, types)) {
+      text += describe(message);
+      gst_message_unref(message);
+    }
+    gst_object_unref(bus);
+    return text;
+  }
+
+  // Waits for EOS; fails on an error, a warning (with `warnings`) or after `timeout`.
+  ::testing::AssertionResult wait_eos(GstClockTime timeout, bool warnings = false) {
+    GstBus* bus = gst_element_get_bus(pipeline_);
+    const auto types =
+        static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR |
+                                    (warnings ? GST_MESSAGE_WARNING : GST_MESSAGE_UNKNOWN));
+    GstMessage* message = gst_bus_timed_pop_filtered(bus, timeout, types);
+    gst_object_unref(bus);
+    if (message == nullptr) return ::testing::AssertionFailure() << "no EOS in time";
+    const bool eos = GST_MESSAGE_TYPE(message) == GST_MESSAGE_EOS;
+    const std::string text = describe(message);
+    gst_message_unref(message);
+    if (!eos) return ::testing::AssertionFailure() << text;
+    return ::testing::AssertionSuccess();
+  }
+
+  // Sends EOS into every source, as gst-launch-1.0 -e does on Ctrl-C, and waits for it.
+  ::testing::AssertionResult end(GstClockTime timeout) {
+    gst_element_send_event(pipeline_, gst_event_new_eos());
+    return wait_eos(timeout);
+  }
+
+ private:
+  static std::string describe(GstMessage* message) {
+    GError* error = nullptr;
+    gchar* debug = nullptr;
+    if (GST_MESSAGE_TYPE(message) == GST_MESSAGE_ERROR) {
+      gst_message_parse_error(message, &error, &debug);
+    } else if (GST_MESSAGE_TYPE(message) == GST_MESSAGE_WARNING) {
+      gst_message_parse_warning(message, &error, &debug);
+    } else {
+      return GST_MESSAGE_TYPE_NAME(message);
+    }
+    std::string text = std::string(GST_MESSAGE_TYPE_NAME(message)) + " from " +
+                       GST_OBJECT_NAME(GST_MESSAGE_SRC(message)) + ": " + error->message + " (" +
+                       (debug != nullptr ? debug : "") + ")\n";
+    g_error_free(error);
+    g_free(debug);
+    return text;
+  }
+
+  GstElement* pipeline_ = nullptr;
+  std::string error_;
+};
+
+// What flows out of an element's src pad: the bytes (text from pfaptextenc) and a count.
+struct Tap {
+  std::mutex mutex;
+  std::string bytes;
+  size_t buffers = 0;
+  size_t size = 0;
+
+  void attach(GstElement* element) {
+    ASSERT_NE(element, nullptr);
+    GstPad* pad = gst_element_get_static_pad(element, "src");
+    gst_pad_add_probe(pad, GST_PAD_PROBE_TYPE_BUFFER, on_buffer, this, nullptr);
+    gst_object_unref(pad);
+  }
+
+  std::string text() {
+    std::lock_guard lock(mutex);
+    return bytes;
+  }
+  size_t lines() {
+    std::lock_guard lock(mutex);
+    return static_cast<size_t>(std::count(bytes.begin(), bytes.end(), '\n'));
+  }
+  size_t count() {
+    std::lock_guard lock(mutex);
+    return buffers;
+  }
+  size_t total_size() {
+    std::lock_guard lock(mutex);
+    return size;
+  }
+
+ private:
+  static GstPadProbeReturn on_buffer(GstPad*, GstPadProbeInfo* info, gpointer data) {
+    auto* tap = static_cast<Tap*>(data);
+    GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+    GstMapInfo map;
+    if (gst_buffer_map(buffer, &map, GST_MAP_READ)) {
+      std::lock_guard lock(tap->mutex);
+      tap->bytes.append(reinterpret_cast<const char*>(map.data), map.size);
+      tap->buffers += 1;
+      tap->size += map.size;
+      gst_buffer_unmap(buffer, &map);
+    }
+    return GST_PAD_PROBE_OK;
+  }
+};
+
+// Waits until `done` holds, failing on a pipeline error or after `timeout`.
+template <typename Done>
+::testing::AssertionResult wait_until(std::vector<Pipeline*> pipelines, Done done,
+                                      std::chrono::milliseconds timeout, const char* what) {
+  const auto deadline = Clock::now() + timeout;
+  while (!done()) {
+    for (Pipeline* p : pipelines) {
+      const std::string error = p->bus_error();
+      if (!error.empty()) return ::testing::AssertionFailure() << error;
+    }
+    if (Clock::now() > deadline) return ::testing::AssertionFailure() << "timed out: " << what;
+    std::this_thread::sleep_for(20ms);
+  }
+  return ::testing::AssertionSuccess();
+}
+
+::testing::AssertionResult plugin_available() {
+  for (const char* name : {"pfapparse", "pfaptextenc", "rtppfappay", "rtppfapdepay"}) {
+    GstElementFactory* factory = gst_element_factory_find(name);
+    if (factory == nullptr) {
+      const char* path = g_getenv("GST_PLUGIN_PATH");
+      return ::testing::AssertionFailure()
+             << "no element " << name << "; GST_PLUGIN_PATH=" << (path != nullptr ? path : "")
+             << " should be the build's gst/ directory";
+    }
+    gst_object_unref(factory);
+  }
+  return ::testing::AssertionSuccess();
+}
+
+// ---------------------------------------------------------------------------------------------
+// The documented commands
+
+// The commands in the ```sh blocks under `heading` (to the next heading) in the docs section:
+// comment lines dropped, lines ending in '\' joined.
+std::vector<std::string> documented_commands(const std::string& heading) {
+  const std::vector<std::string> lines = lines_of(read_file(source_path("docs/elements.md")));
+  std::vector<std::string> commands;
+  bool in_section = false, in_heading = false, in_block = false, continued = false;
+  for (const std::string& line : lines) {
+    if (!in_block && line.rfind("## ", 0) == 0) in_section = line == kSection;
+    if (!in_section) continue;
+    if (!in_block && line.rfind("### ", 0) == 0) in_heading = line == heading;
+    if (!in_heading) continue;
+    if (line.rfind("```", 0) == 0) {
+      in_block = !in_block;
+      continue;
+    }
+    if (!in_block || (!continued && line.rfind('#', 0) == 0)) continue;
+    std::string part = line;
+    const bool continues = !part.empty() && part.back() == '\\';
+    if (continues) part.pop_back();
+    if (continued) {
+      commands.back() += " " + part.substr(part.find_first_not_of(' '));
+    } else {
+      commands.push_back(part);
+    }
+    continued = continues;
+  }
+  for (std::string& c : commands) {
+    while (!c.empty() && c.back() == ' ') c.pop_back();
+  }
+  return commands;
+}
+
+const std::vector<std::string> kHeadings = {
+    "### One process", "### Over UDP", "### Next to audio: one rtpbin on each side", "### RTSP"};
+
+// A documented command made runnable here: documented ports mapped to free ones (the same
+// documented port to the same free port), docs/examples/ to the source tree's, the output
+// files to `dir`, the RTSP URL to `rtsp_url`.
+class Substitution {
+ public:
+  Substitution(const TempDir& dir, std::string rtsp_url = "")
+      : dir_(dir), rtsp_url_(std::move(rtsp_url)) {}
+
+  std::string operator()(std::string command) {
+    replace_all(command, "docs/examples/", source_path("docs/examples/"));
+    replace_all(command, "received.pfap", dir_.file("received.pfap"));
+    replace_all(command, "received.wav", dir_.file("received.wav"));
+    if (!rtsp_url_.empty()) replace_all(command, "rtsp://127.0.0.1:8554/pfap", rtsp_url_);
+    static const std::regex port("port=([0-9]+)");
+    std::string out;
+    auto last = command.cbegin();
+    for (std::sregex_iterator it(command.begin(), command.end(), port), end; it != end; ++it) {
+      out.append(last, (*it)[0].first);
+      out += "port=" + std::to_string(free_port(std::stoi((*it)[1].str())));
+      last = (*it)[0].second;
+    }
+    out.append(last, command.cend());
+    return out;
+  }
+
+  // The launch description of a gst-launch-1.0 command (without the program and -e).
+  std::string launch(const std::string& command) {
+    std::string c = (*this)(command);
+    for (const char* prefix : {"gst-launch-1.0 ", "-e "}) {
+      if (c.rfind(prefix, 0) == 0) c = c.substr(std::string(prefix).size());
+    }
+    return c;
+  }
+
+ private:
+  static void replace_all(std::string& s, const std::string& from, const std::string& to) {
+    for (size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size())) {
+      s.replace(at, from.size(), to);
+    }
+  }
+
+  int free_port(int documented) {
+    auto it = ports_.find(documented);
+    if (it != ports_.end()) return it->second;
+    const std::vector<int> free = free_udp_ports(1);
+    const int port = free.empty() ? documented : free[0];
+    ports_[documented] = port;
+    return port;
+  }
+
+  const TempDir& dir_;
+  std::string rtsp_url_;
+  std::map<int, int> ports_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// ExampleFiles
+
+TEST(ExampleFiles, ThereAreRoundTripSamplesAndStates) {
+  const std::vector<std::string> files = example_files();
+  ASSERT_GE(files.size(), 5u) << "docs/examples/*.pfap";
+  const std::vector<std::string> samples = round_trip_samples();
+  EXPECT_EQ(samples.size(), files.size() - 1) << "every file but states.pfap is a round trip";
+  EXPECT_FALSE(is_round_trip_sample(read_file(source_path("docs/examples/states.pfap"))));
+}
+
+TEST(ExampleFiles, DescribedInReadme) {
+  const std::string readme = read_file(source_path("docs/examples/README.md"));
+  for (const std::string& file : example_files()) {
+    EXPECT_NE(readme.find("| `" + base_name(file) + "` |"), std::string::npos)
+        << base_name(file) << " has no row in docs/examples/README.md";
+  }
+}
+
+TEST(ExampleFiles, EveryFileParses) {
+  ASSERT_TRUE(plugin_available());
+  for (const std::string& file : example_files()) {
+    SCOPED_TRACE(file);
+    Pipeline p("filesrc name=file ! pfapparse name=parse ! fakesink");
+    ASSERT_TRUE(p.error().empty()) << p.error();
+    GstElement* filesrc = p.find("filesrc");
+    g_object_set(filesrc, "location", file.c_str(), nullptr);
+    Tap events;
+    events.attach(p.find("pfapparse"));
+    ASSERT_TRUE(p.play());
+    EXPECT_TRUE(p.wait_eos(5 * GST_SECOND, /*warnings=*/true));
+    EXPECT_EQ(events.count(), count_events(read_file(file)));
+  }
+}
+
+// Canonical lines read and written back unchanged; comments are not written.
+TEST(ExampleFiles, ReadBackThroughTextEnc) {
+  ASSERT_TRUE(plugin_available());
+  for (const std::string& file : example_files()) {
+    SCOPED_TRACE(file);
+    Pipeline p("filesrc name=file ! pfapparse ! pfaptextenc ! fakesink");
+    ASSERT_TRUE(p.error().empty()) << p.error();
+    g_object_set(p.find("filesrc"), "location", file.c_str(), nullptr);
+    Tap text;
+    text.attach(p.find("pfaptextenc"));
+    ASSERT_TRUE(p.play());
+    ASSERT_TRUE(p.wait_eos(5 * GST_SECOND, /*warnings=*/true));
+    EXPECT_EQ(text.text(), event_lines(read_file(file)));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Loopback: tools/pfap-loopback
+
+TEST(Loopback, RoundTripIsByteIdentical) {
+  const std::vector<std::string> samples = round_trip_samples();
+  ASSERT_FALSE(samples.empty());
+  // The default MTU, where max-delay makes the packets, and MTUs that split them further (at
+  // 60 a few phonemes with many FAPs go alone in larger packets, with a warning).
+  for (const char* mtu : {"", "--mtu=80", "--mtu=60"}) {
+    for (const std::string& file : samples) {
+      SCOPED_TRACE(file + " " + mtu);
+      std::vector<std::string> args = {PFAP_LOOPBACK, "--timeout=10"};
+      if (*mtu != '\0') args.push_back(mtu);
+      args.push_back(file);
+      const ProcessResult r = run(args);
+      ASSERT_EQ(r.status, 0) << r.err;
+      EXPECT_EQ(r.out, read_file(file)) << r.err;
+      EXPECT_NE(r.err.find("(0 malformed, 0 lost)"), std::string::npos) << r.err;
+    }
+  }
+}
+
+TEST(Loopback, ReportsErrors) {
+  TempDir dir;
+  {
+    const ProcessResult r = run({PFAP_LOOPBACK, dir.file("missing.pfap")});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("not a readable file"), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "");
+  }
+  {
+    const ProcessResult r = run({PFAP_LOOPBACK});
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("usage:"), std::string::npos) << r.err;
+  }
+  {
+    const std::string bad = dir.file("bad.pfap");
+    ASSERT_TRUE(g_file_set_contents(bad.c_str(), "0 16 60 118 W\n60 3 70 124 WS\n", -1, nullptr));
+    const ProcessResult r = run({PFAP_LOOPBACK, "--timeout=10", bad});
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.err.find("sender: "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("line 2"), std::string::npos) << r.err;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Rtsp: examples/pfap-rtsp-server
+
+struct Sdp {
+  std::mutex mutex;
+  std::string text;
+
+  static void on_sdp(GstElement*, GstSDPMessage* message, gpointer data) {
+    auto* sdp = static_cast<Sdp*>(data);
+    gchar* text = gst_sdp_message_as_text(message);
+    std::lock_guard lock(sdp->mutex);
+    sdp->text = text;
+    g_free(text);
+  }
+  std::string get() {
+    std::lock_guard lock(mutex);
+    return text;
+  }
+};
+
+TEST(Rtsp, ServesAudioAndPhonemes) {
+  ASSERT_TRUE(plugin_available());
+  const std::string file = source_path("docs/examples/hello.pfap");
+  const std::string want = read_file(file);
+  RtspServer server(file);
+  ASSERT_EQ(server.url().rfind("rtsp://127.0.0.1:", 0), 0u) << "URL: " << server.url();
+
+  Pipeline client("rtspsrc name=src location=" + server.url() +
+                  " src. ! rtpL16depay ! fakesink sync=false"
+                  " src. ! rtppfapdepay ! pfaptextenc ! fakesink sync=false");
+  ASSERT_TRUE(client.error().empty()) << client.error();
+  Sdp sdp;
+  g_signal_connect(client.find("rtspsrc"), "on-sdp", G_CALLBACK(Sdp::on_sdp), &sdp);
+  Tap audio, text;
+  audio.attach(client.find("rtpL16depay"));
+  text.attach(client.find("pfaptextenc"));
+  ASSERT_TRUE(client.play());
+  ASSERT_TRUE(wait_until(
+      {&client}, [&] { return text.lines() >= count_events(want) && audio.count() >= 10; }, 15s,
+      "every phoneme and 10 audio buffers"))
+      << text.lines() << " lines, " << audio.count() << " audio buffers";
+
+  // The alphabet in the SDP, the RTP caps and the depayloaded caps.
+  const std::string description = sdp.get();
+  EXPECT_NE(description.find("a=fmtp:97 alphabet=" + std::string(kAlphabet)), std::string::npos)
+      << description;
+  EXPECT_NE(description.find("a=rtpmap:97 PFAP/44100"), std::string::npos) << description;
+  GstPad* pad = gst_element_get_static_pad(client.find("rtppfapdepay"), "src");
+  GstCaps* caps = gst_pad_get_current_caps(pad);
+  ASSERT_NE(caps, nullptr);
+  const gchar* alphabet = gst_structure_get_string(gst_caps_get_structure(caps, 0), "alphabet");
+  EXPECT_STREQ(alphabet, kAlphabet);
+  gst_caps_unref(caps);
+  gst_object_unref(pad);
+
+  EXPECT_TRUE(same_session(text.text(), want, kLiveToleranceMs));
+  EXPECT_GT(audio.total_size(), 0u);
+  gst_element_set_state(client.get(), GST_STATE_NULL);
+  EXPECT_EQ(server.stop(), 0) << "the server ends with status 0 on SIGTERM";
+}
+
+// ---------------------------------------------------------------------------------------------
+// DocumentedLines: docs/elements.md, "Text markup: sending and receiving a session"
+
+// Every command of the section is under a heading that a test below runs, and the examples'
+// README shows no gst-launch-1.0 line of its own.
+TEST(DocumentedLines, EveryCommandIsTested) {
+  const std::string doc = read_file(source_path("docs/elements.md"));
+  const size_t start = doc.find(kSection);
+  ASSERT_NE(start, std::string::npos) << kSection;
+  size_t in_section = 0;
+  bool in_block = false;
+  for (const std::string& line : lines_of(doc.substr(start))) {
+    if (line.rfind("```", 0) == 0) in_block = !in_block;
+    if (in_block && (line.rfind("gst-launch-1.0", 0) == 0 || line.rfind("build/", 0) == 0)) {
+      ++in_section;
+    }
+  }
+  size_t tested = 0;
+  for (const std::string& heading : kHeadings) {
+    const size_t n = documented_commands(heading).size();
+    EXPECT_GT(n, 0u) << heading;
+    tested += n;
+  }
+  EXPECT_EQ(tested, in_section);
+  for (const std::string& line : lines_of(read_file(source_path("docs/examples/README.md")))) {
+    EXPECT_NE(line.rfind("gst-launch-1.0", 0), 0u)
+        << "untested in docs/examples/README.md: " << line;
+  }
+}
+
+TEST(DocumentedLines, OneProcess) {
+  const std::vector<std::string> commands = documented_commands(kHeadings[0]);
+  ASSERT_EQ(commands.size(), 1u);
+  TempDir dir;
+  Substitution substitute(dir);
+  std::vector<std::string> args;
+  gchar** argv = g_strsplit(substitute(commands[0]).c_str(), " ", -1);
+  for (gchar** a = argv; *a != nullptr; ++a) args.emplace_back(*a);
+  g_strfreev(argv);
+  ASSERT_EQ(args.size(), 2u) << commands[0];
+  ASSERT_EQ(args[0], "build/tools/pfap-loopback");
+  args[0] = PFAP_LOOPBACK;
+  const ProcessResult r = run(args);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, read_file(args[1]));
+}
+
+TEST(DocumentedLines, Udp) {
+  ASSERT_TRUE(plugin_available());
+  const std::vector<std::string> commands = documented_commands(kHeadings[1]);
+  ASSERT_EQ(commands.size(), 2u);
+  TempDir dir;
+  Substitution substitute(dir);
+  Pipeline receiver(substitute.launch(commands[0]));
+  Pipeline sender(substitute.launch(commands[1]));
+  ASSERT_TRUE(receiver.error().empty()) << receiver.error();
+  ASSERT_TRUE(sender.error().empty()) << sender.error();
+  const std::string want = read_file(source_path("docs/examples/hello.pfap"));
+  Tap text;
+  text.attach(receiver.find("pfaptextenc"));
+
+  ASSERT_TRUE(receiver.play());  // bound once set_state returns
+  ASSERT_TRUE(sender.play());
+  ASSERT_TRUE(sender.wait_eos(10 * GST_SECOND)) << "the sender sends in real time";
+  ASSERT_TRUE(wait_until(
+      {&receiver}, [&] { return text.lines() >= count_events(want); }, 5s, "every phoneme"));
+  ASSERT_TRUE(receiver.end(5 * GST_SECOND));
+  EXPECT_EQ(read_file(dir.file("received.pfap")), want);
+}
+
+TEST(DocumentedLines, Rtpbin) {
+  ASSERT_TRUE(plugin_available());
+  const std::vector<std::string> commands = documented_commands(kHeadings[2]);
+  ASSERT_EQ(commands.size(), 2u);
+  TempDir dir;
+  Substitution substitute(dir);
+  Pipeline receiver(substitute.launch(commands[0]));
+  Pipeline sender(substitute.launch(commands[1]));
+  ASSERT_TRUE(receiver.error().empty()) << receiver.error();
+  ASSERT_TRUE(sender.error().empty()) << sender.error();
+  const std::string want = read_file(source_path("docs/examples/hello.pfap"));
+  Tap text, audio;
+  text.attach(receiver.find("pfaptextenc"));
+  audio.attach(receiver.find("rtpL16depay"));
+
+  ASSERT_TRUE(receiver.play());
+  ASSERT_TRUE(sender.play());
+  ASSERT_TRUE(wait_until(
+      {&receiver, &sender},
+      [&] { return text.lines() >= count_events(want) && audio.count() >= 10; }, 10s,
+      "every phoneme and 10 audio buffers"))
+      << text.lines() << " lines, " << audio.count() << " audio buffers";
+  ASSERT_TRUE(receiver.end(5 * GST_SECOND));
+  gst_element_set_state(sender.get(), GST_STATE_NULL);
+
+  EXPECT_TRUE(same_session(read_file(dir.file("received.pfap")), want, kLiveToleranceMs));
+  const std::string wav = read_file(dir.file("received.wav"));
+  EXPECT_EQ(wav.rfind("RIFF", 0), 0u);
+  EXPECT_GT(wav.size(), 44u + 4410u * 2) << "at least 0.1 s of audio";
+}
+
+TEST(DocumentedLines, Rtsp) {
+  ASSERT_TRUE(plugin_available());
+  const std::vector<std::string> commands = documented_commands(kHeadings[3]);
+  ASSERT_EQ(commands.size(), 2u);
+  // The server command: the program, the file and the port, which becomes 0 (any free port).
+  TempDir dir;
+  Substitution files(dir);
+  gchar** argv = g_strsplit(files(commands[0]).c_str(), " ", -1);
+  ASSERT_EQ(g_strv_length(argv), 3u) << commands[0];
+  EXPECT_STREQ(argv[0], "build/examples/pfap-rtsp-server");
+  EXPECT_STREQ(argv[2], "8554");
+  const std::string file = argv[1];
+  g_strfreev(argv);
+  RtspServer server(file);
+  ASSERT_EQ(server.url().rfind("rtsp://127.0.0.1:", 0), 0u) << "URL: " << server.url();
+
+  Substitution substitute(dir, server.url());
+  Pipeline client(substitute.launch(commands[1]));
+  ASSERT_TRUE(client.error().empty()) << client.error();
+  const std::string want = read_file(file);
+  Tap text, audio;
+  text.attach(client.find("pfaptextenc"));
+  audio.attach(client.find("rtpL16depay"));
+  ASSERT_TRUE(client.play());
+  ASSERT_TRUE(wait_until(
+      {&client}, [&] { return text.lines() >= count_events(want) && audio.count() >= 10; }, 15s,
+      "every phoneme and 10 audio buffers"))
+      << text.lines() << " lines, " << audio.count() << " audio buffers";
+  ASSERT_TRUE(client.end(5 * GST_SECOND));
+
+  EXPECT_TRUE(same_session(read_file(dir.file("received.pfap")), want, kLiveToleranceMs));
+  const std::string wav = read_file(dir.file("received.wav"));
+  EXPECT_EQ(wav.rfind("RIFF", 0), 0u);
+  EXPECT_GT(wav.size(), 44u + 4410u * 2) << "at least 0.1 s of audio";
+  gst_element_set_state(client.get(), GST_STATE_NULL);  // TEARDOWN while the server is there
+  EXPECT_EQ(server.stop(), 0);
+}
+
+}  // namespace
