@@ -89,12 +89,19 @@ void RecoverySender::reset() {
 
 ReceiveResult RecoveryReceiver::receive(const Packet& packet, uint16_t seqnum, int64_t time_ns) {
   ReceiveResult result;
-  if (last_seqnum_) result.lost = static_cast<uint16_t>(seqnum - *last_seqnum_ - 1);
+  if (last_seqnum_) {
+    const auto gap = static_cast<uint16_t>(seqnum - *last_seqnum_ - 1);
+    result.lost = gap < 0x8000 ? gap : 0;
+  }
   last_seqnum_ = seqnum;
 
   if (packet.recovery_kind == RecoveryKind::kComplete) {
+    const FapState before = state_;
     state_.reset();
     for (const Fap& entry : packet.recovery) state_.apply(entry, time_ns);
+    for (int f = kMinFapIndex; f <= kMaxFapIndex && !result.changed; ++f) {
+      result.changed = state_.settled(f) != before.settled(f);
+    }
     whole_ = true;
     result.recovery = ReceiveResult::Recovery::kComplete;
   } else if (result.lost > 0) {
@@ -102,15 +109,17 @@ ReceiveResult RecoveryReceiver::receive(const Packet& packet, uint16_t seqnum, i
     if (packet.recovery_kind == RecoveryKind::kDynamic && packet.covered_packets >= result.lost) {
       for (const Fap& entry : packet.recovery) state_.apply(entry, time_ns);
       result.recovery = ReceiveResult::Recovery::kRecovered;
-    } else {
-      result.request_complete = whole_;  // once per loss that breaks the state
+    } else if (whole_) {
       whole_ = false;
+      last_request_ns_.reset();
     }
-  } else if (!whole_ && !requested_) {
-    result.request_complete = true;  // joined mid-stream
   }
-  requested_ |= result.request_complete;
-  if (whole_) requested_ = false;
+  if (whole_) {
+    last_request_ns_.reset();
+  } else if (!last_request_ns_ || time_ns - *last_request_ns_ >= retry_ns_) {
+    result.request_complete = true;
+    last_request_ns_ = time_ns;
+  }
 
   int64_t start_ns = time_ns;
   for (size_t i = 0; i < packet.phonemes.size(); ++i) {
@@ -125,7 +134,7 @@ void RecoveryReceiver::reset(bool joined_mid_stream) {
   state_.reset();
   last_seqnum_.reset();
   whole_ = !joined_mid_stream;
-  requested_ = false;
+  last_request_ns_.reset();
 }
 
 }  // namespace pfap

@@ -144,8 +144,9 @@ TEST(Recovery, WithoutRecoveryLossLeavesTheStateWrong) {
 
 TEST(Recovery, BurstLongerThanCoverageBreaksTheStateUntilACompleteState) {
   const std::vector<SentPacket> packets = send_session(5, 2000, 4, 50);
-  RecoveryReceiver lossless, lossy;
+  RecoveryReceiver lossless, lossy(/*retry_ns=*/int64_t{1} << 62);  // no retries
   bool requested = false, broke = false, whole_again = false;
+  int repeats = 0;
   for (size_t i = 0; i < packets.size(); ++i) {
     const SentPacket& s = packets[i];
     lossless.receive(s.packet, s.seqnum, s.time_ns);
@@ -163,11 +164,47 @@ TEST(Recovery, BurstLongerThanCoverageBreaksTheStateUntilACompleteState) {
       }
     } else if (broke && !whole_again) {
       EXPECT_FALSE(r.state_whole);
-      EXPECT_FALSE(r.request_complete) << "asked once per loss";
+      if (r.request_complete) ++repeats;  // only after the retry interval
     }
   }
   EXPECT_TRUE(requested);
   EXPECT_TRUE(whole_again);
+  EXPECT_EQ(repeats, 0) << "asked once per loss";
+}
+
+TEST(RecoveryReceiver, AsksAgainEachRetryIntervalWhileNotWhole) {
+  RecoveryReceiver r(/*retry_ns=*/1000 * kNsPerMs);
+  r.reset(/*joined_mid_stream=*/true);
+  Packet p;
+  p.add_phoneme({.duration_ms = 100}, {});
+  std::vector<int64_t> asked_at;
+  for (int i = 0; i < 30; ++i) {
+    if (r.receive(p, static_cast<uint16_t>(i), i * 100 * kNsPerMs).request_complete) {
+      asked_at.push_back(i * 100);
+    }
+  }
+  EXPECT_EQ(asked_at, (std::vector<int64_t>{0, 1000, 2000}));
+}
+
+TEST(RecoveryReceiver, CompleteStateSaysWhetherItChangedAnything) {
+  RecoveryReceiver r;
+  Packet zero;
+  zero.recovery_kind = RecoveryKind::kComplete;
+  EXPECT_FALSE(r.receive(zero, 1, 0).changed);
+  Packet joy = zero;
+  joy.recovery = {{69, 40, 0, Curve::kLinear}};
+  EXPECT_TRUE(r.receive(joy, 2, 0).changed);
+  EXPECT_FALSE(r.receive(joy, 3, 0).changed);
+}
+
+TEST(RecoveryReceiver, DuplicateOrBackwardSequenceNumberCountsNoLoss) {
+  RecoveryReceiver r;
+  Packet p;
+  p.add_phoneme({.duration_ms = 10}, {});
+  EXPECT_EQ(r.receive(p, 65535, 0).lost, 0u);
+  EXPECT_EQ(r.receive(p, 2, 0).lost, 2u);  // wraps: 0 and 1 missing
+  EXPECT_EQ(r.receive(p, 2, 0).lost, 0u);  // duplicate
+  EXPECT_EQ(r.receive(p, 1, 0).lost, 0u);  // back
 }
 
 TEST(Recovery, LateJoinerIsWholeFromItsFirstCompleteState) {

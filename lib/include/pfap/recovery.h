@@ -60,18 +60,25 @@ struct ReceiveResult {
     kRecovered,  // dynamic entries applied after a covered gap
     kComplete,   // a complete state replaced everything
   } recovery = Recovery::kNone;
+  bool changed = false;           // kComplete: some settled value differs from before
   bool state_whole = true;        // false while the FAP state may be wrong
-  bool request_complete = false;  // a loss the coverage did not span: ask the sender
+  bool request_complete = false;  // ask the sender for a complete state: after a loss the
+                                  // coverage did not span, on joining mid-stream, and
+                                  // again each retry interval while not whole
   uint32_t lost = 0;              // packets missing before this one
 };
 
 // The receiver's side: sequence numbers, recovery and the FAP state.
 class RecoveryReceiver {
  public:
+  // retry_ns: how long after a request for a complete state, in packet time, the receiver
+  // asks again if it is still not whole (the request or the answer may be lost).
+  explicit RecoveryReceiver(int64_t retry_ns = 1'000'000'000) : retry_ns_(retry_ns) {}
+
   // `seqnum` is the RTP sequence number, `time_ns` the packet's time. Applies complete or
   // dynamic recovery when it is due, then the packet's own bookmarks at their phonemes'
-  // starts. Loss is counted from sequence numbers; packets must come in order (after a
-  // jitterbuffer).
+  // starts. Loss is counted from sequence numbers, packets in order (after a jitterbuffer);
+  // a sequence number that goes back (duplicate, late or restarted) counts no loss.
   ReceiveResult receive(const Packet& packet, uint16_t seqnum, int64_t time_ns);
   const FapState& state() const { return state_; }
   bool state_whole() const { return whole_; }
@@ -80,10 +87,11 @@ class RecoveryReceiver {
   void reset(bool joined_mid_stream);
 
  private:
+  int64_t retry_ns_;
   FapState state_;
   std::optional<uint16_t> last_seqnum_;
   bool whole_ = true;
-  bool requested_ = false;  // a complete state was asked for since the state broke
+  std::optional<int64_t> last_request_ns_;  // since the state broke
 };
 
 }  // namespace pfap
