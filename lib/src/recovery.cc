@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cassert>
-#include <cstdlib>
 
 namespace pfap {
 namespace {
@@ -51,20 +50,14 @@ void RecoverySender::add_dynamic(Packet& packet, int64_t time_ns, size_t room) c
   }
 }
 
-void RecoverySender::make_complete(Packet& out, int64_t time_ns, size_t room) const {
+bool RecoverySender::make_complete(Packet& out, int64_t time_ns, size_t room) const {
   out.clear();
   out.recovery_kind = RecoveryKind::kComplete;
   for (int index = kMinFapIndex; index <= kMaxFapIndex; ++index) {
     const Fap entry = state_.recovery_entry(index, time_ns);
     if (entry.amplitude != 0) out.recovery.push_back(entry);
   }
-  const size_t fits = (room - std::min(room, kPacketDescriptorBytes)) / kFapDescriptorBytes;
-  if (out.recovery.size() > fits) {
-    std::stable_sort(out.recovery.begin(), out.recovery.end(), [](const Fap& a, const Fap& b) {
-      return std::abs(a.amplitude) > std::abs(b.amplitude);
-    });
-    out.recovery.resize(fits);
-  }
+  return encoded_size(out) <= room;
 }
 
 void RecoverySender::sent(const Packet& packet, int64_t time_ns) {

@@ -56,7 +56,7 @@ std::vector<SentPacket> send_session(uint32_t seed, int phonemes, unsigned depth
   for (size_t i = 0; i < planned.size(); ++i) {
     if (complete_every > 0 && i % static_cast<size_t>(complete_every) == 0) {
       Packet complete;
-      sender.make_complete(complete, planned[i].start_ns, 1388);
+      EXPECT_TRUE(sender.make_complete(complete, planned[i].start_ns, 1388));
       send(complete, planned[i].start_ns);
     }
     Packet packet = planned[i].packet;
@@ -298,7 +298,7 @@ TEST(RecoverySender, CoverageShrinksToFitTheRoomLeft) {
   }
 }
 
-TEST(RecoverySender, CompleteStateListsOnlyNonZeroFapsAndKeepsTheLargestWhenShort) {
+TEST(RecoverySender, CompleteStateListsOnlyNonZeroFapsAndIsNeverCut) {
   RecoverySender sender(0);
   Packet p;
   p.add_phoneme({.duration_ms = 10}, std::vector<Fap>{{3, 10, 0, Curve::kLinear},
@@ -307,12 +307,13 @@ TEST(RecoverySender, CompleteStateListsOnlyNonZeroFapsAndKeepsTheLargestWhenShor
                                                       {6, 20, 0, Curve::kLinear}});
   sender.sent(p, 0);
   Packet complete;
-  sender.make_complete(complete, kNsPerMs * 100, 1388);
+  ASSERT_TRUE(sender.make_complete(complete, kNsPerMs * 100, 1 + 3 * 6));
   EXPECT_EQ(complete.recovery_kind, RecoveryKind::kComplete);
-  EXPECT_EQ(complete.recovery.size(), 3u);
-  sender.make_complete(complete, kNsPerMs * 100, 1 + 2 * 6);
-  EXPECT_EQ(complete.recovery,
-            (std::vector<Fap>{{5, -300, 0, Curve::kLinear}, {6, 20, 0, Curve::kLinear}}));
+  EXPECT_EQ(complete.recovery, (std::vector<Fap>{{3, 10, 0, Curve::kLinear},
+                                                 {5, -300, 0, Curve::kLinear},
+                                                 {6, 20, 0, Curve::kLinear}}));
+  // One byte short: refused, not cut (a receiver would take the missing FAP for 0).
+  EXPECT_FALSE(sender.make_complete(complete, kNsPerMs * 100, 3 * 6));
 }
 
 }  // namespace

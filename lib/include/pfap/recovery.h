@@ -32,8 +32,9 @@ class RecoverySender {
   void add_dynamic(Packet& packet, int64_t time_ns, size_t room) const;
 
   // A complete-recovery packet of the state at `time_ns`: every FAP whose settled value is
-  // not 0. Entries beyond `room` bytes are left out, the largest amplitudes kept.
-  void make_complete(Packet& out, int64_t time_ns, size_t room) const;
+  // not 0. False, with `out` unusable, when it needs more than `room` bytes: a receiver
+  // takes every FAP left out for 0, so a complete state is never cut (72 FAPs take 433).
+  bool make_complete(Packet& out, int64_t time_ns, size_t room) const;
 
   // Records a packet as sent: data (its phonemes' FAPs, the first phoneme starting at
   // `time_ns`) or recovery only. Every packet counts towards the coverage.
