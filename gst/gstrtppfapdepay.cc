@@ -7,14 +7,44 @@
  *
  * Extracts phonemes and facial animation parameters (FAPs) from RTP packets of the PFAP
  * payload format (draft-ietf-avt-rtp-pfap-00) as application/x-pfap buffers, laid out as
- * pfap/markup.h describes: one buffer per phoneme, holding the FAPs that start with it. A
- * buffer's PTS is the packet's PTS plus the durations of the phonemes before it in the
- * packet, its duration the phoneme's. The first phoneme of a packet with the RTP marker bit
- * set starts a sentence. The output stream is sparse: phonemes come only while someone speaks.
+ * pfap/markup.h describes: one buffer per phoneme, holding the FAPs that start with it, and
+ * state events from recovery information (below). A phoneme buffer's PTS is the packet's PTS
+ * plus the durations of the phonemes before it in the packet, its duration the phoneme's.
+ * The first phoneme of a packet with the RTP marker bit set starts a sentence. The output
+ * stream is sparse: phonemes come only while someone speaks.
  *
  * A malformed packet is dropped whole and counted in #GstRtpPfapDepay:stats; warnings are
- * posted for the 1st, 2nd, 4th, 8th, ... malformed packet. Recovery information is counted
- * but not applied yet.
+ * posted for the 1st, 2nd, 4th, 8th, ... malformed packet.
+ *
+ * ## Loss recovery
+ *
+ * The element keeps the FAP state the stream has built (pfap::RecoveryReceiver) and uses the
+ * recovery information of draft sections 6.1, 6.4 and 8 to repair it after a loss:
+ *
+ * - After lost packets that the next packet's dynamic recovery covers: a recovered event
+ *   (PFAP_EVENT_RECOVERED) with that packet's recovery entries, at its PTS, before its
+ *   phonemes; without FAPs when nothing in the covered packets still had an effect.
+ *   Recovery entries when nothing was lost are not output: the phonemes before them
+ *   already set those FAPs.
+ * - A complete-recovery packet: a complete event (PFAP_EVENT_COMPLETE) with the whole state
+ *   at the packet's PTS, only if it changes the state. An unchanged complete state tells
+ *   downstream nothing, and leaving it out keeps the output of a stream without loss what
+ *   the sender was given.
+ * - After a loss the coverage does not span, the state may be wrong: every event is flagged
+ *   PFAP_FLAG_UNCERTAIN until a complete state comes, and the element asks the sender for
+ *   one (#GstRtpPfapDepay:request-recovery).
+ *
+ * A depayloader cannot know whether it joined a stream at its start, so after READY to
+ * PAUSED, a flush or a new SSRC it takes itself for joined mid-stream: uncertain, and asking
+ * for a complete state, unless the first packet is one. Senders begin every stream with a
+ * complete state (rtppfappay does), so a receiver there from the start is whole at once; the
+ * all-zero state a stream starts with outputs nothing.
+ *
+ * A packet dropped as malformed counts as lost: its FAPs are missing just the same, and
+ * recovery repairs both alike. Losses are accounted at the next good packet, from sequence
+ * numbers, because only that packet's coverage tells whether they are repaired;
+ * rtpjitterbuffer's packet-lost events are counted and, as in every depayloader, become GAP
+ * events.
  *
  * ## Example pipeline
  * |[
@@ -26,16 +56,19 @@
 #include "gstrtppfapdepay.h"
 
 #include <gst/rtp/gstrtpbuffer.h>
+#include <gst/video/video.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <iterator>
 #include <memory>
 #include <new>
+#include <optional>
 #include <span>
-#include <vector>
 
 #include "pfap/payload.h"
+#include "pfap/recovery.h"
 #include "pfapbuffer.h"
 
 GST_DEBUG_CATEGORY_STATIC(rtp_pfap_depay_debug);
@@ -82,25 +115,13 @@ struct Stats {
   guint64 malformed = 0;
   std::array<guint64, pfap::kDecodeStatusCount> malformed_by_status{};
   guint64 lost = 0;
-  guint64 complete_recoveries = 0;
-  guint64 recovery_entries = 0;
-};
-
-// The last packet seen, for counting losses.
-struct SeqnumTracker {
-  bool started = false;
-  guint32 ssrc = 0;
-  guint16 last = 0;
-
-  // The packets missing before `seqnum`: a forward jump of under 2^15. A backward jump (the
-  // base class has already dropped duplicates and late packets, so the sender restarted) or
-  // a new SSRC says nothing about loss.
-  guint64 advance(guint32 packet_ssrc, guint16 seqnum) {
-    const guint16 gap = static_cast<guint16>(seqnum - last - 1);
-    const guint64 lost = started && packet_ssrc == ssrc && gap < 0x8000 ? gap : 0;
-    *this = {true, packet_ssrc, seqnum};
-    return lost;
-  }
+  guint64 gaps = 0;
+  guint64 recovered = 0;
+  guint64 faps_recovered = 0;
+  guint64 complete_states = 0;
+  guint64 complete_changes = 0;
+  guint64 requests = 0;
+  guint64 packet_lost_events = 0;
 };
 
 // Every warning cannot go to the bus (a broken sender could flood it), so warn at the 1st,
@@ -116,12 +137,18 @@ struct _GstRtpPfapDepay {
 
   // C++ members: constructed in init, destroyed in finalize.
   pfap::Packet packet;      // reused, so decoding stops allocating
-  pfap::MarkupEvent event;  // one phoneme's event, reused
-  SeqnumTracker seqnums;
-  Stats stats;  // under the object lock: the stats property is read from any thread
+  pfap::MarkupEvent event;  // one output event, reused
+  pfap::RecoveryReceiver receiver;
+  std::optional<guint32> ssrc;  // the stream's; none until a good packet starts one
+  // Under the object lock: the stats property is read from any thread.
+  Stats stats;
+  // A gboolean, atomic: the property may be set from any thread.
+  gint request_recovery;
 };
 
-enum { PROP_0, PROP_STATS };
+enum { PROP_0, PROP_STATS, PROP_REQUEST_RECOVERY };
+
+constexpr gboolean kDefaultRequestRecovery = TRUE;
 
 static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
     "sink", GST_PAD_SINK, GST_PAD_ALWAYS,
@@ -142,9 +169,9 @@ static void update_stats(GstRtpPfapDepay* self, Update&& update) {
   GST_OBJECT_UNLOCK(self);
 }
 
-// Forgets the stream position (FLUSH_STOP, READY to PAUSED). The stats are counters and
-// outlive a flush.
-static void reset(GstRtpPfapDepay* self) { self->seqnums = {}; }
+// Forgets the stream (FLUSH_STOP, READY to PAUSED): the next good packet starts a new one,
+// as a new SSRC does. The stats are counters and outlive a flush.
+static void reset(GstRtpPfapDepay* self) { self->ssrc.reset(); }
 
 static gboolean gst_rtp_pfap_depay_set_caps(GstRTPBaseDepayload* depay, GstCaps* caps) {
   const GstStructure* s = gst_caps_get_structure(caps, 0);
@@ -218,72 +245,149 @@ static void drop_malformed(GstRtpPfapDepay* self, pfap::DecodeResult result, gui
   }
 }
 
-// Phoneme i of the decoded packet as an x-pfap buffer, or NULL when it does not fit one
-// (more FAPs than its 16-bit count holds).
-static GstBuffer* phoneme_buffer(GstRtpPfapDepay* self, size_t i, bool sentence_start) {
+// x-pfap counts an event's FAPs in 16 bits, and only a payload over 393 KB holds more in one
+// phoneme or recovery list. Such a packet is dropped before the receiver sees it, so that
+// it counts as lost, like a malformed one.
+static bool fits_x_pfap(GstRtpPfapDepay* self, guint16 seqnum) {
+  const pfap::Packet& packet = self->packet;
+  size_t most = packet.recovery.size();
+  for (size_t i = 0; i < packet.phonemes.size(); ++i) {
+    most = std::max(most, packet.faps_of(i).size());
+  }
+  if (most <= G_MAXUINT16) return true;
+  GST_ELEMENT_WARNING(self, STREAM, DECODE,
+                      ("Dropped a PFAP packet with %zu FAPs in one event; an x-pfap buffer "
+                       "holds at most %u",
+                       most, G_MAXUINT16),
+                      ("RTP seqnum %u", seqnum));
+  return false;
+}
+
+// self->event as a buffer. It always fits: fits_x_pfap checked the counts and the decoder
+// every value.
+static GstBuffer* event_buffer(GstRtpPfapDepay* self, GstClockTime pts, GstClockTime duration) {
+  GstBuffer* buffer = pfap_buffer_new(self->event);
+  g_assert(buffer);
+  GST_BUFFER_PTS(buffer) = pts;
+  GST_BUFFER_DURATION(buffer) = duration;
+  return buffer;
+}
+
+// The decoded packet's recovery entries as a recovered or complete event at `pts`.
+static GstBuffer* state_buffer(GstRtpPfapDepay* self, PfapEventKind kind, bool uncertain,
+                               GstClockTime pts) {
+  pfap::MarkupEvent& event = self->event;
+  event.kind = kind;
+  event.phoneme = {};
+  event.sentence_start = false;
+  event.uncertain = uncertain;
+  event.faps = self->packet.recovery;
+  return event_buffer(self, pts, GST_CLOCK_TIME_NONE);
+}
+
+// Phoneme i of the decoded packet, starting at `pts`.
+static GstBuffer* phoneme_buffer(GstRtpPfapDepay* self, size_t i, bool sentence_start,
+                                 bool uncertain, GstClockTime pts) {
   const std::span<const pfap::Fap> faps = self->packet.faps_of(i);
   pfap::MarkupEvent& event = self->event;
+  event.kind = PFAP_EVENT_PHONEME;
   event.phoneme = self->packet.phonemes[i].phoneme;
   event.sentence_start = sentence_start;
+  event.uncertain = uncertain;
   event.faps.assign(faps.begin(), faps.end());
-  return pfap_buffer_new(event);
+  return event_buffer(self, pts, event.phoneme.duration_ms * GST_MSECOND);
+}
+
+// Asks the sender for a complete state with the event video depayloaders send for a key
+// frame (all headers: the whole state); rtpbin sends it on as RTCP feedback.
+static void request_complete_state(GstRtpPfapDepay* self, guint16 seqnum) {
+  GST_DEBUG_OBJECT(self, "asking for a complete state at packet %u", seqnum);
+  gst_pad_push_event(GST_RTP_BASE_DEPAYLOAD_SINKPAD(self),
+                     gst_video_event_new_upstream_force_key_unit(GST_CLOCK_TIME_NONE, TRUE, 0));
+  update_stats(self, [](Stats& s) { ++s.requests; });
 }
 
 static GstBuffer* gst_rtp_pfap_depay_process_rtp_packet(GstRTPBaseDepayload* depay,
                                                         GstRTPBuffer* rtp) {
   GstRtpPfapDepay* self = GST_RTP_PFAP_DEPAY(depay);
   const guint16 seqnum = gst_rtp_buffer_get_seq(rtp);
-  const guint64 lost = self->seqnums.advance(gst_rtp_buffer_get_ssrc(rtp), seqnum);
   const std::span<const uint8_t> payload(
       static_cast<const uint8_t*>(gst_rtp_buffer_get_payload(rtp)),
       gst_rtp_buffer_get_payload_len(rtp));
   const pfap::DecodeResult result = pfap::decode_payload(payload, self->packet);
-  update_stats(self, [&](Stats& s) {
-    ++s.packets;
-    s.lost += lost;
-  });
+  update_stats(self, [](Stats& s) { ++s.packets; });
   if (!result.ok()) {
     drop_malformed(self, result, seqnum);
     return nullptr;
   }
+  if (!fits_x_pfap(self, seqnum)) return nullptr;
 
+  // A new SSRC is a new sender, or one restarted: its sequence numbers and FAP state owe
+  // nothing to the last one's.
+  const guint32 ssrc = gst_rtp_buffer_get_ssrc(rtp);
+  if (self->ssrc != ssrc) {
+    GST_DEBUG_OBJECT(self, "new stream, SSRC %08x", ssrc);
+    self->receiver.reset(/*joined_mid_stream=*/true);
+    self->ssrc = ssrc;
+  }
   const pfap::Packet& packet = self->packet;
   // The base class derives no time from the RTP timestamp: the PTS comes from upstream
   // (rtpjitterbuffer), and DISCONT after a gap is set on our first buffer by the base class.
   const GstClockTime packet_pts = GST_BUFFER_PTS(rtp->buffer);
-  GstBufferList* list = gst_buffer_list_new_sized(static_cast<guint>(packet.phonemes.size()));
+  const pfap::ReceiveResult r = self->receiver.receive(
+      packet, seqnum, GST_CLOCK_TIME_IS_VALID(packet_pts) ? static_cast<int64_t>(packet_pts) : 0);
+  const bool uncertain = !r.state_whole;
+
+  using Recovery = pfap::ReceiveResult::Recovery;
+  const bool recovered = r.recovery == Recovery::kRecovered;
+  // An unchanged complete state changes nothing downstream; left out, a stream without loss
+  // comes out as it was sent.
+  const bool complete_changed = r.recovery == Recovery::kComplete && r.changed;
+  // The state event goes first in the list: before the phonemes, and the one that carries
+  // the DISCONT after a gap.
+  GstBufferList* list = gst_buffer_list_new_sized(static_cast<guint>(packet.phonemes.size() + 1));
+  if (recovered || complete_changed) {
+    gst_buffer_list_add(
+        list, state_buffer(self, recovered ? PFAP_EVENT_RECOVERED : PFAP_EVENT_COMPLETE, uncertain,
+                           packet_pts));
+  }
   GstClockTime offset = 0;
   for (size_t i = 0; i < packet.phonemes.size(); ++i) {
-    GstBuffer* buffer = phoneme_buffer(self, i, i == 0 && gst_rtp_buffer_get_marker(rtp));
-    if (!buffer) {
-      GST_ELEMENT_WARNING(self, STREAM, DECODE,
-                          ("Dropped a PFAP packet whose phoneme %zu does not fit an x-pfap "
-                           "buffer (%zu FAPs)",
-                           i, packet.faps_of(i).size()),
-                          ("RTP seqnum %u", seqnum));
-      gst_buffer_list_unref(list);
-      return nullptr;
-    }
-    const GstClockTime duration = packet.phonemes[i].phoneme.duration_ms * GST_MSECOND;
-    GST_BUFFER_PTS(buffer) =
+    const bool sentence_start = i == 0 && gst_rtp_buffer_get_marker(rtp);
+    const GstClockTime pts =
         GST_CLOCK_TIME_IS_VALID(packet_pts) ? packet_pts + offset : GST_CLOCK_TIME_NONE;
-    GST_BUFFER_DURATION(buffer) = duration;
-    offset += duration;
+    GstBuffer* buffer = phoneme_buffer(self, i, sentence_start, uncertain, pts);
+    offset += GST_BUFFER_DURATION(buffer);
     gst_buffer_list_add(list, buffer);
   }
   update_stats(self, [&](Stats& s) {
     s.phonemes += packet.phonemes.size();
     s.faps += packet.faps.size();
-    s.recovery_entries += packet.recovery.size();
-    s.complete_recoveries += packet.recovery_kind == pfap::RecoveryKind::kComplete;
+    s.lost += r.lost;
+    s.gaps += r.lost > 0;
+    s.recovered += recovered;
+    s.faps_recovered += recovered ? packet.recovery.size() : 0;
+    s.complete_states += r.recovery == Recovery::kComplete;
+    s.complete_changes += complete_changed;
   });
 
   if (gst_buffer_list_length(list) == 0) {
-    gst_buffer_list_unref(list);  // recovery only: nothing to output until recovery is applied
-    return nullptr;
+    gst_buffer_list_unref(list);  // no loss to repair, no change and no phoneme
+  } else {
+    gst_rtp_base_depayload_push_list(depay, list);
   }
-  gst_rtp_base_depayload_push_list(depay, list);
+  if (r.request_complete && g_atomic_int_get(&self->request_recovery)) {
+    request_complete_state(self, seqnum);
+  }
   return nullptr;
+}
+
+// Counted only: the loss is accounted at the next packet, whose sequence number tells how
+// many were lost and whose coverage whether recovery repairs them. The parent pushes a GAP,
+// so that downstream does not wait for the lost time.
+static gboolean gst_rtp_pfap_depay_packet_lost(GstRTPBaseDepayload* depay, GstEvent* event) {
+  update_stats(GST_RTP_PFAP_DEPAY(depay), [](Stats& s) { ++s.packet_lost_events; });
+  return GST_RTP_BASE_DEPAYLOAD_CLASS(gst_rtp_pfap_depay_parent_class)->packet_lost(depay, event);
 }
 
 static GstStructure* stats_structure(GstRtpPfapDepay* self) {
@@ -298,11 +402,24 @@ static GstStructure* stats_structure(GstRtpPfapDepay* self) {
     gst_structure_set(out, field.name, G_TYPE_UINT64,
                       s.malformed_by_status[static_cast<size_t>(field.status)], nullptr);
   }
-  gst_structure_set(out, "lost", G_TYPE_UINT64, s.lost, "complete-recoveries", G_TYPE_UINT64,
-                    s.complete_recoveries, "recovery-entries", G_TYPE_UINT64, s.recovery_entries,
-                    "recovered", G_TYPE_UINT64, guint64{0},  // recovery is not applied yet
-                    nullptr);
+  gst_structure_set(out, "lost", G_TYPE_UINT64, s.lost, "gaps", G_TYPE_UINT64, s.gaps, "recovered",
+                    G_TYPE_UINT64, s.recovered, "faps-recovered", G_TYPE_UINT64, s.faps_recovered,
+                    "complete-states", G_TYPE_UINT64, s.complete_states, "complete-changes",
+                    G_TYPE_UINT64, s.complete_changes, "requests", G_TYPE_UINT64, s.requests,
+                    "packet-lost-events", G_TYPE_UINT64, s.packet_lost_events, nullptr);
   return out;
+}
+
+static void gst_rtp_pfap_depay_set_property(GObject* object, guint prop_id, const GValue* value,
+                                            GParamSpec* pspec) {
+  switch (prop_id) {
+    case PROP_REQUEST_RECOVERY:
+      g_atomic_int_set(&GST_RTP_PFAP_DEPAY(object)->request_recovery, g_value_get_boolean(value));
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
 }
 
 static void gst_rtp_pfap_depay_get_property(GObject* object, guint prop_id, GValue* value,
@@ -310,6 +427,9 @@ static void gst_rtp_pfap_depay_get_property(GObject* object, guint prop_id, GVal
   switch (prop_id) {
     case PROP_STATS:
       g_value_take_boxed(value, stats_structure(GST_RTP_PFAP_DEPAY(object)));
+      break;
+    case PROP_REQUEST_RECOVERY:
+      g_value_set_boolean(value, g_atomic_int_get(&GST_RTP_PFAP_DEPAY(object)->request_recovery));
       break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
@@ -335,14 +455,17 @@ static void gst_rtp_pfap_depay_init(GstRtpPfapDepay* self) {
   GST_PAD_SET_ACCEPT_INTERSECT(GST_RTP_BASE_DEPAYLOAD_SINKPAD(self));
   new (&self->packet) pfap::Packet();
   new (&self->event) pfap::MarkupEvent();
-  new (&self->seqnums) SeqnumTracker();
+  new (&self->receiver) pfap::RecoveryReceiver();
+  new (&self->ssrc) std::optional<guint32>();
   new (&self->stats) Stats();
+  self->request_recovery = kDefaultRequestRecovery;
 }
 
 static void gst_rtp_pfap_depay_finalize(GObject* object) {
   GstRtpPfapDepay* self = GST_RTP_PFAP_DEPAY(object);
   std::destroy_at(&self->packet);
   std::destroy_at(&self->event);
+  std::destroy_at(&self->receiver);
   G_OBJECT_CLASS(gst_rtp_pfap_depay_parent_class)->finalize(object);
 }
 
@@ -351,6 +474,7 @@ static void gst_rtp_pfap_depay_class_init(GstRtpPfapDepayClass* klass) {
   GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
   GstRTPBaseDepayloadClass* depay_class = GST_RTP_BASE_DEPAYLOAD_CLASS(klass);
 
+  gobject_class->set_property = gst_rtp_pfap_depay_set_property;
   gobject_class->get_property = gst_rtp_pfap_depay_get_property;
   gobject_class->finalize = gst_rtp_pfap_depay_finalize;
 
@@ -376,10 +500,15 @@ static void gst_rtp_pfap_depay_class_init(GstRtpPfapDepayClass* klass) {
    * - malformed-data-in-complete-recovery: a complete recovery announcing phonemes or FAPs
    * - malformed-unterminated-recovery: a recovery list without its last entry
    * - malformed-empty-packet: no recovery entries and no phoneme
-   * - lost: packets missing, from forward jumps of the RTP sequence number
-   * - complete-recoveries: complete-recovery packets received (not applied yet)
-   * - recovery-entries: recovery entries received in good packets (not applied yet)
-   * - recovered: FAP states restored from recovery information (0: not applied yet)
+   * - lost: packets missing before good packets, from forward jumps of the RTP sequence
+   *   number; packets dropped here (malformed, or too large for x-pfap) count too
+   * - gaps: good packets that came after lost ones
+   * - recovered: gaps that dynamic recovery covered: the recovered events output
+   * - faps-recovered: the recovery entries in those events
+   * - complete-states: complete-recovery packets received
+   * - complete-changes: those that changed the state: the complete events output
+   * - requests: requests for a complete state sent upstream (GstForceKeyUnit events)
+   * - packet-lost-events: rtpjitterbuffer's packet-lost events received
    */
   g_object_class_install_property(
       gobject_class, PROP_STATS,
@@ -390,10 +519,31 @@ static void gst_rtp_pfap_depay_class_init(GstRtpPfapDepayClass* klass) {
           "-reserved-recovery-type, -reserved-info-bits, -missing-coverage, "
           "-fap-index-out-of-range, -amplitude-out-of-range, -curve-zero, "
           "-missing-final-phoneme, -trailing-bytes, -data-in-complete-recovery, "
-          "-unterminated-recovery, -empty-packet); lost packets (sequence-number gaps); "
-          "complete-recoveries and recovery-entries received; recovered (0: recovery is not "
-          "applied yet)",
+          "-unterminated-recovery, -empty-packet); lost packets (sequence-number gaps, "
+          "malformed packets included); gaps, recovered (gaps covered by dynamic recovery), "
+          "faps-recovered; complete-states received, complete-changes (those that changed "
+          "the state); requests for a complete state sent; packet-lost-events received",
           GST_TYPE_STRUCTURE, static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
+
+  /**
+   * GstRtpPfapDepay:request-recovery:
+   *
+   * Whether to ask the sender for a complete FAP state while the state may be wrong: after
+   * a loss that dynamic recovery does not cover, on joining a stream mid-way, and again each
+   * second of stream time until one comes (the request or its answer may be lost). The
+   * request is the upstream GstForceKeyUnit event that rtpvp8depay and rtph264depay send
+   * for request-keyframe; rtpbin turns it into RTCP PLI feedback when the receiving caps
+   * have rtcp-fb-nack-pli=(boolean)true (SDP `a=rtcp-fb:<pt> nack pli`).
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_REQUEST_RECOVERY,
+      g_param_spec_boolean(
+          "request-recovery", "Request recovery",
+          "Ask the sender for a complete FAP state (upstream GstForceKeyUnit, RTCP PLI in "
+          "rtpbin) when the state may be wrong after a loss or on joining mid-stream",
+          kDefaultRequestRecovery,
+          static_cast<GParamFlags>(G_PARAM_READWRITE | GST_PARAM_MUTABLE_PLAYING |
+                                   G_PARAM_STATIC_STRINGS)));
 
   gst_element_class_add_static_pad_template(element_class, &sink_template);
   gst_element_class_add_static_pad_template(element_class, &src_template);
@@ -407,6 +557,7 @@ static void gst_rtp_pfap_depay_class_init(GstRtpPfapDepayClass* klass) {
   depay_class->set_caps = gst_rtp_pfap_depay_set_caps;
   depay_class->handle_event = gst_rtp_pfap_depay_handle_event;
   depay_class->process_rtp_packet = gst_rtp_pfap_depay_process_rtp_packet;
+  depay_class->packet_lost = gst_rtp_pfap_depay_packet_lost;
 
   GST_DEBUG_CATEGORY_INIT(rtp_pfap_depay_debug, "rtppfapdepay", 0, "PFAP RTP depayloader");
 }

@@ -20,8 +20,35 @@
  * A buffer without a PTS starts where the previous phoneme ended (the first one at the
  * segment start): phonemes follow one another, so this is what a TTS source that left
  * the PTS out means. Malformed buffers are dropped with a warning and the stream goes on.
- * State events (recovered or complete FAP state) are dropped: the payloader will make its
- * own recovery information.
+ * State events (recovered or complete FAP state) are dropped: the payloader makes its own
+ * recovery information.
+ *
+ * Loss recovery (draft sections 6.1, 6.4 and 8) is the library's pfap::RecoverySender:
+ *
+ * - Every data packet carries dynamic recovery (C=0) covering the
+ *   #GstRtpPfapPay:recovery-depth packets before it: one entry per FAP those packets
+ *   bookmarked whose effect is not over, with its transition adjusted to the packet's time,
+ *   so a receiver that lost up to that many packets gets its FAP state back.
+ * - Complete-recovery packets (C=1, every FAP whose value is not 0) make a receiver whole
+ *   whatever it lost or when it joined. Every stream (after READY to PAUSED and after a
+ *   FLUSH) starts with one, so that a receiver knows from the start that its state is whole,
+ *   even without RTCP; one goes before a data packet each
+ *   #GstRtpPfapPay:complete-recovery-interval of stream time; and one answers a request.
+ * - A request is an upstream GstForceKeyUnit event on the src pad: what rtpbin's session
+ *   sends when a receiver sends RTCP PLI or FIR for our SSRC, and what an application can
+ *   send. If the stream is idle the packet goes out at once, with the state at the end of
+ *   the last data packet; otherwise the streaming thread sends it before its next packet,
+ *   or at GAP or EOS. The event is not forwarded upstream: the complete state is made here,
+ *   and a PFAP source has no key units to force.
+ * - Recovery never makes a packet exceed the MTU. Dynamic recovery shrinks its coverage to
+ *   the deepest step whose entries fit the room the data leaves (PP says which), and goes
+ *   without entries if none fits. A complete state is never cut, since a receiver takes
+ *   every FAP it leaves out for 0: one that does not fit (all 72 FAPs non-zero take 433
+ *   bytes) is not sent, with a warning, and the next one is due an interval or a request
+ *   later.
+ *
+ * A complete-recovery packet has PTS = the time whose state it holds, M = 0 and no
+ * duration. #GstRtpPfapPay:stats counts packets and requests.
  *
  * The RTP clock rate is the one downstream asks for (e.g. a capsfilter with
  * `application/x-rtp,clock-rate=90000`), else the draft's 44100 Hz. The sink caps' `alphabet`
@@ -36,12 +63,15 @@
 #include "gstrtppfappay.h"
 
 #include <gst/rtp/gstrtpbuffer.h>
+#include <gst/video/video-event.h>
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "pfap/packetizer.h"
 #include "pfap/payload.h"
+#include "pfap/recovery.h"
 #include "pfapbuffer.h"
 
 GST_DEBUG_CATEGORY_STATIC(rtppfappay_debug);
@@ -52,27 +82,75 @@ namespace {
 // Below rtpbin's default jitterbuffer latency of 200 ms, so a live receiver still gets each
 // phoneme in time to show it in lip sync with the audio.
 constexpr guint kDefaultMaxDelayMs = 100;
+// A burst of up to 4 lost packets (400 ms of speech in 100 ms packets) needs no complete
+// state, for 6 bytes per FAP still in effect in the 4 packets before.
+constexpr guint kDefaultRecoveryDepth = 4;
+// Late joiners of shared RTSP media on 1.22 have no request path (rtsp-server does not
+// necessarily pass on the PLI of a new joiner) and wait for the periodic packet.
+constexpr guint kDefaultCompleteIntervalMs = 1000;
 
-enum { PROP_0, PROP_MAX_DELAY };
+enum { PROP_0, PROP_MAX_DELAY, PROP_RECOVERY_DEPTH, PROP_COMPLETE_RECOVERY_INTERVAL, PROP_STATS };
 
-// What the streaming thread keeps between buffers. GObject runs no C++ constructors, so it
-// lives behind a pointer made in init and deleted in finalize.
+struct Stats {
+  guint64 packets = 0;           // data packets
+  guint64 recovery_entries = 0;  // dynamic recovery entries in them
+  guint64 complete_recoveries = 0;
+  guint64 requests = 0;
+  guint64 requests_served = 0;     // complete packets that answered at least one request
+  guint64 complete_too_large = 0;  // complete states not sent: larger than the MTU allows
+};
+
+// What the streaming thread keeps between buffers, under the sink pad's stream lock (the
+// src event handler sends requested packets under it too). GObject runs no C++
+// constructors, so it lives behind a pointer made in init and deleted in finalize.
 struct Stream {
   pfap::Packetizer packetizer{pfap::PacketizerConfig{}};
   uint32_t clock_rate = pfap::kDefaultClockRate;
-  GstClockTime next_start = GST_CLOCK_TIME_NONE;  // where a phoneme without PTS starts
+  GstClockTime next_start = GST_CLOCK_TIME_NONE;    // where a phoneme without PTS starts
+  unsigned recovery_depth = kDefaultRecoveryDepth;  // the sender's
+  pfap::RecoverySender sender{kDefaultRecoveryDepth};
+  // The end of the last data packet sent (start + duration): where the stream is now. None
+  // until the stream's first data packet, which a complete packet must precede.
+  std::optional<int64_t> position;
+  int64_t last_complete_ns = 0;  // the time of the last complete packet, once position is set
+  bool pushing = false;          // inside a push: a request from this thread must wait
   // Reused for every buffer so that steady streaming does not allocate.
   pfap::MarkupEvent event;
   std::vector<pfap::PlannedPacket> planned;
+  pfap::Packet complete;
 };
 
 }  // namespace
 
 struct _GstRtpPfapPay {
   GstRTPBasePayload parent;
-  guint max_delay_ms;  // under the object lock
+  // Under the object lock: properties, the pending request and the counters.
+  guint max_delay_ms;
+  guint recovery_depth;
+  guint complete_interval_ms;
+  bool complete_requested;
+  Stats stats;
   Stream* stream;
 };
+
+GType gst_rtp_pfap_recovery_depth_get_type() {
+  static gsize type = 0;
+  static const GEnumValue values[] = {
+      {0, "No dynamic recovery", "0"},
+      {1, "Recover a loss of the previous packet", "1"},
+      {2, "Recover losses within the previous 2 packets", "2"},
+      {4, "Recover losses within the previous 4 packets", "4"},
+      {7, "Recover losses within the previous 7 packets", "7"},
+      {15, "Recover losses within the previous 15 packets", "15"},
+      {25, "Recover losses within the previous 25 packets", "25"},
+      {40, "Recover losses within the previous 40 packets", "40"},
+      {0, nullptr, nullptr},
+  };
+  if (g_once_init_enter(&type)) {
+    g_once_init_leave(&type, g_enum_register_static("GstRtpPfapRecoveryDepth", values));
+  }
+  return type;
+}
 
 static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
     "sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
@@ -86,10 +164,19 @@ static GstStaticPadTemplate src_template = GST_STATIC_PAD_TEMPLATE(
 G_DEFINE_TYPE(GstRtpPfapPay, gst_rtp_pfap_pay, GST_TYPE_RTP_BASE_PAYLOAD)
 GST_ELEMENT_REGISTER_DEFINE(rtppfappay, "rtppfappay", GST_RANK_NONE, GST_TYPE_RTP_PFAP_PAY)
 
-// Forgets the pending packet and the stream position (state changes, FLUSH).
+// Forgets the pending packet, the stream position and what was sent: the next data packet
+// starts a new stream, after a complete packet (state changes, FLUSH). Under the stream
+// lock, which the streaming thread already holds at FLUSH_STOP, because a request may send
+// from another thread.
 static void reset(GstRtpPfapPay* self) {
-  self->stream->packetizer.reset();
-  self->stream->next_start = GST_CLOCK_TIME_NONE;
+  GstPad* sinkpad = GST_RTP_BASE_PAYLOAD_SINKPAD(self);
+  GST_PAD_STREAM_LOCK(sinkpad);
+  Stream& stream = *self->stream;
+  stream.packetizer.reset();
+  stream.next_start = GST_CLOCK_TIME_NONE;
+  stream.sender.reset();
+  stream.position.reset();
+  GST_PAD_STREAM_UNLOCK(sinkpad);
 }
 
 static pfap::PacketizerConfig current_config(GstRtpPfapPay* self) {
@@ -120,52 +207,174 @@ static void update_config(GstRtpPfapPay* self) {
   }
 }
 
-static GstFlowReturn push_packet(GstRtpPfapPay* self, const pfap::PlannedPacket& planned) {
-  GstRTPBasePayload* payload = GST_RTP_BASE_PAYLOAD(self);
-  const size_t size = pfap::encoded_size(planned.packet);
+// An RTP buffer with `packet` as its payload, or nullptr (with an error posted) if it cannot
+// be encoded.
+static GstBuffer* make_buffer(GstRtpPfapPay* self, const pfap::Packet& packet, bool marker) {
+  const size_t size = pfap::encoded_size(packet);
+  GstBuffer* buffer =
+      gst_rtp_base_payload_allocate_output_buffer(GST_RTP_BASE_PAYLOAD(self), size, 0, 0);
+  GstRTPBuffer rtp = GST_RTP_BUFFER_INIT;
+  gst_rtp_buffer_map(buffer, GST_MAP_WRITE, &rtp);
+  const pfap::EncodeStatus status =
+      pfap::encode_payload(packet, {static_cast<uint8_t*>(gst_rtp_buffer_get_payload(&rtp)), size});
+  gst_rtp_buffer_set_marker(&rtp, marker);
+  gst_rtp_buffer_unmap(&rtp);
+  if (status != pfap::EncodeStatus::kOk) {
+    // Packets come from validated input and the library: this is a bug, not bad data.
+    gst_buffer_unref(buffer);
+    GST_ELEMENT_ERROR(self, STREAM, ENCODE, (nullptr),
+                      ("cannot encode a packet: %s", pfap::to_string(status)));
+    return nullptr;
+  }
+  return buffer;
+}
+
+static GstFlowReturn push_buffer(GstRtpPfapPay* self, GstBuffer* buffer) {
+  Stream& stream = *self->stream;
+  stream.pushing = true;
+  const GstFlowReturn ret = gst_rtp_base_payload_push(GST_RTP_BASE_PAYLOAD(self), buffer);
+  stream.pushing = false;
+  return ret;
+}
+
+// Sends the FAP state at `time_ns` as a complete-recovery packet; it answers every request
+// made before. A state too large for the MTU is not sent at all, since a receiver takes
+// every FAP it leaves out for 0; it counts as sent for the interval, so that the warning
+// and the attempt come at most once per interval or request.
+static GstFlowReturn push_complete(GstRtpPfapPay* self, int64_t time_ns) {
+  Stream& stream = *self->stream;
+  GST_OBJECT_LOCK(self);
+  const bool requested = self->complete_requested;
+  self->complete_requested = false;
+  GST_OBJECT_UNLOCK(self);
+  const size_t max_size = stream.packetizer.config().max_payload_size;
+  if (!stream.sender.make_complete(stream.complete, time_ns, max_size)) {
+    stream.last_complete_ns = time_ns;
+    GST_OBJECT_LOCK(self);
+    const guint64 too_large = ++self->stats.complete_too_large;
+    GST_OBJECT_UNLOCK(self);
+    // At the 1st, 2nd, 4th, 8th, ...: a state that stays too large must not flood the bus.
+    if ((too_large & (too_large - 1)) == 0) {
+      GST_ELEMENT_WARNING(
+          self, STREAM, ENCODE, ("The complete FAP state does not fit in the MTU."),
+          ("%" G_GSIZE_FORMAT " non-zero FAPs at %" GST_TIME_FORMAT " need %" G_GSIZE_FORMAT
+           " bytes, mtu %u leaves %" G_GSIZE_FORMAT "; not sent (%" G_GUINT64_FORMAT
+           " times so far, warned at the 1st, 2nd, 4th, 8th, ...)",
+           stream.complete.recovery.size(), GST_TIME_ARGS(time_ns),
+           pfap::encoded_size(stream.complete),
+           GST_RTP_BASE_PAYLOAD_MTU(GST_RTP_BASE_PAYLOAD(self)), max_size, too_large));
+    }
+    return GST_FLOW_OK;
+  }
+  GstBuffer* buffer = make_buffer(self, stream.complete, false);
+  if (buffer == nullptr) return GST_FLOW_ERROR;
+  GST_BUFFER_PTS(buffer) = time_ns;
+  GST_BUFFER_DURATION(buffer) = 0;
+  GST_LOG_OBJECT(self, "complete recovery of %" G_GSIZE_FORMAT " FAPs at %" GST_TIME_FORMAT,
+                 stream.complete.recovery.size(), GST_TIME_ARGS(time_ns));
+  const GstFlowReturn ret = push_buffer(self, buffer);
+  // The packet took a sequence number whatever downstream did with it: it counts.
+  stream.sender.sent(stream.complete, time_ns);
+  stream.last_complete_ns = time_ns;
+  GST_OBJECT_LOCK(self);
+  self->stats.complete_recoveries++;
+  if (requested) self->stats.requests_served++;
+  GST_OBJECT_UNLOCK(self);
+  return ret;
+}
+
+// Whether a complete packet must go before a data packet starting at `start_ns`: the
+// stream's first, a request, or the interval since the last one is over.
+static bool complete_due(GstRtpPfapPay* self, int64_t start_ns) {
+  const Stream& stream = *self->stream;
+  if (!stream.position) return true;
+  GST_OBJECT_LOCK(self);
+  const bool requested = self->complete_requested;
+  const int64_t interval_ns = int64_t{self->complete_interval_ms} * pfap::kNsPerMs;
+  GST_OBJECT_UNLOCK(self);
+  // Stream time that goes back (a new segment) would otherwise hold the next one back.
+  const int64_t since = start_ns - stream.last_complete_ns;
+  return requested || (interval_ns > 0 && (since < 0 || since >= interval_ns));
+}
+
+// Puts a recovery-depth change into effect before the next data packet; the sender keeps
+// the FAP state and never claims coverage of packets it no longer holds.
+static void update_recovery_depth(GstRtpPfapPay* self) {
+  Stream& stream = *self->stream;
+  GST_OBJECT_LOCK(self);
+  const unsigned depth = self->recovery_depth;
+  GST_OBJECT_UNLOCK(self);
+  if (depth == stream.recovery_depth) return;
+  GST_DEBUG_OBJECT(self, "recovery depth %u", depth);
+  stream.sender.set_depth(depth);
+  stream.recovery_depth = depth;
+}
+
+static GstFlowReturn push_packet(GstRtpPfapPay* self, pfap::PlannedPacket& planned) {
+  Stream& stream = *self->stream;
+  update_recovery_depth(self);
+  if (complete_due(self, planned.start_ns)) {
+    // Sampled before this packet's bookmarks: the state a receiver has when it arrives.
+    const GstFlowReturn ret = push_complete(self, planned.start_ns);
+    if (ret != GST_FLOW_OK) return ret;
+  }
+
+  const size_t max_size = stream.packetizer.config().max_payload_size;
+  const size_t data_size = pfap::encoded_size(planned.packet);
   if (planned.oversized) {
     GST_ELEMENT_WARNING(self, STREAM, ENCODE, ("A phoneme and its FAPs do not fit in the MTU."),
                         ("sending a %" G_GSIZE_FORMAT "-byte payload at %" GST_TIME_FORMAT
                          "; mtu %u leaves room for %" G_GSIZE_FORMAT " bytes",
-                         size, GST_TIME_ARGS(planned.start_ns), GST_RTP_BASE_PAYLOAD_MTU(payload),
-                         self->stream->packetizer.config().max_payload_size));
+                         data_size, GST_TIME_ARGS(planned.start_ns),
+                         GST_RTP_BASE_PAYLOAD_MTU(GST_RTP_BASE_PAYLOAD(self)), max_size));
   }
-
-  GstBuffer* buffer = gst_rtp_base_payload_allocate_output_buffer(payload, size, 0, 0);
-  GstRTPBuffer rtp = GST_RTP_BUFFER_INIT;
-  gst_rtp_buffer_map(buffer, GST_MAP_WRITE, &rtp);
-  const pfap::EncodeStatus status = pfap::encode_payload(
-      planned.packet, {static_cast<uint8_t*>(gst_rtp_buffer_get_payload(&rtp)), size});
-  gst_rtp_buffer_set_marker(&rtp, planned.marker);
-  gst_rtp_buffer_unmap(&rtp);
-  if (status != pfap::EncodeStatus::kOk) {
-    // The packetizer only plans packets of validated input: this is a bug, not bad data.
-    gst_buffer_unref(buffer);
-    GST_ELEMENT_ERROR(self, STREAM, ENCODE, (nullptr),
-                      ("cannot encode a packet: %s", pfap::to_string(status)));
-    return GST_FLOW_ERROR;
-  }
+  stream.sender.add_dynamic(planned.packet, planned.start_ns,
+                            data_size < max_size ? max_size - data_size : 0);
+  GstBuffer* buffer = make_buffer(self, planned.packet, planned.marker);
+  if (buffer == nullptr) return GST_FLOW_ERROR;
 
   uint32_t duration_ms = 0;
   for (const pfap::PacketPhoneme& p : planned.packet.phonemes) duration_ms += p.phoneme.duration_ms;
   // The base class makes the RTP timestamp from the PTS.
   GST_BUFFER_PTS(buffer) = planned.start_ns;
   GST_BUFFER_DURATION(buffer) = duration_ms * GST_MSECOND;
-  GST_LOG_OBJECT(self, "packet of %" G_GSIZE_FORMAT " phonemes, %" G_GSIZE_FORMAT " bytes, M=%d",
-                 planned.packet.phonemes.size(), size, planned.marker);
-  return gst_rtp_base_payload_push(payload, buffer);
+  GST_LOG_OBJECT(self,
+                 "packet of %" G_GSIZE_FORMAT " phonemes, %" G_GSIZE_FORMAT
+                 " bytes, M=%d, %" G_GSIZE_FORMAT " recovery entries covering %u packets",
+                 planned.packet.phonemes.size(), pfap::encoded_size(planned.packet), planned.marker,
+                 planned.packet.recovery.size(), planned.packet.covered_packets);
+  const GstFlowReturn ret = push_buffer(self, buffer);
+  stream.sender.sent(planned.packet, planned.start_ns);
+  stream.position = planned.start_ns + int64_t{duration_ms} * pfap::kNsPerMs;
+  GST_OBJECT_LOCK(self);
+  self->stats.packets++;
+  self->stats.recovery_entries += planned.packet.recovery.size();
+  GST_OBJECT_UNLOCK(self);
+  return ret;
 }
 
 // Sends the packets the packetizer completed, one push each: the base class gives all the
 // packets of a buffer list the RTP timestamp of the first.
 static GstFlowReturn push_planned(GstRtpPfapPay* self) {
   GstFlowReturn ret = GST_FLOW_OK;
-  for (const pfap::PlannedPacket& planned : self->stream->planned) {
+  for (pfap::PlannedPacket& planned : self->stream->planned) {
     ret = push_packet(self, planned);
     if (ret != GST_FLOW_OK) break;
   }
   self->stream->planned.clear();
   return ret;
+}
+
+// Answers a pending request at once, with the state where the stream is now. Before the
+// stream's first data packet there is nothing to send yet: the complete packet that goes
+// before it answers. Under the stream lock.
+static GstFlowReturn serve_request(GstRtpPfapPay* self) {
+  const Stream& stream = *self->stream;
+  if (!stream.position || stream.pushing) return GST_FLOW_OK;
+  GST_OBJECT_LOCK(self);
+  const bool requested = self->complete_requested;
+  GST_OBJECT_UNLOCK(self);
+  return requested ? push_complete(self, *stream.position) : GST_FLOW_OK;
 }
 
 // Sends the pending packet now: no later phoneme may join it.
@@ -239,6 +448,10 @@ static gboolean gst_rtp_pfap_pay_sink_event(GstRTPBasePayload* payload, GstEvent
     // follows is read under new caps (another alphabet) or a new segment.
     case GST_EVENT_EOS:
     case GST_EVENT_GAP:
+      drain(self);
+      // No packet may come for a while, or ever: a request waiting for one goes now.
+      serve_request(self);
+      break;
     case GST_EVENT_CAPS:
     case GST_EVENT_SEGMENT:
       drain(self);
@@ -252,10 +465,51 @@ static gboolean gst_rtp_pfap_pay_sink_event(GstRTPBasePayload* payload, GstEvent
   return GST_RTP_BASE_PAYLOAD_CLASS(gst_rtp_pfap_pay_parent_class)->sink_event(payload, event);
 }
 
+// A request for the complete state (GstForceKeyUnit). It comes from another thread (rtpbin's
+// RTCP, an application) while the streaming thread may be pushing: it is sent from here only
+// if the stream lock is free, else the streaming thread sends it before its next packet.
+static gboolean gst_rtp_pfap_pay_src_event(GstRTPBasePayload* payload, GstEvent* event) {
+  if (!gst_video_event_parse_upstream_force_key_unit(event, nullptr, nullptr, nullptr)) {
+    return GST_RTP_BASE_PAYLOAD_CLASS(gst_rtp_pfap_pay_parent_class)->src_event(payload, event);
+  }
+  GstRtpPfapPay* self = GST_RTP_PFAP_PAY(payload);
+  GST_DEBUG_OBJECT(self, "complete recovery requested");
+  GST_OBJECT_LOCK(self);
+  self->complete_requested = true;
+  self->stats.requests++;
+  GST_OBJECT_UNLOCK(self);
+  GstPad* sinkpad = GST_RTP_BASE_PAYLOAD_SINKPAD(payload);
+  if (GST_PAD_STREAM_TRYLOCK(sinkpad)) {
+    serve_request(self);
+    GST_PAD_STREAM_UNLOCK(sinkpad);
+  }
+  // Answered here: upstream has no key units, and the complete state is made here.
+  gst_event_unref(event);
+  return TRUE;
+}
+
+static GstStructure* stats_structure(GstRtpPfapPay* self) {
+  GST_OBJECT_LOCK(self);
+  const Stats s = self->stats;
+  GST_OBJECT_UNLOCK(self);
+  return gst_structure_new("application/x-rtp-pfap-pay-stats", "packets", G_TYPE_UINT64, s.packets,
+                           "recovery-entries", G_TYPE_UINT64, s.recovery_entries,
+                           "complete-recoveries", G_TYPE_UINT64, s.complete_recoveries, "requests",
+                           G_TYPE_UINT64, s.requests, "requests-served", G_TYPE_UINT64,
+                           s.requests_served, "complete-too-large", G_TYPE_UINT64,
+                           s.complete_too_large, nullptr);
+}
+
 static GstStateChangeReturn gst_rtp_pfap_pay_change_state(GstElement* element,
                                                           GstStateChange transition) {
   GstRtpPfapPay* self = GST_RTP_PFAP_PAY(element);
-  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) reset(self);
+  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) {
+    reset(self);
+    GST_OBJECT_LOCK(self);
+    self->stats = {};
+    self->complete_requested = false;  // a new stream starts with a complete packet anyway
+    GST_OBJECT_UNLOCK(self);
+  }
   const GstStateChangeReturn ret =
       GST_ELEMENT_CLASS(gst_rtp_pfap_pay_parent_class)->change_state(element, transition);
   if (transition == GST_STATE_CHANGE_PAUSED_TO_READY) reset(self);
@@ -292,6 +546,16 @@ static void gst_rtp_pfap_pay_set_property(GObject* object, guint prop_id, const 
       // The pipeline asks for the latency again.
       gst_element_post_message(GST_ELEMENT(self), gst_message_new_latency(GST_OBJECT(self)));
       break;
+    case PROP_RECOVERY_DEPTH:
+      GST_OBJECT_LOCK(self);
+      self->recovery_depth = static_cast<guint>(g_value_get_enum(value));
+      GST_OBJECT_UNLOCK(self);
+      break;
+    case PROP_COMPLETE_RECOVERY_INTERVAL:
+      GST_OBJECT_LOCK(self);
+      self->complete_interval_ms = g_value_get_uint(value);
+      GST_OBJECT_UNLOCK(self);
+      break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
       break;
@@ -306,6 +570,19 @@ static void gst_rtp_pfap_pay_get_property(GObject* object, guint prop_id, GValue
       GST_OBJECT_LOCK(self);
       g_value_set_uint(value, self->max_delay_ms);
       GST_OBJECT_UNLOCK(self);
+      break;
+    case PROP_RECOVERY_DEPTH:
+      GST_OBJECT_LOCK(self);
+      g_value_set_enum(value, static_cast<gint>(self->recovery_depth));
+      GST_OBJECT_UNLOCK(self);
+      break;
+    case PROP_COMPLETE_RECOVERY_INTERVAL:
+      GST_OBJECT_LOCK(self);
+      g_value_set_uint(value, self->complete_interval_ms);
+      GST_OBJECT_UNLOCK(self);
+      break;
+    case PROP_STATS:
+      g_value_take_boxed(value, stats_structure(self));
       break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
@@ -347,6 +624,76 @@ static void gst_rtp_pfap_pay_class_init(GstRtpPfapPayClass* klass) {
                         static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
                                                  GST_PARAM_MUTABLE_PLAYING)));
 
+  /**
+   * GstRtpPfapPay:recovery-depth:
+   *
+   * How many packets before it each data packet's dynamic recovery covers: 0 (none) or a
+   * coverage the PP field can signal, 1, 2, 4, 7, 15, 25 or 40. A receiver that lost at
+   * most that many packets in a row gets its FAP state back from the next packet, without
+   * waiting for a complete state. It costs 6 bytes in every data packet per FAP bookmarked
+   * in the covered packets whose effect is not over, and nothing when there is none. Where
+   * the MTU leaves too little room, a packet covers fewer packets (PP says how many). The
+   * default of 4 covers most loss bursts.
+   *
+   * A change takes effect from the next data packet. A deeper setting covers only the
+   * packets the payloader still holds, and grows to the new depth one packet at a time: a
+   * packet never claims to cover packets whose bookmarks it does not know.
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_RECOVERY_DEPTH,
+      g_param_spec_enum("recovery-depth", "Recovery depth",
+                        "Packets each data packet's dynamic recovery covers (0 = none; 6 bytes "
+                        "per FAP still in effect in them, less coverage where the MTU lacks room)",
+                        GST_TYPE_RTP_PFAP_RECOVERY_DEPTH, kDefaultRecoveryDepth,
+                        static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                 GST_PARAM_MUTABLE_PLAYING)));
+
+  /**
+   * GstRtpPfapPay:complete-recovery-interval:
+   *
+   * The stream time in milliseconds after which a complete-recovery packet goes before the
+   * next data packet; 0 sends one only at the start of a stream and on request. The default
+   * of 1000 ms is for receivers that cannot ask: late joiners of shared RTSP media on
+   * GStreamer 1.22 get no request path (rtsp-server does not necessarily pass on a new
+   * joiner's PLI) and depend on the periodic packet. 1 s bounds their wait for 13 bytes
+   * (RTP header and packet descriptor) plus 6 per FAP not at 0, each second. The packet goes
+   * before a data packet, so a stream that only sends GAP sends none until it speaks again.
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_COMPLETE_RECOVERY_INTERVAL,
+      g_param_spec_uint("complete-recovery-interval", "Complete recovery interval",
+                        "Stream time between complete-recovery packets, in ms (0 = only at the "
+                        "start of a stream and on request)",
+                        0, G_MAXUINT, kDefaultCompleteIntervalMs,
+                        static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                 GST_PARAM_MUTABLE_PLAYING)));
+
+  /**
+   * GstRtpPfapPay:stats:
+   *
+   * Counters since the element last went from READY to PAUSED (a flush keeps them), all
+   * guint64, in an application/x-rtp-pfap-pay-stats structure:
+   *
+   * - packets: data packets sent
+   * - recovery-entries: dynamic recovery entries in them
+   * - complete-recoveries: complete-recovery packets sent, for any reason
+   * - requests: requests for the complete state received (GstForceKeyUnit events)
+   * - requests-served: complete-recovery packets that answered requests (requests that
+   *   arrive before one is sent share it)
+   * - complete-too-large: complete states not sent because they do not fit in the MTU
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_STATS,
+      g_param_spec_boxed("stats", "Statistics",
+                         "Counters since READY to PAUSED (guint64): packets (data), "
+                         "recovery-entries (dynamic, in them), complete-recoveries, requests "
+                         "(GstForceKeyUnit received), requests-served (complete packets that "
+                         "answered requests), complete-too-large (complete states not sent: "
+                         "over the MTU)",
+                         GST_TYPE_STRUCTURE,
+                         static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
+
+  gst_type_mark_as_plugin_api(GST_TYPE_RTP_PFAP_RECOVERY_DEPTH, static_cast<GstPluginAPIFlags>(0));
   gst_element_class_add_static_pad_template(element_class, &sink_template);
   gst_element_class_add_static_pad_template(element_class, &src_template);
   gst_element_class_set_static_metadata(
@@ -360,10 +707,15 @@ static void gst_rtp_pfap_pay_class_init(GstRtpPfapPayClass* klass) {
   payload_class->set_caps = gst_rtp_pfap_pay_set_caps;
   payload_class->handle_buffer = gst_rtp_pfap_pay_handle_buffer;
   payload_class->sink_event = gst_rtp_pfap_pay_sink_event;
+  payload_class->src_event = gst_rtp_pfap_pay_src_event;
 }
 
 static void gst_rtp_pfap_pay_init(GstRtpPfapPay* self) {
   self->max_delay_ms = kDefaultMaxDelayMs;
+  self->recovery_depth = kDefaultRecoveryDepth;
+  self->complete_interval_ms = kDefaultCompleteIntervalMs;
+  self->complete_requested = false;
+  self->stats = {};
   self->stream = new Stream{};
   gst_pad_set_query_function(GST_RTP_BASE_PAYLOAD_SRCPAD(self), gst_rtp_pfap_pay_src_query);
 }

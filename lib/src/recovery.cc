@@ -38,7 +38,7 @@ void RecoverySender::add_dynamic(Packet& packet, int64_t time_ns, size_t room) c
   // so its entries are never more.
   for (int step = static_cast<int>(std::size(kCoverageSteps)) - 1; step >= 0; --step) {
     const unsigned coverage = kCoverageSteps[step];
-    if (coverage > depth_) continue;
+    if (coverage > depth_ || (!whole_history_ && coverage > window_.size())) continue;
     const size_t covered = std::min<size_t>(coverage, window_.size());
     entries_for(std::span(window_).last(covered), state_, time_ns, entries);
     if (entries.size() * kFapDescriptorBytes <= room) {
@@ -70,13 +70,26 @@ void RecoverySender::sent(const Packet& packet, int64_t time_ns) {
     }
     start_ns += int64_t{packet.phonemes[i].phoneme.duration_ms} * kNsPerMs;
   }
-  if (depth_ == 0) return;
-  if (window_.size() == depth_) window_.erase(window_.begin());
+  if (window_.size() == depth_) {
+    whole_history_ = false;
+    if (depth_ == 0) return;
+    window_.erase(window_.begin());
+  }
   window_.push_back(std::move(bookmarks));
+}
+
+void RecoverySender::set_depth(unsigned depth) {
+  assert(depth == 0 || is_valid_coverage(depth));
+  depth_ = depth;
+  if (window_.size() > depth_) {
+    window_.erase(window_.begin(), window_.end() - depth_);
+    whole_history_ = false;
+  }
 }
 
 void RecoverySender::reset() {
   window_.clear();
+  whole_history_ = true;
   state_.reset();
 }
 

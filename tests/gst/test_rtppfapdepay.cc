@@ -1,5 +1,5 @@
-// rtppfapdepay: hand-built PFAP RTP packets in, x-pfap phoneme buffers out, read back with
-// pfap::testing::read_event.
+// rtppfapdepay: hand-built PFAP RTP packets in, x-pfap phoneme and state buffers out, read
+// back with pfap::testing::read_event; requests for a complete state out upstream.
 #include <gst/check/gstharness.h>
 #include <gst/rtp/gstrtpbuffer.h>
 #include <gtest/gtest.h>
@@ -49,6 +49,15 @@ GstBuffer* rtp_packet(const Bytes& payload, guint16 seqnum, GstClockTime pts, bo
   return buffer;
 }
 
+// The same packet from another sender.
+GstBuffer* with_ssrc(GstBuffer* packet, guint32 ssrc) {
+  GstRTPBuffer rtp = GST_RTP_BUFFER_INIT;
+  EXPECT_TRUE(gst_rtp_buffer_map(packet, GST_MAP_WRITE, &rtp));
+  gst_rtp_buffer_set_ssrc(&rtp, ssrc);
+  gst_rtp_buffer_unmap(&rtp);
+  return packet;
+}
+
 Event phoneme_event(const Phoneme& p, std::vector<Fap> faps, uint8_t flags, GstClockTime pts,
                     bool discont = false) {
   return {PFAP_EVENT_PHONEME,
@@ -58,6 +67,12 @@ Event phoneme_event(const Phoneme& p, std::vector<Fap> faps, uint8_t flags, GstC
           pts,
           static_cast<GstClockTime>(p.duration_ms) * GST_MSECOND,
           discont};
+}
+
+// A recovered or complete event: no phoneme, no duration.
+Event state_event(PfapEventKind kind, std::vector<Fap> faps, GstClockTime pts, uint8_t flags = 0,
+                  bool discont = false) {
+  return {kind, flags, Phoneme{}, std::move(faps), pts, GST_CLOCK_TIME_NONE, discont};
 }
 
 // Every buffer the element has output so far.
@@ -82,6 +97,24 @@ guint64 stat(GstHarness* h, const char* field) {
   EXPECT_TRUE(gst_structure_get_uint64(stats, field, &value)) << "no stats field " << field;
   gst_structure_free(stats);
   return value;
+}
+
+// How many requests for a complete state the element has sent upstream so far. The check is
+// gst_video_event_is_force_key_unit's, spelled out: the tests do not link gstreamer-video.
+int pull_requests(GstHarness* h) {
+  int requests = 0;
+  while (GstEvent* event = gst_harness_try_pull_upstream_event(h)) {
+    if (GST_EVENT_TYPE(event) == GST_EVENT_CUSTOM_UPSTREAM &&
+        gst_event_has_name(event, "GstForceKeyUnit")) {
+      gboolean all_headers = FALSE;
+      EXPECT_TRUE(
+          gst_structure_get_boolean(gst_event_get_structure(event), "all-headers", &all_headers));
+      EXPECT_TRUE(all_headers);  // the whole state
+      ++requests;
+    }
+    gst_event_unref(event);
+  }
+  return requests;
 }
 
 // The warnings on `bus`, as "message | debug".
@@ -111,6 +144,35 @@ Bytes good_payload() {
   p.add_phoneme(kGood, {});
   return encode(p);
 }
+
+// A complete state: `entries`, every other FAP 0.
+Bytes complete_payload(std::vector<Fap> entries = {}) {
+  Packet p;
+  p.recovery_kind = RecoveryKind::kComplete;
+  p.recovery = std::move(entries);
+  return encode(p);
+}
+
+// Dynamic recovery over `covered` packets, then kGood with `faps` unless `recovery_only`.
+Bytes dynamic_payload(uint8_t covered, std::vector<Fap> entries, std::vector<Fap> faps = {},
+                      bool recovery_only = false) {
+  Packet p;
+  p.recovery_kind = RecoveryKind::kDynamic;
+  p.covered_packets = covered;
+  p.recovery = std::move(entries);
+  if (!recovery_only) p.add_phoneme(kGood, faps);
+  return encode(p);
+}
+
+// The all-zero complete state a sender begins a stream with (rtppfappay does): it makes the
+// receiver whole and outputs nothing, so the packets after it are certain and ask nothing.
+void start_stream(GstHarness* h, guint16 seqnum, GstClockTime pts = 0) {
+  EXPECT_EQ(gst_harness_push(h, rtp_packet(complete_payload(), seqnum, pts)), GST_FLOW_OK);
+  EXPECT_EQ(gst_harness_try_pull(h), nullptr);
+}
+
+const Fap kJoy{69, 40, 2000, Curve::kSpline};
+const Fap kJaw{3, -500, 120, Curve::kLinear};
 
 class RtpPfapDepayTest : public ::testing::Test {
  protected:
@@ -148,6 +210,7 @@ TEST_F(RtpPfapDepayTest, EachPhonemeBecomesABufferWithItsFapsAndTime) {
   packet.add_phoneme(c, faps_c);
 
   const GstClockTime t = 3 * GST_SECOND;
+  start_stream(h_, 0, t);
   const std::vector<Event> expected = {
       phoneme_event(a, faps_a, PFAP_FLAG_STRESS | PFAP_FLAG_WORD_BEGIN | PFAP_FLAG_SENTENCE_START,
                     t),
@@ -155,7 +218,7 @@ TEST_F(RtpPfapDepayTest, EachPhonemeBecomesABufferWithItsFapsAndTime) {
       phoneme_event(c, faps_c, PFAP_FLAG_END_OF_TEXT, t + 180 * GST_MSECOND),
   };
   EXPECT_EQ(push(h_, rtp_packet(encode(packet), 1, t, /*marker=*/true)), expected);
-  EXPECT_EQ(stat(h_, "packets"), 1u);
+  EXPECT_EQ(stat(h_, "packets"), 2u);  // with the complete state
   EXPECT_EQ(stat(h_, "phonemes"), 3u);
   EXPECT_EQ(stat(h_, "faps"), 3u);
 }
@@ -165,6 +228,7 @@ TEST_F(RtpPfapDepayTest, SentenceStartComesOnlyFromTheMarkerBitOnTheFirstPhoneme
   Packet packet;
   packet.add_phoneme(p, {});
   packet.add_phoneme(p, {});
+  start_stream(h_, 0);
   const std::vector<Event> without_marker = push(h_, rtp_packet(encode(packet), 1, 0));
   ASSERT_EQ(without_marker.size(), 2u);
   EXPECT_EQ(without_marker[0].flags, 0);
@@ -242,12 +306,14 @@ TEST_F(RtpPfapDepayTest, EachMalformedClassIsDroppedAndCountedWhileTheNextPacket
 
   guint16 seqnum = 100;
   GstClockTime t = GST_SECOND;
+  start_stream(h_, seqnum++);
   for (size_t i = 0; i < bad_list.size(); ++i) {
     const BadPacket& bad = bad_list[i];
     SCOPED_TRACE(bad.name);
     EXPECT_TRUE(push(h_, rtp_packet(bad.payload, seqnum++, t, true)).empty());
     t += GST_SECOND;
-    const std::vector<Event> expected = {phoneme_event(kGood, {}, 0, t)};
+    // The bad packet's FAPs are lost as a lost packet's would be, and nothing recovers them.
+    const std::vector<Event> expected = {phoneme_event(kGood, {}, PFAP_FLAG_UNCERTAIN, t)};
     EXPECT_EQ(push(h_, rtp_packet(good_payload(), seqnum++, t)), expected);
     t += GST_SECOND;
 
@@ -255,10 +321,24 @@ TEST_F(RtpPfapDepayTest, EachMalformedClassIsDroppedAndCountedWhileTheNextPacket
     for (const auto& [field, count] : expected_counts)
       EXPECT_EQ(stat(h_, field.c_str()), count) << field;
     EXPECT_EQ(stat(h_, "malformed"), i + 1);
-    EXPECT_EQ(stat(h_, "packets"), 2 * (i + 1));
+    EXPECT_EQ(stat(h_, "packets"), 2 * (i + 1) + 1);
     EXPECT_EQ(stat(h_, "phonemes"), i + 1);
-    EXPECT_EQ(stat(h_, "lost"), 0u);
+    EXPECT_EQ(stat(h_, "lost"), i + 1);
   }
+}
+
+TEST_F(RtpPfapDepayTest, MalformedPacketIsRecoveredLikeALostOne) {
+  start_stream(h_, 0);
+  push(h_, rtp_packet(good_payload(), 1, GST_SECOND));
+  EXPECT_TRUE(push(h_, rtp_packet({0x02}, 2, 2 * GST_SECOND)).empty());
+  const std::vector<Event> expected = {
+      state_event(PFAP_EVENT_RECOVERED, {kJaw}, 3 * GST_SECOND),
+      phoneme_event(kGood, {}, 0, 3 * GST_SECOND),
+  };
+  EXPECT_EQ(push(h_, rtp_packet(dynamic_payload(1, {kJaw}), 3, 3 * GST_SECOND)), expected);
+  EXPECT_EQ(stat(h_, "lost"), 1u);
+  EXPECT_EQ(stat(h_, "recovered"), 1u);
+  EXPECT_EQ(pull_requests(h_), 0);
 }
 
 TEST_F(RtpPfapDepayTest, MalformedPacketPostsAWarningNamingTheErrorAndItsOffset) {
@@ -284,6 +364,7 @@ TEST_F(RtpPfapDepayTest, WarningsAreLimitedToPowersOfTwoOfTheMalformedCount) {
 // Only a payload over 393 KB can hold this many FAPs; x-pfap counts them in 16 bits.
 TEST_F(RtpPfapDepayTest, PhonemeWithMoreFapsThanXPfapHoldsDropsThePacketWithAWarning) {
   GstBus* bus = watch_bus();
+  start_stream(h_, 0);
   Packet huge;
   huge.add_phoneme(kGood, std::vector<Fap>(G_MAXUINT16 + 1, Fap{3, 1, 0, Curve::kLinear}));
   EXPECT_TRUE(push(h_, rtp_packet(encode(huge), 1, 0)).empty());
@@ -291,8 +372,10 @@ TEST_F(RtpPfapDepayTest, PhonemeWithMoreFapsThanXPfapHoldsDropsThePacketWithAWar
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_TRUE(contains(warnings[0], "65536 FAPs")) << warnings[0];
 
-  const std::vector<Event> expected = {phoneme_event(kGood, {}, 0, GST_SECOND)};
+  // Its FAPs are missing downstream, so it counts as lost.
+  const std::vector<Event> expected = {phoneme_event(kGood, {}, PFAP_FLAG_UNCERTAIN, GST_SECOND)};
   EXPECT_EQ(push(h_, rtp_packet(good_payload(), 2, GST_SECOND)), expected);
+  EXPECT_EQ(stat(h_, "lost"), 1u);
 }
 
 TEST_F(RtpPfapDepayTest, SequenceGapMarksTheNextOutputDiscontAndCountsTheLostPackets) {
@@ -306,7 +389,8 @@ TEST_F(RtpPfapDepayTest, SequenceGapMarksTheNextOutputDiscontAndCountsTheLostPac
   // A gap before a malformed packet: the DISCONT waits for the next buffer out.
   EXPECT_TRUE(push(h_, rtp_packet({0x02}, 110, 4 * GST_SECOND)).empty());
   EXPECT_TRUE(push(h_, rtp_packet(good_payload(), 111, 5 * GST_SECOND)).at(0).discont);
-  EXPECT_EQ(stat(h_, "lost"), 6u);
+  EXPECT_EQ(stat(h_, "lost"), 7u);  // 107 to 110: the malformed packet counts too
+  EXPECT_EQ(stat(h_, "gaps"), 2u);
 }
 
 TEST_F(RtpPfapDepayTest, LostPacketsAreCountedAcrossTheSequenceNumberWrap) {
@@ -323,32 +407,186 @@ TEST_F(RtpPfapDepayTest, OnlyForwardJumpsCountAsLoss) {
   EXPECT_TRUE(push(h_, rtp_packet(good_payload(), 30000, 2 * GST_SECOND)).at(0).discont);
   EXPECT_EQ(stat(h_, "lost"), 19999u);
   // Another sender's sequence numbers say nothing about this one's losses.
-  GstBuffer* other_sender = rtp_packet(good_payload(), 31000, 3 * GST_SECOND);
-  GstRTPBuffer rtp = GST_RTP_BUFFER_INIT;
-  ASSERT_TRUE(gst_rtp_buffer_map(other_sender, GST_MAP_WRITE, &rtp));
-  gst_rtp_buffer_set_ssrc(&rtp, kSsrc + 1);
-  gst_rtp_buffer_unmap(&rtp);
-  EXPECT_TRUE(push(h_, other_sender).at(0).discont);
+  EXPECT_TRUE(push(h_, with_ssrc(rtp_packet(good_payload(), 31000, 3 * GST_SECOND), kSsrc + 1))
+                  .at(0)
+                  .discont);
   EXPECT_EQ(stat(h_, "lost"), 19999u);
 }
 
-TEST_F(RtpPfapDepayTest, RecoveryIsCountedButNotOutputYet) {
-  // Complete recovery, one entry: FAP 3 = 100 (test_payload.cc "complete_recovery").
-  EXPECT_TRUE(push(h_, rtp_packet({0xA2, 0x06, 0x00, 0x01, 0x90, 0x00, 0x07}, 1, 0)).empty());
-  // Dynamic recovery over 4 packets with two entries, then a phoneme.
-  Packet dynamic;
-  dynamic.recovery_kind = RecoveryKind::kDynamic;
-  dynamic.covered_packets = 4;
-  dynamic.recovery = {{48, -20000, 0, Curve::kLinear}, {74, 5, 300, Curve::kTriangle}};
-  dynamic.add_phoneme(kGood, {});
-  const std::vector<Event> expected = {phoneme_event(kGood, {}, 0, GST_SECOND)};
-  EXPECT_EQ(push(h_, rtp_packet(encode(dynamic), 2, GST_SECOND)), expected);
+TEST_F(RtpPfapDepayTest, CoveredGapOutputsTheRecoveryEntriesBeforeThePhonemesStayingCertain) {
+  start_stream(h_, 9);
+  push(h_, rtp_packet(good_payload(), 10, GST_SECOND));
+  // 11 and 12 are lost; 13 covers 4 packets.
+  const GstClockTime t = 2 * GST_SECOND;
+  const std::vector<Event> expected = {
+      state_event(PFAP_EVENT_RECOVERED, {kJaw, kJoy}, t, 0, /*discont=*/true),
+      phoneme_event(kGood, {kJoy}, 0, t),
+  };
+  EXPECT_EQ(push(h_, rtp_packet(dynamic_payload(4, {kJaw, kJoy}, {kJoy}), 13, t)), expected);
+  EXPECT_EQ(stat(h_, "lost"), 2u);
+  EXPECT_EQ(stat(h_, "gaps"), 1u);
+  EXPECT_EQ(stat(h_, "recovered"), 1u);
+  EXPECT_EQ(stat(h_, "faps-recovered"), 2u);
+  EXPECT_EQ(stat(h_, "phonemes"), 2u);
+  EXPECT_EQ(stat(h_, "faps"), 1u);  // phoneme FAPs only
+  EXPECT_EQ(pull_requests(h_), 0);
+}
 
-  EXPECT_EQ(stat(h_, "complete-recoveries"), 1u);
-  EXPECT_EQ(stat(h_, "recovery-entries"), 3u);
+TEST_F(RtpPfapDepayTest, RecoveryOnlyPacketAfterACoveredGapOutputsTheRecoveredEvent) {
+  start_stream(h_, 0);
+  push(h_, rtp_packet(good_payload(), 1, GST_SECOND));
+  const std::vector<Event> expected = {
+      state_event(PFAP_EVENT_RECOVERED, {kJoy}, 2 * GST_SECOND, 0, /*discont=*/true)};
+  EXPECT_EQ(push(h_, rtp_packet(dynamic_payload(2, {kJoy}, {}, /*recovery_only=*/true), 3,
+                                2 * GST_SECOND)),
+            expected);
+  EXPECT_EQ(stat(h_, "recovered"), 1u);
+}
+
+// PP without entries: the covered packets left nothing in effect, so the state is whole.
+TEST_F(RtpPfapDepayTest, CoveredGapWithNothingToRecoverOutputsARecoveredEventWithoutFaps) {
+  start_stream(h_, 0);
+  push(h_, rtp_packet(good_payload(), 1, GST_SECOND));
+  const std::vector<Event> expected = {
+      state_event(PFAP_EVENT_RECOVERED, {}, 2 * GST_SECOND, 0, /*discont=*/true),
+      phoneme_event(kGood, {}, 0, 2 * GST_SECOND)};
+  EXPECT_EQ(push(h_, rtp_packet(dynamic_payload(1, {}), 3, 2 * GST_SECOND)), expected);
+  EXPECT_EQ(stat(h_, "faps-recovered"), 0u);
+  EXPECT_EQ(pull_requests(h_), 0);
+}
+
+// The phonemes before the entries already set those FAPs: applying them again is no news.
+TEST_F(RtpPfapDepayTest, RecoveryEntriesWithoutLossAreNotOutput) {
+  start_stream(h_, 0);
+  const std::vector<Event> expected = {phoneme_event(kGood, {}, 0, GST_SECOND)};
+  EXPECT_EQ(push(h_, rtp_packet(dynamic_payload(4, {kJaw, kJoy}), 1, GST_SECOND)), expected);
+  EXPECT_EQ(stat(h_, "gaps"), 0u);
   EXPECT_EQ(stat(h_, "recovered"), 0u);
-  EXPECT_EQ(stat(h_, "malformed"), 0u);
-  EXPECT_EQ(stat(h_, "packets"), 2u);
+  EXPECT_EQ(stat(h_, "faps-recovered"), 0u);
+}
+
+TEST_F(RtpPfapDepayTest, UncoveredGapIsUncertainAndAsksForACompleteStateUntilOneComes) {
+  start_stream(h_, 0);
+  EXPECT_EQ(push(h_, rtp_packet(good_payload(), 1, 100 * GST_MSECOND)).at(0).flags, 0);
+  EXPECT_EQ(pull_requests(h_), 0);
+
+  // 2 to 6 are lost; 7 covers only 2 packets, so its entries are not applied.
+  const std::vector<Event> uncovered = {
+      phoneme_event(kGood, {}, PFAP_FLAG_UNCERTAIN, GST_SECOND, /*discont=*/true)};
+  EXPECT_EQ(push(h_, rtp_packet(dynamic_payload(2, {kJoy}), 7, GST_SECOND)), uncovered);
+  EXPECT_EQ(pull_requests(h_), 1);
+  // Asked again only after a second of packet time: the request or the answer may be lost.
+  EXPECT_EQ(push(h_, rtp_packet(good_payload(), 8, 1500 * GST_MSECOND)).at(0).flags,
+            PFAP_FLAG_UNCERTAIN);
+  EXPECT_EQ(pull_requests(h_), 0);
+  EXPECT_EQ(push(h_, rtp_packet(good_payload(), 9, 2 * GST_SECOND)).at(0).flags,
+            PFAP_FLAG_UNCERTAIN);
+  EXPECT_EQ(pull_requests(h_), 1);
+
+  const GstClockTime t = 2200 * GST_MSECOND;
+  const std::vector<Event> complete = {state_event(PFAP_EVENT_COMPLETE, {kJaw, kJoy}, t)};
+  EXPECT_EQ(push(h_, rtp_packet(complete_payload({kJaw, kJoy}), 10, t)), complete);
+  EXPECT_EQ(push(h_, rtp_packet(good_payload(), 11, 3500 * GST_MSECOND)).at(0).flags, 0);
+  EXPECT_EQ(pull_requests(h_), 0);
+
+  EXPECT_EQ(stat(h_, "lost"), 5u);
+  EXPECT_EQ(stat(h_, "gaps"), 1u);
+  EXPECT_EQ(stat(h_, "recovered"), 0u);
+  EXPECT_EQ(stat(h_, "requests"), 2u);
+  EXPECT_EQ(stat(h_, "complete-states"), 2u);
+  EXPECT_EQ(stat(h_, "complete-changes"), 1u);
+}
+
+TEST_F(RtpPfapDepayTest, WithoutRequestRecoveryAnUncoveredGapAsksForNothing) {
+  gboolean request_recovery = FALSE;
+  g_object_get(h_->element, "request-recovery", &request_recovery, nullptr);
+  EXPECT_TRUE(request_recovery);  // the default
+  g_object_set(h_->element, "request-recovery", FALSE, nullptr);
+
+  start_stream(h_, 0);
+  push(h_, rtp_packet(good_payload(), 1, 0));
+  EXPECT_EQ(push(h_, rtp_packet(good_payload(), 7, GST_SECOND)).at(0).flags, PFAP_FLAG_UNCERTAIN);
+  EXPECT_EQ(push(h_, rtp_packet(good_payload(), 8, 3 * GST_SECOND)).at(0).flags,
+            PFAP_FLAG_UNCERTAIN);
+  EXPECT_EQ(pull_requests(h_), 0);
+  EXPECT_EQ(stat(h_, "requests"), 0u);
+}
+
+// A depayloader cannot tell a stream's first packet from one it joined late.
+TEST_F(RtpPfapDepayTest, StreamThatStartsWithDataIsUncertainAndAsksForACompleteState) {
+  const std::vector<Event> expected = {phoneme_event(kGood, {}, PFAP_FLAG_UNCERTAIN, 0)};
+  EXPECT_EQ(push(h_, rtp_packet(good_payload(), 1, 0)), expected);
+  EXPECT_EQ(pull_requests(h_), 1);
+  EXPECT_EQ(stat(h_, "lost"), 0u);
+}
+
+TEST_F(RtpPfapDepayTest, StreamThatStartsWithAnAllZeroCompleteStateIsWholeAndOutputsNothing) {
+  EXPECT_TRUE(push(h_, rtp_packet(complete_payload(), 1, 0)).empty());
+  EXPECT_EQ(push(h_, rtp_packet(good_payload(), 2, GST_SECOND)).at(0).flags, 0);
+  EXPECT_EQ(pull_requests(h_), 0);
+  EXPECT_EQ(stat(h_, "complete-states"), 1u);
+  EXPECT_EQ(stat(h_, "complete-changes"), 0u);
+}
+
+// An unchanged state says nothing new, and a stream without loss stays what was sent.
+TEST_F(RtpPfapDepayTest, CompleteStateEqualToTheCurrentStateOutputsNothing) {
+  start_stream(h_, 0);
+  const Fap jaw_at_once{3, -500, 0, Curve::kLinear};
+  push(h_, rtp_packet(dynamic_payload(1, {}, {kJaw}), 1, 0));
+  // kJaw has settled by then; its value with no transition is the same state.
+  EXPECT_TRUE(push(h_, rtp_packet(complete_payload({jaw_at_once}), 2, GST_SECOND)).empty());
+
+  const Fap jaw_closed{3, 0, 0, Curve::kLinear};
+  const std::vector<Event> changed = {
+      state_event(PFAP_EVENT_COMPLETE, {jaw_closed}, 2 * GST_SECOND)};
+  EXPECT_EQ(push(h_, rtp_packet(complete_payload({jaw_closed}), 3, 2 * GST_SECOND)), changed);
+  EXPECT_EQ(stat(h_, "complete-states"), 3u);
+  EXPECT_EQ(stat(h_, "complete-changes"), 1u);
+}
+
+TEST_F(RtpPfapDepayTest, NewSsrcStartsANewStream) {
+  start_stream(h_, 0);
+  EXPECT_EQ(push(h_, rtp_packet(good_payload(), 1, 0)).at(0).flags, 0);
+  // A restarted sender: no loss counted between the two, and it may be joined mid-stream.
+  const std::vector<Event> joined = {
+      phoneme_event(kGood, {}, PFAP_FLAG_UNCERTAIN, GST_SECOND, /*discont=*/true)};
+  EXPECT_EQ(push(h_, with_ssrc(rtp_packet(good_payload(), 40000, GST_SECOND), kSsrc + 1)), joined);
+  EXPECT_EQ(pull_requests(h_), 1);
+  EXPECT_EQ(stat(h_, "lost"), 0u);
+
+  // A third sender that begins with a complete state is whole at once.
+  EXPECT_TRUE(
+      push(h_, with_ssrc(rtp_packet(complete_payload(), 7, 2 * GST_SECOND), kSsrc + 2)).empty());
+  EXPECT_EQ(
+      push(h_, with_ssrc(rtp_packet(good_payload(), 8, 3 * GST_SECOND), kSsrc + 2)).at(0).flags, 0);
+  EXPECT_EQ(pull_requests(h_), 0);
+}
+
+// rtpjitterbuffer's packet-lost event says the loss before the next packet does, but not
+// whether that packet's recovery covers it: the loss is counted there.
+TEST_F(RtpPfapDepayTest, PacketLostEventIsCountedAndBecomesAGap) {
+  start_stream(h_, 0);
+  push(h_, rtp_packet(good_payload(), 1, 0));
+  while (GstEvent* event = gst_harness_try_pull_event(h_)) gst_event_unref(event);
+  GstStructure* lost =
+      gst_structure_new("GstRTPPacketLost", "seqnum", G_TYPE_UINT, 2u, "timestamp", G_TYPE_UINT64,
+                        GST_SECOND, "duration", G_TYPE_UINT64, 100 * GST_MSECOND, nullptr);
+  EXPECT_TRUE(gst_harness_push_event(h_, gst_event_new_custom(GST_EVENT_CUSTOM_DOWNSTREAM, lost)));
+
+  GstEvent* gap = gst_harness_try_pull_event(h_);
+  ASSERT_NE(gap, nullptr);
+  ASSERT_EQ(GST_EVENT_TYPE(gap), GST_EVENT_GAP);
+  GstClockTime start = GST_CLOCK_TIME_NONE;
+  GstClockTime duration = GST_CLOCK_TIME_NONE;
+  gst_event_parse_gap(gap, &start, &duration);
+  EXPECT_EQ(start, GST_SECOND);
+  EXPECT_EQ(duration, 100 * GST_MSECOND);
+  gst_event_unref(gap);
+  EXPECT_EQ(stat(h_, "packet-lost-events"), 1u);
+  EXPECT_EQ(stat(h_, "lost"), 0u);
+
+  push(h_, rtp_packet(good_payload(), 3, 2 * GST_SECOND));
+  EXPECT_EQ(stat(h_, "lost"), 1u);
 }
 
 TEST_F(RtpPfapDepayTest, StreamStartOnTheSourceSideIsSparse) {
@@ -461,18 +699,21 @@ TEST_F(RtpPfapDepayTest, EosPassesThrough) {
   EXPECT_TRUE(saw_eos);
 }
 
-TEST_F(RtpPfapDepayTest, FlushForgetsTheSequenceNumberButKeepsTheCounters) {
-  push(h_, rtp_packet(good_payload(), 10, 0));
+// After a seek the stream goes on somewhere else: a new stream, maybe joined mid-way.
+TEST_F(RtpPfapDepayTest, FlushStartsANewStreamButKeepsTheCounters) {
+  start_stream(h_, 9);
+  EXPECT_EQ(push(h_, rtp_packet(good_payload(), 10, 0)).at(0).flags, 0);
   EXPECT_TRUE(gst_harness_push_event(h_, gst_event_new_flush_start()));
   EXPECT_TRUE(gst_harness_push_event(h_, gst_event_new_flush_stop(TRUE)));
   GstSegment segment;
   gst_segment_init(&segment, GST_FORMAT_TIME);
   EXPECT_TRUE(gst_harness_push_event(h_, gst_event_new_segment(&segment)));
 
-  const std::vector<Event> expected = {phoneme_event(kGood, {}, 0, GST_SECOND)};
+  const std::vector<Event> expected = {phoneme_event(kGood, {}, PFAP_FLAG_UNCERTAIN, GST_SECOND)};
   EXPECT_EQ(push(h_, rtp_packet(good_payload(), 5000, GST_SECOND)), expected);
+  EXPECT_EQ(pull_requests(h_), 1);
   EXPECT_EQ(stat(h_, "lost"), 0u);
-  EXPECT_EQ(stat(h_, "packets"), 2u);
+  EXPECT_EQ(stat(h_, "packets"), 3u);
 }
 
 TEST_F(RtpPfapDepayTest, GoingFromReadyToPausedClearsTheCounters) {

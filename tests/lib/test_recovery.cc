@@ -298,6 +298,55 @@ TEST(RecoverySender, CoverageShrinksToFitTheRoomLeft) {
   }
 }
 
+// Packets with one FAP each, FAP 3 + i in packet i.
+void send_packets(RecoverySender& sender, int from, int to) {
+  for (int i = from; i < to; ++i) {
+    Packet p;
+    p.add_phoneme({.duration_ms = 10},
+                  std::vector<Fap>{{static_cast<uint8_t>(3 + i), 100, 0, Curve::kLinear}});
+    sender.sent(p, i * 10 * kNsPerMs);
+  }
+}
+
+TEST(RecoverySender, AtStreamStartTheFullDepthIsClaimedSinceNothingIsOlder) {
+  RecoverySender sender(15);
+  send_packets(sender, 0, 2);
+  Packet next;
+  sender.add_dynamic(next, 100 * kNsPerMs, 1000);
+  EXPECT_EQ(next.covered_packets, 15);
+  EXPECT_EQ(next.recovery.size(), 2u);
+}
+
+TEST(RecoverySender, DeeperDepthMidStreamGrowsWithThePacketsItHolds) {
+  RecoverySender sender(2);
+  send_packets(sender, 0, 5);  // holds packets 3 and 4 only
+  sender.set_depth(7);
+  Packet next;
+  sender.add_dynamic(next, 100 * kNsPerMs, 1000);
+  EXPECT_EQ(next.covered_packets, 2) << "never claims packets it did not keep";
+  send_packets(sender, 5, 7);  // now holds 3..6
+  sender.add_dynamic(next, 100 * kNsPerMs, 1000);
+  EXPECT_EQ(next.covered_packets, 4);
+  send_packets(sender, 7, 12);
+  sender.add_dynamic(next, 200 * kNsPerMs, 1000);
+  EXPECT_EQ(next.covered_packets, 7);
+  EXPECT_EQ(next.recovery.size(), 7u);
+}
+
+TEST(RecoverySender, ShallowerDepthKeepsTheStateAndTheNewestPackets) {
+  RecoverySender sender(7);
+  send_packets(sender, 0, 7);
+  sender.set_depth(2);
+  Packet next;
+  sender.add_dynamic(next, 100 * kNsPerMs, 1000);
+  EXPECT_EQ(next.covered_packets, 2);
+  EXPECT_EQ(next.recovery,
+            (std::vector<Fap>{{8, 100, 0, Curve::kLinear}, {9, 100, 0, Curve::kLinear}}));
+  Packet complete;
+  ASSERT_TRUE(sender.make_complete(complete, 100 * kNsPerMs, 1000));
+  EXPECT_EQ(complete.recovery.size(), 7u) << "the state is kept";
+}
+
 TEST(RecoverySender, CompleteStateListsOnlyNonZeroFapsAndIsNeverCut) {
   RecoverySender sender(0);
   Packet p;

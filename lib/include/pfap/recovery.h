@@ -36,6 +36,11 @@ class RecoverySender {
   // takes every FAP left out for 0, so a complete state is never cut (72 FAPs take 433).
   bool make_complete(Packet& out, int64_t time_ns, size_t room) const;
 
+  // Changes the depth mid-stream, keeping the FAP state. The coverage a packet claims never
+  // reaches further back than the packets the sender still holds since the stream began,
+  // so after a deeper depth it grows one packet at a time.
+  void set_depth(unsigned depth);
+
   // Records a packet as sent: data (its phonemes' FAPs, the first phoneme starting at
   // `time_ns`) or recovery only. Every packet counts towards the coverage.
   void sent(const Packet& packet, int64_t time_ns);
@@ -51,6 +56,8 @@ class RecoverySender {
  private:
   unsigned depth_;
   std::vector<std::vector<Bookmark>> window_;  // the last `depth` packets, oldest first
+  // The window holds every packet since the stream began: there is nothing older to cover.
+  bool whole_history_ = true;
   FapState state_;
 };
 
