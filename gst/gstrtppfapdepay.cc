@@ -382,11 +382,18 @@ static GstBuffer* gst_rtp_pfap_depay_process_rtp_packet(GstRTPBaseDepayload* dep
   return nullptr;
 }
 
-// Counted only: the loss is accounted at the next packet, whose sequence number tells how
-// many were lost and whose coverage whether recovery repairs them. The parent pushes a GAP,
-// so that downstream does not wait for the lost time.
+// A loss with a sequence number is accounted at the next packet, whose sequence number tells
+// how many were lost and whose coverage whether recovery repairs them. One without (what
+// rtpulpfecdec sends for a packet it could not rebuild, after renumbering the rest) leaves no
+// gap in the sequence numbers to see: the state is uncertain from here. The parent pushes a
+// GAP, so that downstream does not wait for the lost time.
 static gboolean gst_rtp_pfap_depay_packet_lost(GstRTPBaseDepayload* depay, GstEvent* event) {
-  update_stats(GST_RTP_PFAP_DEPAY(depay), [](Stats& s) { ++s.packet_lost_events; });
+  GstRtpPfapDepay* self = GST_RTP_PFAP_DEPAY(depay);
+  update_stats(self, [](Stats& s) { ++s.packet_lost_events; });
+  if (!gst_structure_has_field(gst_event_get_structure(event), "seqnum")) {
+    GST_DEBUG_OBJECT(self, "packet lost without a sequence number: state uncertain");
+    self->receiver.lost_unknown();
+  }
   return GST_RTP_BASE_DEPAYLOAD_CLASS(gst_rtp_pfap_depay_parent_class)->packet_lost(depay, event);
 }
 

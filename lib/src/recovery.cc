@@ -136,6 +136,12 @@ ReceiveResult RecoveryReceiver::receive(const Packet& packet, uint16_t seqnum, i
   return result;
 }
 
+void RecoveryReceiver::lost_unknown() {
+  if (!whole_) return;
+  whole_ = false;
+  last_request_ns_.reset();
+}
+
 void RecoveryReceiver::reset(bool joined_mid_stream) {
   state_.reset();
   last_seqnum_.reset();

@@ -589,6 +589,24 @@ TEST_F(RtpPfapDepayTest, PacketLostEventIsCountedAndBecomesAGap) {
   EXPECT_EQ(stat(h_, "lost"), 1u);
 }
 
+// rtpulpfecdec renumbers what it passes on and reports a packet it could not rebuild with a
+// packet-lost event without a sequence number: no gap shows, so the state is uncertain.
+TEST_F(RtpPfapDepayTest, PacketLostEventWithoutSeqnumMakesTheStateUncertainAndAsks) {
+  start_stream(h_, 0);
+  push(h_, rtp_packet(good_payload(), 1, 0));
+  while (GstEvent* event = gst_harness_try_pull_event(h_)) gst_event_unref(event);
+  GstStructure* lost = gst_structure_new("GstRTPPacketLost", "timestamp", G_TYPE_UINT64, GST_SECOND,
+                                         "duration", G_TYPE_UINT64, 100 * GST_MSECOND,
+                                         "might-have-been-fec", G_TYPE_BOOLEAN, TRUE, nullptr);
+  EXPECT_TRUE(gst_harness_push_event(h_, gst_event_new_custom(GST_EVENT_CUSTOM_DOWNSTREAM, lost)));
+  EXPECT_EQ(pull_requests(h_), 0);
+
+  const std::vector<Event> next = push(h_, rtp_packet(good_payload(), 2, 2 * GST_SECOND));
+  ASSERT_EQ(next.size(), 1u);
+  EXPECT_EQ(next[0].flags, PFAP_FLAG_UNCERTAIN);
+  EXPECT_EQ(pull_requests(h_), 1);
+}
+
 TEST_F(RtpPfapDepayTest, StreamStartOnTheSourceSideIsSparse) {
   push(h_, rtp_packet(good_payload(), 1, 0));
   GstEvent* upstream = gst_pad_get_sticky_event(h_->srcpad, GST_EVENT_STREAM_START, 0);

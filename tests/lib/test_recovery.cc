@@ -186,6 +186,22 @@ TEST(RecoveryReceiver, AsksAgainEachRetryIntervalWhileNotWhole) {
   EXPECT_EQ(asked_at, (std::vector<int64_t>{0, 1000, 2000}));
 }
 
+TEST(RecoveryReceiver, LossOfUnknownSizeBreaksTheStateUntilACompleteState) {
+  RecoveryReceiver r;
+  Packet covered;
+  covered.recovery_kind = RecoveryKind::kDynamic;
+  covered.covered_packets = 40;
+  covered.add_phoneme({.duration_ms = 10}, {});
+  EXPECT_TRUE(r.receive(covered, 1, 0).state_whole);
+  r.lost_unknown();
+  const ReceiveResult next = r.receive(covered, 2, 10 * kNsPerMs);  // no seqnum gap
+  EXPECT_FALSE(next.state_whole) << "no coverage is known to span a loss of unknown size";
+  EXPECT_TRUE(next.request_complete);
+  Packet complete;
+  complete.recovery_kind = RecoveryKind::kComplete;
+  EXPECT_TRUE(r.receive(complete, 3, 20 * kNsPerMs).state_whole);
+}
+
 TEST(RecoveryReceiver, CompleteStateSaysWhetherItChangedAnything) {
   RecoveryReceiver r;
   Packet zero;

@@ -88,6 +88,11 @@ class RecoveryReceiver {
   // starts. Loss is counted from sequence numbers, packets in order (after a jitterbuffer);
   // a sequence number that goes back (duplicate, late or restarted) counts no loss.
   ReceiveResult receive(const Packet& packet, uint16_t seqnum, int64_t time_ns);
+  // A loss whose size is unknown (a packet-lost event without a sequence number, as
+  // rtpulpfecdec sends for what it could not rebuild after renumbering): no coverage can be
+  // known to span it, so the state is not whole until a complete state, and the next packet
+  // asks for one.
+  void lost_unknown();
   const FapState& state() const { return state_; }
   bool state_whole() const { return whole_; }
   // Back to no packet seen. A receiver that may have joined mid-stream is not whole until
