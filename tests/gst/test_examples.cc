@@ -35,6 +35,8 @@
 #include <thread>
 #include <vector>
 
+#include "pipeline.h"
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -288,112 +290,7 @@ class RtspServer {
 // Pipelines
 
 // A pipeline from a launch description, set to NULL and released on destruction.
-class Pipeline {
- public:
-  explicit Pipeline(const std::string& description) {
-    GError* error = nullptr;
-    GstElement* element = gst_parse_launch(description.c_str(), &error);
-    if (error != nullptr) {
-      error_ = std::string(error->message) + " in: " + description;
-      g_error_free(error);
-      if (element != nullptr) gst_object_unref(element);
-      return;
-    }
-    pipeline_ = element;
-  }
-  ~Pipeline() {
-    if (pipeline_ == nullptr) return;
-    gst_element_set_state(pipeline_, GST_STATE_NULL);
-    gst_object_unref(pipeline_);
-  }
-  Pipeline(const Pipeline&) = delete;
-  Pipeline& operator=(const Pipeline&) = delete;
-
-  GstElement* get() const { return pipeline_; }
-  const std::string& error() const { return error_; }
-
-  // The first element made by `factory`, searched through bins (not a new reference).
-  GstElement* find(const char* factory) const {
-    GstElement* found = nullptr;
-    GstIterator* it = gst_bin_iterate_recurse(GST_BIN(pipeline_));
-    GValue item = G_VALUE_INIT;
-    while (found == nullptr && gst_iterator_next(it, &item) == GST_ITERATOR_OK) {
-      auto* element = GST_ELEMENT(g_value_get_object(&item));
-      GstElementFactory* f = gst_element_get_factory(element);
-      if (f != nullptr && std::string(GST_OBJECT_NAME(f)) == factory) found = element;
-      g_value_reset(&item);
-    }
-    g_value_unset(&item);
-    gst_iterator_free(it);
-    return found;
-  }
-
-  // Starts it: a live pipeline completes PLAYING only when data comes, so no waiting here.
-  ::testing::AssertionResult play() {
-    if (gst_element_set_state(pipeline_, GST_STATE_PLAYING) == GST_STATE_CHANGE_FAILURE) {
-      return ::testing::AssertionFailure() << "cannot start: " << bus_error();
-    }
-    return ::testing::AssertionSuccess();
-  }
-
-  // An error (or, with warnings, a warning) posted so far, or "".
-  std::string bus_error(bool warnings = false) {
-    GstBus* bus = gst_element_get_bus(pipeline_);
-    const auto types = static_cast<GstMessageType>(
-        GST_MESSAGE_ERROR | (warnings ? GST_MESSAGE_WARNING : GST_MESSAGE_UNKNOWN));
-    std::string text;
-    while (GstMessage* message = gst_bus_pop_filtered(bus, types)) {
-      text += describe(message);
-      gst_message_unref(message);
-    }
-    gst_object_unref(bus);
-    return text;
-  }
-
-  // Waits for EOS; fails on an error, a warning (with `warnings`) or after `timeout`.
-  ::testing::AssertionResult wait_eos(GstClockTime timeout, bool warnings = false) {
-    GstBus* bus = gst_element_get_bus(pipeline_);
-    const auto types =
-        static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR |
-                                    (warnings ? GST_MESSAGE_WARNING : GST_MESSAGE_UNKNOWN));
-    GstMessage* message = gst_bus_timed_pop_filtered(bus, timeout, types);
-    gst_object_unref(bus);
-    if (message == nullptr) return ::testing::AssertionFailure() << "no EOS in time";
-    const bool eos = GST_MESSAGE_TYPE(message) == GST_MESSAGE_EOS;
-    const std::string text = describe(message);
-    gst_message_unref(message);
-    if (!eos) return ::testing::AssertionFailure() << text;
-    return ::testing::AssertionSuccess();
-  }
-
-  // Sends EOS into every source, as gst-launch-1.0 -e does on Ctrl-C, and waits for it.
-  ::testing::AssertionResult end(GstClockTime timeout) {
-    gst_element_send_event(pipeline_, gst_event_new_eos());
-    return wait_eos(timeout);
-  }
-
- private:
-  static std::string describe(GstMessage* message) {
-    GError* error = nullptr;
-    gchar* debug = nullptr;
-    if (GST_MESSAGE_TYPE(message) == GST_MESSAGE_ERROR) {
-      gst_message_parse_error(message, &error, &debug);
-    } else if (GST_MESSAGE_TYPE(message) == GST_MESSAGE_WARNING) {
-      gst_message_parse_warning(message, &error, &debug);
-    } else {
-      return GST_MESSAGE_TYPE_NAME(message);
-    }
-    std::string text = std::string(GST_MESSAGE_TYPE_NAME(message)) + " from " +
-                       GST_OBJECT_NAME(GST_MESSAGE_SRC(message)) + ": " + error->message + " (" +
-                       (debug != nullptr ? debug : "") + ")\n";
-    g_error_free(error);
-    g_free(debug);
-    return text;
-  }
-
-  GstElement* pipeline_ = nullptr;
-  std::string error_;
-};
+using pfap::testing::Pipeline;
 
 // What flows out of an element's src pad: the bytes (text from pfaptextenc) and a count.
 struct Tap {
@@ -449,7 +346,7 @@ template <typename Done>
   const auto deadline = Clock::now() + timeout;
   while (!done()) {
     for (Pipeline* p : pipelines) {
-      const std::string error = p->bus_error();
+      const std::string error = p->poll_error();
       if (!error.empty()) return ::testing::AssertionFailure() << error;
     }
     if (Clock::now() > deadline) return ::testing::AssertionFailure() << "timed out: " << what;
@@ -594,8 +491,8 @@ TEST(ExampleFiles, EveryFileParses) {
     g_object_set(filesrc, "location", file.c_str(), nullptr);
     Tap events;
     events.attach(p.find("pfapparse"));
-    ASSERT_TRUE(p.play());
-    EXPECT_TRUE(p.wait_eos(5 * GST_SECOND, /*warnings=*/true));
+    ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+    EXPECT_EQ(p.wait_eos(std::chrono::seconds(5), /*warnings=*/true), "");
     EXPECT_EQ(events.count(), count_events(read_file(file)));
   }
 }
@@ -610,8 +507,8 @@ TEST(ExampleFiles, ReadBackThroughTextEnc) {
     g_object_set(p.find("filesrc"), "location", file.c_str(), nullptr);
     Tap text;
     text.attach(p.find("pfaptextenc"));
-    ASSERT_TRUE(p.play());
-    ASSERT_TRUE(p.wait_eos(5 * GST_SECOND, /*warnings=*/true));
+    ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+    ASSERT_EQ(p.wait_eos(std::chrono::seconds(5), /*warnings=*/true), "");
     EXPECT_EQ(text.text(), event_lines(read_file(file)));
   }
 }
@@ -697,7 +594,7 @@ TEST(Rtsp, ServesAudioAndPhonemes) {
   Tap audio, text;
   audio.attach(client.find("rtpL16depay"));
   text.attach(client.find("pfaptextenc"));
-  ASSERT_TRUE(client.play());
+  ASSERT_EQ(client.set_state(GST_STATE_PLAYING), "");
   ASSERT_TRUE(wait_until(
       {&client}, [&] { return text.lines() >= count_events(want) && audio.count() >= 10; }, 15s,
       "every phoneme and 10 audio buffers"))
@@ -783,12 +680,12 @@ TEST(DocumentedLines, Udp) {
   Tap text;
   text.attach(receiver.find("pfaptextenc"));
 
-  ASSERT_TRUE(receiver.play());  // bound once set_state returns
-  ASSERT_TRUE(sender.play());
-  ASSERT_TRUE(sender.wait_eos(10 * GST_SECOND)) << "the sender sends in real time";
+  ASSERT_EQ(receiver.set_state(GST_STATE_PLAYING), "");  // bound once set_state returns
+  ASSERT_EQ(sender.set_state(GST_STATE_PLAYING), "");
+  ASSERT_EQ(sender.wait_eos(std::chrono::seconds(10)), "") << "the sender sends in real time";
   ASSERT_TRUE(wait_until(
       {&receiver}, [&] { return text.lines() >= count_events(want); }, 5s, "every phoneme"));
-  ASSERT_TRUE(receiver.end(5 * GST_SECOND));
+  ASSERT_EQ(receiver.end(std::chrono::seconds(5)), "");
   EXPECT_EQ(read_file(dir.file("received.pfap")), want);
 }
 
@@ -807,14 +704,14 @@ TEST(DocumentedLines, Rtpbin) {
   text.attach(receiver.find("pfaptextenc"));
   audio.attach(receiver.find("rtpL16depay"));
 
-  ASSERT_TRUE(receiver.play());
-  ASSERT_TRUE(sender.play());
+  ASSERT_EQ(receiver.set_state(GST_STATE_PLAYING), "");
+  ASSERT_EQ(sender.set_state(GST_STATE_PLAYING), "");
   ASSERT_TRUE(wait_until(
       {&receiver, &sender},
       [&] { return text.lines() >= count_events(want) && audio.count() >= 10; }, 10s,
       "every phoneme and 10 audio buffers"))
       << text.lines() << " lines, " << audio.count() << " audio buffers";
-  ASSERT_TRUE(receiver.end(5 * GST_SECOND));
+  ASSERT_EQ(receiver.end(std::chrono::seconds(5)), "");
   gst_element_set_state(sender.get(), GST_STATE_NULL);
 
   EXPECT_TRUE(same_session(read_file(dir.file("received.pfap")), want, kLiveToleranceMs));
@@ -846,12 +743,12 @@ TEST(DocumentedLines, Rtsp) {
   Tap text, audio;
   text.attach(client.find("pfaptextenc"));
   audio.attach(client.find("rtpL16depay"));
-  ASSERT_TRUE(client.play());
+  ASSERT_EQ(client.set_state(GST_STATE_PLAYING), "");
   ASSERT_TRUE(wait_until(
       {&client}, [&] { return text.lines() >= count_events(want) && audio.count() >= 10; }, 15s,
       "every phoneme and 10 audio buffers"))
       << text.lines() << " lines, " << audio.count() << " audio buffers";
-  ASSERT_TRUE(client.end(5 * GST_SECOND));
+  ASSERT_EQ(client.end(std::chrono::seconds(5)), "");
 
   EXPECT_TRUE(same_session(read_file(dir.file("received.pfap")), want, kLiveToleranceMs));
   const std::string wav = read_file(dir.file("received.wav"));

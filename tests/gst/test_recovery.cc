@@ -39,6 +39,7 @@
 #include "pfap/markup.h"
 #include "pfap/model.h"
 #include "pfap_buffers.h"
+#include "pipeline.h"
 #include "random_markup.h"
 
 namespace {
@@ -169,91 +170,7 @@ class ReceiverState {
 // ---------------------------------------------------------------------------------------------
 // Pipelines
 
-// A pipeline from a gst-launch description, set to NULL and released on destruction.
-class Pipeline {
- public:
-  explicit Pipeline(const std::string& description) {
-    GError* error = nullptr;
-    GstElement* element = gst_parse_launch(description.c_str(), &error);
-    if (error != nullptr) {
-      error_ = std::string(error->message) + " in: " + description;
-      g_error_free(error);
-      if (element != nullptr) gst_object_unref(element);
-      return;
-    }
-    pipeline_ = element;
-    bus_ = gst_element_get_bus(pipeline_);
-  }
-  ~Pipeline() {
-    if (pipeline_ != nullptr) {
-      gst_element_set_state(pipeline_, GST_STATE_NULL);
-      gst_object_unref(bus_);
-      gst_object_unref(pipeline_);
-    }
-  }
-  Pipeline(const Pipeline&) = delete;
-  Pipeline& operator=(const Pipeline&) = delete;
-
-  bool ok() const { return pipeline_ != nullptr; }
-  const std::string& error() const { return error_; }
-  GstElement* get() const { return pipeline_; }
-
-  // The named element (the pipeline keeps it alive), or nullptr.
-  GstElement* by_name(const char* name) const {
-    GstElement* e = gst_bin_get_by_name(GST_BIN(pipeline_), name);
-    if (e != nullptr) gst_object_unref(e);
-    return e;
-  }
-
-  std::string set_state(GstState state) {
-    if (gst_element_set_state(pipeline_, state) == GST_STATE_CHANGE_FAILURE) {
-      std::string text = std::string("cannot set state ") + gst_element_state_get_name(state);
-      const std::string bus_error = poll_error();
-      if (!bus_error.empty()) text += ": " + bus_error;
-      return text;
-    }
-    return "";
-  }
-
-  // The first error on the bus so far, without waiting ("" when none).
-  std::string poll_error() {
-    if (GstMessage* m = gst_bus_pop_filtered(bus_, GST_MESSAGE_ERROR)) {
-      std::string text = error_text(m);
-      gst_message_unref(m);
-      return text;
-    }
-    return "";
-  }
-
-  // Waits for EOS; returns "" or why it did not come.
-  std::string wait_eos(std::chrono::milliseconds timeout) {
-    GstMessage* m = gst_bus_timed_pop_filtered(
-        bus_, static_cast<GstClockTime>(timeout.count()) * GST_MSECOND,
-        static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR));
-    if (m == nullptr) return "no EOS within " + std::to_string(timeout.count()) + " ms";
-    std::string text;
-    if (GST_MESSAGE_TYPE(m) == GST_MESSAGE_ERROR) text = error_text(m);
-    gst_message_unref(m);
-    return text;
-  }
-
- private:
-  static std::string error_text(GstMessage* m) {
-    GError* error = nullptr;
-    gchar* debug = nullptr;
-    gst_message_parse_error(m, &error, &debug);
-    std::string text = std::string("error from ") + GST_OBJECT_NAME(GST_MESSAGE_SRC(m)) + ": " +
-                       (error != nullptr ? error->message : "?") + " (" +
-                       (debug != nullptr ? debug : "") + ")";
-    if (error != nullptr) g_error_free(error);
-    g_free(debug);
-    return text;
-  }
-
-  GstElement* pipeline_ = nullptr;
-  GstBus* bus_ = nullptr;
-  std::string error_;
-};
+using pfap::testing::Pipeline;
 
 GstFlowReturn push(GstElement* appsrc, const Event& e) {
   GstBuffer* buffer = pfap::testing::phoneme_buffer(e.phoneme, e.faps, e.pts,
