@@ -161,4 +161,24 @@ inline std::vector<GstSample*> pull_all(GstElement* appsink) {
   return samples;
 }
 
+// RTCP every ~100 ms in rtpbin's sessions 0 and 1, so that sync and feedback come within a
+// test's few seconds.
+inline void fast_rtcp(GstElement* rtpbin) {
+  for (guint id : {0u, 1u}) {
+    GObject* session = nullptr;
+    g_signal_emit_by_name(rtpbin, "get-internal-session", id, &session);
+    if (session == nullptr) continue;
+    g_object_set(session, "rtcp-min-interval", guint64{100 * GST_MSECOND}, "rtcp-fraction",
+                 200000.0, nullptr);
+    g_object_unref(session);
+  }
+}
+
+// The port a udpsrc bound: port=0 picks a free one, known from READY on.
+inline guint bound_port(GstElement* udpsrc) {
+  gint port = 0;
+  g_object_get(udpsrc, "port", &port, nullptr);
+  return static_cast<guint>(port);
+}
+
 }  // namespace pfap::testing

@@ -79,7 +79,9 @@ GstBuffer* make_buffer(const Event& e) {
 }
 
 // A pipeline from a gst-launch description, set to NULL and released on destruction.
+using pfap::testing::bound_port;
 using pfap::testing::end_of_stream;
+using pfap::testing::fast_rtcp;
 using pfap::testing::Pipeline;
 using pfap::testing::pull_all;
 using pfap::testing::push;
@@ -672,24 +674,6 @@ void on_rtpbin_pad(GstElement*, GstPad* pad, gpointer data) {
     links->received->link_errors.push_back("cannot link " + pad_name + ": " +
                                            gst_pad_link_get_name(ret));
   }
-}
-
-// RTCP every ~100 ms so that sync comes within the test's few seconds.
-void fast_rtcp(GstElement* rtpbin) {
-  for (guint id : {0u, 1u}) {
-    GObject* session = nullptr;
-    g_signal_emit_by_name(rtpbin, "get-internal-session", id, &session);
-    if (session == nullptr) continue;
-    g_object_set(session, "rtcp-min-interval", guint64{100 * GST_MSECOND}, "rtcp-fraction",
-                 200000.0, nullptr);
-    g_object_unref(session);
-  }
-}
-
-guint bound_port(GstElement* udpsrc) {
-  gint port = 0;
-  g_object_get(udpsrc, "port", &port, nullptr);
-  return static_cast<guint>(port);
 }
 
 // The phonemes the sender sends: sentences of contiguous phonemes with pauses between them,

@@ -170,6 +170,8 @@ class ReceiverState {
 // ---------------------------------------------------------------------------------------------
 // Pipelines
 
+using pfap::testing::bound_port;
+using pfap::testing::fast_rtcp;
 using pfap::testing::Pipeline;
 
 GstFlowReturn push(GstElement* appsrc, const Event& e) {
@@ -288,22 +290,6 @@ constexpr const char* kReceiveCaps =
 
 GstCaps* on_request_pt_map(GstElement*, guint, guint pt, gpointer) {
   return pt == 97 ? gst_caps_from_string(kReceiveCaps) : nullptr;
-}
-
-// RTCP every ~100 ms, so that feedback comes within the test's seconds.
-void fast_rtcp(GstElement* rtpbin) {
-  GObject* session = nullptr;
-  g_signal_emit_by_name(rtpbin, "get-internal-session", 0u, &session);
-  if (session == nullptr) return;
-  g_object_set(session, "rtcp-min-interval", guint64{100 * GST_MSECOND}, "rtcp-fraction", 200000.0,
-               nullptr);
-  g_object_unref(session);
-}
-
-guint bound_port(GstElement* udpsrc) {
-  gint port = 0;
-  g_object_get(udpsrc, "port", &port, nullptr);
-  return static_cast<guint>(port);
 }
 
 // Pushes each phoneme when the pipeline's running time reaches its start, as a live TTS
