@@ -1,22 +1,34 @@
-"""Counts the test cases behind a meson test log: GoogleTest cases from each gtest program's
-result lines, one case for any other test. Prints 'tests: N passed, M failed'."""
+"""Counts the test cases behind meson test logs: GoogleTest cases from each gtest program's
+result lines, one case for any other test. With one log, prints 'tests: N passed, M failed';
+with several (one per build), a line for each and then that line for them all."""
 import json
 import re
 import sys
 
-passed = failed = 0
-with open(sys.argv[1]) as log:
-    for line in log:
-        test = json.loads(line)
-        out = test.get("stdout") or ""
-        ok = len(re.findall(r"^\[       OK \]", out, re.M))
-        bad = len(re.findall(r"^\[  FAILED  \] .*\(\d+ ms\)$", out, re.M))
-        if ok or bad:
-            passed, failed = passed + ok, failed + bad
-            if test["result"] != "OK" and not bad:
-                failed += 1  # crashed or timed out after its last finished case
-        elif test["result"] in ("OK", "EXPECTEDFAIL"):
-            passed += 1
-        elif test["result"] != "SKIP":
-            failed += 1
-print(f"tests: {passed} passed, {failed} failed")
+
+def count(path):
+    passed = failed = 0
+    with open(path) as log:
+        for line in log:
+            test = json.loads(line)
+            out = test.get("stdout") or ""
+            ok = len(re.findall(r"^\[       OK \]", out, re.M))
+            bad = len(re.findall(r"^\[  FAILED  \] .*\(\d+ ms\)$", out, re.M))
+            if ok or bad:
+                passed, failed = passed + ok, failed + bad
+                if test["result"] != "OK" and not bad:
+                    failed += 1  # crashed or timed out after its last finished case
+            elif test["result"] in ("OK", "EXPECTEDFAIL"):
+                passed += 1
+            elif test["result"] != "SKIP":
+                failed += 1
+    return passed, failed
+
+
+total_passed = total_failed = 0
+for path in sys.argv[1:]:
+    passed, failed = count(path)
+    if len(sys.argv) > 2:
+        print(f"{path}: {passed} passed, {failed} failed")
+    total_passed, total_failed = total_passed + passed, total_failed + failed
+print(f"tests: {total_passed} passed, {total_failed} failed")
