@@ -1,0 +1,56 @@
+// Phoneme alphabets: the 8-bit symbol tables that the draft leaves to out-of-band signalling
+// (section 5: "the mapping ... is signalled out of band"; here the `alphabet` caps field and
+// SDP `a=fmtp:<pt> alphabet=<name>`), with the MPEG-4 viseme of each phoneme for renderers.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string_view>
+
+namespace pfap {
+
+// The MPEG-4 visemes (ISO/IEC 14496-2, FAP 1 viseme_select): mouth shapes, each named by the
+// phonemes that share it.
+enum class Viseme : uint8_t {
+  kNone = 0,  // silence, and phonemes with no mouth shape of their own
+  kPBM = 1,   // p b m: lips closed
+  kFV = 2,    // f v: lower lip to upper teeth
+  kTH = 3,    // T D (think, that): tongue between teeth
+  kTD = 4,    // t d
+  kKG = 5,    // k g
+  kCh = 6,    // tS dZ S (cheese, joy, she): lips rounded forward
+  kSZ = 7,    // s z: teeth nearly closed
+  kNL = 8,    // n l
+  kR = 9,     // r
+  kA = 10,    // A: (car): jaw open
+  kE = 11,    // e (bed)
+  kI = 12,    // I (tip): lips spread
+  kQ = 13,    // Q (top): open, rounded
+  kU = 14,    // U (book): rounded, nearly closed
+};
+
+struct PhonemeInfo {
+  std::string_view name;  // the phoneme's name in its alphabet, e.g. "AA"
+  Viseme viseme;
+};
+
+struct PhonemeAlphabet {
+  std::string_view name;                 // the `alphabet` caps field's value
+  std::span<const PhonemeInfo> symbols;  // indexed by symbol; symbols past the end are unknown
+};
+
+// x-pfap-arpabet: 0 is a pause, then the 39 ARPAbet phonemes of the CMU Pronouncing
+// Dictionary in alphabetical order, AA = 1 ... ZH = 39 (docs/examples/README.md).
+inline constexpr std::string_view kArpabetAlphabet = "x-pfap-arpabet";
+
+// The alphabet called `name`, or nullptr if it is not one this library knows.
+const PhonemeAlphabet* find_alphabet(std::string_view name);
+
+// Symbol `symbol` of `alphabet`, or nullptr if the alphabet has no such symbol.
+const PhonemeInfo* find_phoneme(const PhonemeAlphabet& alphabet, uint8_t symbol);
+
+// The symbol of the phoneme called `name` in `alphabet`.
+std::optional<uint8_t> find_symbol(const PhonemeAlphabet& alphabet, std::string_view name);
+
+}  // namespace pfap
