@@ -343,13 +343,23 @@ static GstBuffer* gst_rtp_pfap_depay_process_rtp_packet(GstRTPBaseDepayload* dep
   // An unchanged complete state changes nothing downstream; left out, a stream without loss
   // comes out as it was sent.
   const bool complete_changed = r.recovery == Recovery::kComplete && r.changed;
-  // The state event goes first in the list: before the phonemes, and the one that carries
-  // the DISCONT after a gap.
-  GstBufferList* list = gst_buffer_list_new_sized(static_cast<guint>(packet.phonemes.size() + 1));
-  if (recovered || complete_changed) {
-    gst_buffer_list_add(
-        list, state_buffer(self, recovered ? PFAP_EVENT_RECOVERED : PFAP_EVENT_COMPLETE, uncertain,
-                           packet_pts));
+  // The state event goes first: before the phonemes, and the one that carries the DISCONT
+  // after a gap. A lone buffer (every packet at max-delay=0) is pushed without a list, which
+  // would cost an allocation and the base class's walk over it.
+  const bool state_event = recovered || complete_changed;
+  const size_t n_out = packet.phonemes.size() + (state_event ? 1 : 0);
+  GstBufferList* list = n_out > 1 ? gst_buffer_list_new_sized(static_cast<guint>(n_out)) : nullptr;
+  GstBuffer* lone = nullptr;
+  auto output = [&](GstBuffer* buffer) {
+    if (list != nullptr) {
+      gst_buffer_list_add(list, buffer);
+    } else {
+      lone = buffer;
+    }
+  };
+  if (state_event) {
+    output(state_buffer(self, recovered ? PFAP_EVENT_RECOVERED : PFAP_EVENT_COMPLETE, uncertain,
+                        packet_pts));
   }
   GstClockTime offset = 0;
   for (size_t i = 0; i < packet.phonemes.size(); ++i) {
@@ -358,7 +368,7 @@ static GstBuffer* gst_rtp_pfap_depay_process_rtp_packet(GstRTPBaseDepayload* dep
         GST_CLOCK_TIME_IS_VALID(packet_pts) ? packet_pts + offset : GST_CLOCK_TIME_NONE;
     GstBuffer* buffer = phoneme_buffer(self, i, sentence_start, uncertain, pts);
     offset += GST_BUFFER_DURATION(buffer);
-    gst_buffer_list_add(list, buffer);
+    output(buffer);
   }
   update_stats(self, [&](Stats& s) {
     s.phonemes += packet.phonemes.size();
@@ -371,10 +381,11 @@ static GstBuffer* gst_rtp_pfap_depay_process_rtp_packet(GstRTPBaseDepayload* dep
     s.complete_changes += complete_changed;
   });
 
-  if (gst_buffer_list_length(list) == 0) {
-    gst_buffer_list_unref(list);  // no loss to repair, no change and no phoneme
-  } else {
+  // Nothing at all when there is no loss to repair, no change and no phoneme.
+  if (list != nullptr) {
     gst_rtp_base_depayload_push_list(depay, list);
+  } else if (lone != nullptr) {
+    gst_rtp_base_depayload_push(depay, lone);
   }
   if (r.request_complete && g_atomic_int_get(&self->request_recovery)) {
     request_complete_state(self, seqnum);

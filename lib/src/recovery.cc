@@ -13,14 +13,18 @@ void entries_for(std::span<const std::vector<RecoverySender::Bookmark>> packets,
                  const FapState& state, int64_t time_ns, std::vector<Fap>& out) {
   // A triangle that is over changed nothing a FAP holds (FapState): the draft leaves it out.
   std::array<bool, kFapCount> in_effect{};
+  size_t count = 0;
   for (const auto& packet : packets) {
     for (const RecoverySender::Bookmark& b : packet) {
       const bool over = time_ns - b.start_ns >= int64_t{b.fap.transition_ms} * kNsPerMs;
-      in_effect[b.fap.index] |= b.fap.curve != Curve::kTriangle || !over;
+      const bool effect = b.fap.curve != Curve::kTriangle || !over;
+      count += effect && !in_effect[b.fap.index];
+      in_effect[b.fap.index] |= effect;
     }
   }
   out.clear();
-  for (int index = kMinFapIndex; index <= kMaxFapIndex; ++index) {
+  out.reserve(count);  // one allocation per packet at most, not one per doubling
+  for (int index = kMinFapIndex; index <= kMaxFapIndex && out.size() < count; ++index) {
     if (in_effect[index]) out.push_back(state.recovery_entry(index, time_ns));
   }
 }
@@ -33,21 +37,20 @@ RecoverySender::RecoverySender(unsigned depth) : depth_(depth) {
 
 void RecoverySender::add_dynamic(Packet& packet, int64_t time_ns, size_t room) const {
   if (depth_ == 0) return;
-  std::vector<Fap> entries;
   // The deepest coverage whose entries fit; a shallower one covers a subset of the packets,
   // so its entries are never more.
   for (int step = static_cast<int>(std::size(kCoverageSteps)) - 1; step >= 0; --step) {
     const unsigned coverage = kCoverageSteps[step];
     if (coverage > depth_ || (!whole_history_ && coverage > window_.size())) continue;
     const size_t covered = std::min<size_t>(coverage, window_.size());
-    entries_for(std::span(window_).last(covered), state_, time_ns, entries);
-    if (entries.size() * kFapDescriptorBytes <= room) {
+    entries_for(std::span(window_).last(covered), state_, time_ns, packet.recovery);
+    if (packet.recovery.size() * kFapDescriptorBytes <= room) {
       packet.recovery_kind = RecoveryKind::kDynamic;
       packet.covered_packets = static_cast<uint8_t>(coverage);
-      packet.recovery = std::move(entries);
       return;
     }
   }
+  packet.recovery.clear();
 }
 
 bool RecoverySender::make_complete(Packet& out, int64_t time_ns, size_t room) const {
@@ -61,21 +64,27 @@ bool RecoverySender::make_complete(Packet& out, int64_t time_ns, size_t room) co
 }
 
 void RecoverySender::sent(const Packet& packet, int64_t time_ns) {
-  std::vector<Bookmark> bookmarks;
+  std::vector<Bookmark>* bookmarks = nullptr;  // this packet's place in the window
+  if (window_.size() < depth_) {
+    bookmarks = &window_.emplace_back();
+  } else {
+    whole_history_ = false;
+    if (depth_ > 0) {
+      // The oldest packet's place becomes the newest: its capacity is reused, so a stream
+      // stops allocating here once every place has held its largest packet.
+      std::rotate(window_.begin(), window_.begin() + 1, window_.end());
+      bookmarks = &window_.back();
+      bookmarks->clear();
+    }
+  }
   int64_t start_ns = time_ns;
   for (size_t i = 0; i < packet.phonemes.size(); ++i) {
     for (const Fap& fap : packet.faps_of(i)) {
-      bookmarks.push_back({fap, start_ns});
+      if (bookmarks != nullptr) bookmarks->push_back({fap, start_ns});
       state_.apply(fap, start_ns);
     }
     start_ns += int64_t{packet.phonemes[i].phoneme.duration_ms} * kNsPerMs;
   }
-  if (window_.size() == depth_) {
-    whole_history_ = false;
-    if (depth_ == 0) return;
-    window_.erase(window_.begin());
-  }
-  window_.push_back(std::move(bookmarks));
 }
 
 void RecoverySender::set_depth(unsigned depth) {

@@ -1,12 +1,19 @@
-// Pipeline throughput of the PFAP elements beside GStreamer's own generic RTP payloader:
+// Pipeline throughput of the PFAP elements beside GStreamer's own RTP payloaders for opaque
+// data and for metadata:
 //
 //   appsrc ! rtppfappay ! rtppfapdepay ! fakesink     (N phoneme events)
+//   appsrc ! rtpklvpay  ! rtpklvdepay  ! fakesink     (N KLV units, each holding one event)
 //   appsrc ! rtpgstpay  ! rtpgstdepay  ! fakesink     (N buffers of the same bytes, sizes and
 //                                                      timestamps)
 //
 // rtpgstpay carries any buffer as opaque bytes (one packet each here) and is the reference:
-// what a payloader that parses nothing costs in the same pipeline. The runs alternate
-// (pfap, rtpgst, rtpgst, pfap, ...) and each is timed from PLAYING to EOS: process CPU time
+// what a payloader that parses nothing costs in the same pipeline. rtpklvpay (SMPTE ST 336
+// KLV, RFC 6597) is how GStreamer carries timed metadata; rtpklvdepay checks each unit's key
+// and BER length. A KLV unit is at least 17 bytes (16-byte universal label key, 1 length
+// byte), more than most events (8 bytes, 24 with 2 FAPs), so it cannot have the event's
+// size: each unit is the key, the BER length and the event's bytes as its value, what an
+// application carrying these events in KLV would send. The runs rotate their order and each
+// is timed from PLAYING to EOS: process CPU time
 // (every thread: the application pushing into appsrc, and the streaming thread) and wall
 // time. Printed: each run, then the medians, items/s and the ratio to rtpgst.
 //
@@ -18,6 +25,7 @@
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <string>
 #include <utility>
@@ -86,6 +94,31 @@ std::vector<GstBuffer*> copies(const std::vector<GstBuffer*>& buffers) {
   return out;
 }
 
+// Each buffer as the value of a KLV unit with the same timestamps: a SMPTE universal label
+// key (06 0E 2B 34 ..., what rtpklvdepay looks for) and a BER short-form length.
+std::vector<GstBuffer*> klv_units(const std::vector<GstBuffer*>& buffers) {
+  static constexpr uint8_t kKey[16] = {0x06, 0x0E, 0x2B, 0x34, 0x02, 0x0B, 0x01, 0x01,
+                                       0x0E, 0x01, 0x03, 0x01, 0x01, 0x00, 0x00, 0x00};
+  std::vector<GstBuffer*> out;
+  for (GstBuffer* b : buffers) {
+    const gsize size = gst_buffer_get_size(b);
+    if (size > 127) {
+      std::fprintf(stderr, "an event of %zu bytes needs a long-form BER length\n", size);
+      std::exit(1);
+    }
+    GstBuffer* unit = gst_buffer_new_allocate(nullptr, sizeof kKey + 1 + size, nullptr);
+    GstMapInfo map;
+    gst_buffer_map(unit, &map, GST_MAP_WRITE);
+    std::memcpy(map.data, kKey, sizeof kKey);
+    map.data[sizeof kKey] = static_cast<uint8_t>(size);
+    gst_buffer_extract(b, 0, map.data + sizeof kKey + 1, size);
+    gst_buffer_unmap(unit, &map);
+    gst_buffer_copy_into(unit, b, GST_BUFFER_COPY_TIMESTAMPS, 0, static_cast<gsize>(-1));
+    out.push_back(unit);
+  }
+  return out;
+}
+
 double cpu_seconds() {
   timespec ts;
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
@@ -120,10 +153,11 @@ GstPadProbeReturn count_buffers(GstPad*, GstPadProbeInfo* info, gpointer data) {
 }
 
 // One run: the pipeline is made beforehand; timed from PLAYING to EOS.
-Timing run(const char* payloader, const char* depayloader, const std::vector<GstBuffer*>& buffers) {
-  const std::string description =
-      std::string("appsrc name=src format=time max-bytes=0 caps=application/x-pfap ! ") +
-      payloader + " ! " + depayloader + " name=depay ! fakesink name=sink sync=false";
+Timing run(const char* caps, const char* payloader, const char* depayloader,
+           const std::vector<GstBuffer*>& buffers) {
+  const std::string description = std::string("appsrc name=src format=time max-bytes=0 caps=") +
+                                  caps + " ! " + payloader + " ! " + depayloader +
+                                  " name=depay ! fakesink name=sink sync=false";
   GError* error = nullptr;
   GstElement* pipeline = gst_parse_launch(description.c_str(), &error);
   if (error != nullptr) fail(std::string(error->message) + " in: " + description);
@@ -194,23 +228,31 @@ int main(int argc, char** argv) {
   const int n = argc > 1 ? std::atoi(argv[1]) : 100000;
   const int repetitions = argc > 2 ? std::atoi(argv[2]) : 7;
   if (n <= 0 || repetitions <= 0) fail("usage: bench_elements [N [repetitions]]");
-  for (const char* name : {"rtppfappay", "rtppfapdepay", "rtpgstpay", "rtpgstdepay"}) {
+  for (const char* name :
+       {"rtppfappay", "rtppfapdepay", "rtpklvpay", "rtpklvdepay", "rtpgstpay", "rtpgstdepay"}) {
     GstElementFactory* f = gst_element_factory_find(name);
     if (f == nullptr) fail(std::string("no element ") + name + " (GST_PLUGIN_PATH?)");
     gst_object_unref(f);
   }
 
   const std::vector<GstBuffer*> pfap = speech(n);
+  const std::vector<GstBuffer*> klv = klv_units(pfap);
   const std::vector<GstBuffer*> plain = copies(pfap);
   size_t bytes = 0;
   for (GstBuffer* b : pfap) bytes += gst_buffer_get_size(b);
-  std::printf("%d phoneme events, %zu bytes (%.1f bytes each), %d repetitions, alternating\n", n,
-              bytes, static_cast<double>(bytes) / n, repetitions);
+  std::printf(
+      "%d phoneme events, %zu bytes (%.1f bytes each; as KLV units %.1f), %d repetitions, "
+      "order rotating\n",
+      n, bytes, static_cast<double>(bytes) / n, static_cast<double>(bytes) / n + 17, repetitions);
 
   // The reference last: ratios are to it. max-delay=0 makes one packet per phoneme, as
-  // rtpgstpay does, so that row compares the cost per packet.
+  // rtpgstpay does, so that row compares the cost per packet; the next one leaves out the
+  // complete state sent each second (one more packet per second of speech), so that it has
+  // rtpgstpay's packet count exactly.
+  constexpr const char* kPfapCaps = "application/x-pfap";
   struct Variant {
     const char* name;
+    const char* caps;
     const char* payloader;
     const char* depayloader;
     const std::vector<GstBuffer*>& buffers;
@@ -218,18 +260,32 @@ int main(int argc, char** argv) {
     long packets = 0;
   };
   std::vector<Variant> variants = {
-      {"rtppfappay ! rtppfapdepay", "rtppfappay", "rtppfapdepay", pfap, {}, {}},
-      {"  (max-delay=0)", "rtppfappay max-delay=0", "rtppfapdepay", pfap, {}, {}},
-      {"rtpgstpay ! rtpgstdepay", "rtpgstpay", "rtpgstdepay", plain, {}, {}},
+      {"rtppfappay ! rtppfapdepay", kPfapCaps, "rtppfappay", "rtppfapdepay", pfap, {}, {}},
+      {"  (max-delay=0)", kPfapCaps, "rtppfappay max-delay=0", "rtppfapdepay", pfap, {}, {}},
+      {"  (same, no periodic complete)",
+       kPfapCaps,
+       "rtppfappay max-delay=0 complete-recovery-interval=0",
+       "rtppfapdepay",
+       pfap,
+       {},
+       {}},
+      {"rtpklvpay ! rtpklvdepay",
+       "meta/x-klv,parsed=true",
+       "rtpklvpay",
+       "rtpklvdepay",
+       klv,
+       {},
+       {}},
+      {"rtpgstpay ! rtpgstdepay", kPfapCaps, "rtpgstpay", "rtpgstdepay", plain, {}, {}},
   };
   // Warm-up: the registry, plugin loading and first allocations are not measured.
-  for (Variant& v : variants) run(v.payloader, v.depayloader, v.buffers);
+  for (Variant& v : variants) run(v.caps, v.payloader, v.depayloader, v.buffers);
   for (int r = 0; r < repetitions; ++r) {
     std::printf("run %d:", r + 1);
     // Rotate the order so that no variant always runs first or last.
     for (size_t k = 0; k < variants.size(); ++k) {
       Variant& v = variants[(k + static_cast<size_t>(r)) % variants.size()];
-      const Timing t = run(v.payloader, v.depayloader, v.buffers);
+      const Timing t = run(v.caps, v.payloader, v.depayloader, v.buffers);
       v.cpu.push_back(t.cpu);
       v.wall.push_back(t.wall);
       v.packets = t.packets;
@@ -241,14 +297,16 @@ int main(int argc, char** argv) {
   const Variant& reference = variants.back();
   const double rc = median(reference.cpu);
   std::printf(
-      "\nmedian of %d               CPU time   items/s (CPU)   RTP packets   vs rtpgst (items/s)\n",
+      "\nmedian of %d                      CPU time   items/s (CPU)   RTP packets   vs rtpgst "
+      "(items/s)\n",
       repetitions);
   for (const Variant& v : variants) {
     const double c = median(v.cpu);
-    std::printf("%-25s %8.4f s %13.0f %13ld %12.3f\n", v.name, c, n / c, v.packets, rc / c);
+    std::printf("%-32s %8.4f s %13.0f %13ld %12.3f\n", v.name, c, n / c, v.packets, rc / c);
   }
 
   for (GstBuffer* b : pfap) gst_buffer_unref(b);
+  for (GstBuffer* b : klv) gst_buffer_unref(b);
   for (GstBuffer* b : plain) gst_buffer_unref(b);
   return 0;
 }

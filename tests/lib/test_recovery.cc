@@ -2,6 +2,7 @@
 // whenever every gap is within the coverage of the packet after it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <vector>
 
@@ -347,6 +348,33 @@ TEST(RecoverySender, DeeperDepthMidStreamGrowsWithThePacketsItHolds) {
   sender.add_dynamic(next, 200 * kNsPerMs, 1000);
   EXPECT_EQ(next.covered_packets, 7);
   EXPECT_EQ(next.recovery.size(), 7u);
+}
+
+TEST(RecoverySender, OnlyTheLastDepthPacketsAreCoveredAsTheWindowMovesOn) {
+  // Packets of 0, 1 or 2 FAPs, so that each place in the window holds packets of every size.
+  RecoverySender sender(4);
+  for (int i = 0; i < 30; ++i) {
+    std::vector<Fap> faps;
+    for (int k = 0; k < i % 3; ++k) {
+      faps.push_back({static_cast<uint8_t>(3 + (2 * i + k) % 60), 100, 0, Curve::kLinear});
+    }
+    Packet p;
+    p.add_phoneme({.duration_ms = 10}, faps);
+    sender.sent(p, i * 10 * kNsPerMs);
+    if (i < 4) continue;
+    std::vector<Fap> expected;  // the FAPs of packets i - 3 .. i, by index
+    for (int j = i - 3; j <= i; ++j) {
+      for (int k = 0; k < j % 3; ++k) {
+        expected.push_back({static_cast<uint8_t>(3 + (2 * j + k) % 60), 100, 0, Curve::kLinear});
+      }
+    }
+    std::sort(expected.begin(), expected.end(),
+              [](const Fap& a, const Fap& b) { return a.index < b.index; });
+    Packet next;
+    sender.add_dynamic(next, (i + 1) * 10 * kNsPerMs, 1000);
+    EXPECT_EQ(next.covered_packets, 4) << i;
+    EXPECT_EQ(next.recovery, expected) << i;
+  }
 }
 
 TEST(RecoverySender, ShallowerDepthKeepsTheStateAndTheNewestPackets) {
