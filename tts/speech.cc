@@ -1,0 +1,128 @@
+#include "speech.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "arpabet.h"
+#include "f0.h"
+#include "placement.h"
+#include "stress.h"
+
+namespace pfap::tts {
+namespace {
+
+struct Segment {
+  size_t start;
+  size_t end;
+  size_t espeak_index;  // SIZE_MAX for the lead-in pause
+  size_t sentence;
+};
+
+uint64_t to_ms(size_t sample, unsigned rate) {
+  return (static_cast<uint64_t>(sample) * 1000 + rate / 2) / rate;
+}
+
+}  // namespace
+
+bool speak(const Utterance& utterance, const VoiceSettings& settings, Speech& out,
+           std::string& error) {
+  Synthesis syn;
+  if (!synthesize(utterance.text_utf8(), settings, syn, error)) return false;
+  out = Speech{};
+  out.sample_rate = syn.sample_rate;
+  const size_t total = syn.samples.size();
+
+  // The segments that tile the audio, and where each espeak-ng phoneme went.
+  std::vector<Segment> segments;
+  std::vector<size_t> segment_of(syn.phonemes.size() + 1, SIZE_MAX);
+  if (!syn.phonemes.empty() && syn.phonemes[0].sample > 0) {
+    segments.push_back({0, std::min(syn.phonemes[0].sample, total), SIZE_MAX, 0});
+  }
+  for (size_t i = 0; i < syn.phonemes.size(); ++i) {
+    const size_t start = std::min(syn.phonemes[i].sample, total);
+    const size_t end =
+        i + 1 < syn.phonemes.size() ? std::min(syn.phonemes[i + 1].sample, total) : total;
+    if (end <= start) continue;
+    segment_of[i] = segments.size();
+    segments.push_back({start, end, i, syn.phonemes[i].sentence});
+  }
+  if (segments.empty()) segments.push_back({0, total, SIZE_MAX, 0});
+
+  // Words by segment: the first and last of their phonemes that have samples.
+  std::vector<Word> words;
+  for (const Synthesis::Word& w : syn.words) {
+    size_t first = SIZE_MAX, last = SIZE_MAX;
+    for (size_t p = w.first_phoneme; p < w.end_phoneme; ++p) {
+      if (segment_of[p] == SIZE_MAX) continue;
+      if (first == SIZE_MAX) first = segment_of[p];
+      last = segment_of[p];
+    }
+    if (first != SIZE_MAX) words.push_back({w.start, w.sentence, first, last});
+  }
+
+  std::vector<std::string> mnemonics;
+  for (const Synthesis::Phoneme& p : syn.phonemes) mnemonics.push_back(p.mnemonic);
+  const std::vector<bool> stressed = primary_stress(syn.transcription, mnemonics);
+
+  std::vector<size_t> bounds;
+  for (const Segment& s : segments) bounds.push_back(s.start);
+  bounds.push_back(segments.back().end);
+  const std::vector<double> f0 = segment_f0(syn.samples, syn.sample_rate, bounds);
+
+  std::vector<MarkupEvent> events(segments.size());
+  for (size_t k = 0; k < segments.size(); ++k) {
+    const Segment& s = segments[k];
+    MarkupEvent& e = events[k];
+    e.kind = PFAP_EVENT_PHONEME;
+    if (s.espeak_index != SIZE_MAX) {
+      const std::string& m = syn.phonemes[s.espeak_index].mnemonic;
+      const std::optional<ArpabetSymbol> symbol = arpabet_symbol(m);
+      e.phoneme.symbol = symbol ? symbol->symbol : 0;
+      if ((!symbol || !symbol->exact) &&
+          std::find(out.inexact.begin(), out.inexact.end(), m) == out.inexact.end()) {
+        out.inexact.push_back(m);
+      }
+      e.phoneme.stress = stressed[s.espeak_index];
+    }
+    e.phoneme.f0 = f0_code(static_cast<unsigned>(std::lround(f0[k])));
+    e.sentence_start = k == 0 || segments[k - 1].sentence != s.sentence;
+    e.phoneme.end_of_text = k + 1 == segments.size() || segments[k + 1].sentence != s.sentence;
+  }
+  for (const Word& w : words) events[w.first_phoneme].phoneme.word_begin = true;
+  for (const Bookmark& b : utterance.bookmarks) {
+    const size_t at = place_bookmark(words, utterance.text, b.position).value_or(0);
+    events[at].faps.insert(events[at].faps.end(), b.faps.begin(), b.faps.end());
+  }
+
+  const unsigned rate = syn.sample_rate;
+  std::vector<Phoneme> pieces;
+  for (size_t k = 0; k < segments.size(); ++k) {
+    const Segment& s = segments[k];
+    const uint64_t ms = to_ms(s.end, rate) - to_ms(s.start, rate);
+    pieces.clear();
+    split_long_phoneme(events[k].phoneme, static_cast<uint32_t>(ms), pieces);
+    size_t piece_start = s.start;
+    for (size_t i = 0; i < pieces.size(); ++i) {
+      const size_t piece_end =
+          i + 1 < pieces.size()
+              ? piece_start + static_cast<size_t>(uint64_t{kMaxPhonemeDurationMs} * rate / 1000)
+              : s.end;
+      SpokenPhoneme p;
+      p.event = events[k];
+      p.event.phoneme = pieces[i];
+      if (i > 0) {
+        p.event.faps.clear();
+        p.event.sentence_start = false;
+      }
+      p.start = piece_start;
+      p.n_samples = piece_end - piece_start;
+      p.mnemonic = s.espeak_index != SIZE_MAX ? syn.phonemes[s.espeak_index].mnemonic : "";
+      out.phonemes.push_back(std::move(p));
+      piece_start = piece_end;
+    }
+  }
+  out.samples = std::move(syn.samples);
+  return true;
+}
+
+}  // namespace pfap::tts
