@@ -70,11 +70,8 @@ bool set_voice(const VoiceSettings& settings, std::string& error) {
   return true;
 }
 
-}  // namespace
-
-bool synthesize(std::string_view text, const VoiceSettings& settings, Synthesis& out,
-                std::string& error) {
-  std::lock_guard lock(espeak_mutex);
+// Under espeak_mutex.
+bool start(std::string& error) {
   if (!initialized) {
     initialized = true;
     espeak_rate = espeak_Initialize(AUDIO_OUTPUT_SYNCHRONOUS, 0, nullptr,
@@ -85,7 +82,22 @@ bool synthesize(std::string_view text, const VoiceSettings& settings, Synthesis&
     error = "espeak-ng could not start (its data not installed?)";
     return false;
   }
-  if (!set_voice(settings, error)) return false;
+  return true;
+}
+
+}  // namespace
+
+bool check_voice(const VoiceSettings& settings, unsigned& sample_rate, std::string& error) {
+  std::lock_guard lock(espeak_mutex);
+  if (!start(error) || !set_voice(settings, error)) return false;
+  sample_rate = static_cast<unsigned>(espeak_rate);
+  return true;
+}
+
+bool synthesize(std::string_view text, const VoiceSettings& settings, Synthesis& out,
+                std::string& error) {
+  std::lock_guard lock(espeak_mutex);
+  if (!start(error) || !set_voice(settings, error)) return false;
   out = Synthesis{};
   out.sample_rate = static_cast<unsigned>(espeak_rate);  // until its event says otherwise
   const std::string input(text);

@@ -40,6 +40,10 @@ struct Synthesis {
   std::string transcription;  // espeak_TextToPhonemes, with stress marks
 };
 
+// Whether espeak-ng starts and has the voice; `sample_rate` is the rate espeak-ng starts with
+// (a synthesis reports its own, which is the one to use).
+bool check_voice(const VoiceSettings& settings, unsigned& sample_rate, std::string& error);
+
 // Speaks plain UTF-8 `text` (no SSML). False with `error` set when espeak-ng cannot start or
 // has no such voice.
 bool synthesize(std::string_view text, const VoiceSettings& settings, Synthesis& out,

@@ -1,30 +1,14 @@
 #include "placement.h"
 
+#include <algorithm>
+
 namespace pfap::tts {
 namespace {
 
 // What may stand between a bookmark and the first word of the sentence it starts.
 bool leads_a_sentence(char32_t c) {
-  switch (c) {
-    case U' ':
-    case U'\t':
-    case U'\r':
-    case U'\n':
-    case U'"':
-    case U'\'':
-    case U'(':
-    case U'[':
-    case U'{':
-    case U'\u00A0':
-    case U'\u00AB':
-    case U'\u00BF':
-    case U'\u00A1':
-    case U'\u2018':
-    case U'\u201C':
-      return true;
-    default:
-      return false;
-  }
+  return std::u32string_view(U" \t\r\n\"'([{\u00A0\u00AB\u00BF\u00A1\u2018\u201C").find(c) !=
+         std::u32string_view::npos;
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include "arpabet.h"
 #include "f0.h"
+#include "pfap/phoneme_table.h"
 #include "placement.h"
 #include "stress.h"
 
@@ -69,6 +70,7 @@ bool speak(const Utterance& utterance, const VoiceSettings& settings, Speech& ou
   bounds.push_back(segments.back().end);
   const std::vector<double> f0 = segment_f0(syn.samples, syn.sample_rate, bounds);
 
+  const PhonemeAlphabet& arpabet = *find_alphabet(kArpabetAlphabet);
   std::vector<MarkupEvent> events(segments.size());
   for (size_t k = 0; k < segments.size(); ++k) {
     const Segment& s = segments[k];
@@ -78,9 +80,10 @@ bool speak(const Utterance& utterance, const VoiceSettings& settings, Speech& ou
       const std::string& m = syn.phonemes[s.espeak_index].mnemonic;
       const std::optional<ArpabetSymbol> symbol = arpabet_symbol(m);
       e.phoneme.symbol = symbol ? symbol->symbol : 0;
-      if ((!symbol || !symbol->exact) &&
-          std::find(out.inexact.begin(), out.inexact.end(), m) == out.inexact.end()) {
-        out.inexact.push_back(m);
+      const bool known = std::any_of(out.inexact.begin(), out.inexact.end(),
+                                     [&](const Speech::Inexact& i) { return i.mnemonic == m; });
+      if ((!symbol || !symbol->exact) && !known) {
+        out.inexact.push_back({m, find_phoneme(arpabet, e.phoneme.symbol)->name});
       }
       e.phoneme.stress = stressed[s.espeak_index];
     }

@@ -25,8 +25,13 @@ struct Speech {
   std::vector<int16_t> samples;
   // Contiguous from sample 0 to the end of `samples`, in order.
   std::vector<SpokenPhoneme> phonemes;
-  // Mnemonics with no exact x-pfap-arpabet symbol: found by their base, or spoken as a pause.
-  std::vector<std::string> inexact;
+  // Each mnemonic with no exact x-pfap-arpabet symbol (found by its base, or else a pause),
+  // once, with the symbol's name it was sent as.
+  struct Inexact {
+    std::string mnemonic;
+    std::string_view sent_as;
+  };
+  std::vector<Inexact> inexact;
 };
 
 // Speaks `utterance`. False with `error` when espeak-ng cannot (no such voice).
