@@ -76,7 +76,8 @@ struct Stream {
   unsigned rate = 0;        // of the audio caps sent
   GstClockTime base = 0;
   uint64_t samples = 0;
-  bool discont = true;
+  bool audio_discont = true;  // the next buffer on each pad is the first since a start or flush
+  bool pfap_discont = true;
   GstSegment input_segment;               // the sink pad's, for utterance running times
   std::set<std::string> warned_phonemes;  // inexact mnemonics already warned about
 
@@ -128,7 +129,8 @@ static void reset(GstPfapTts* self) {
   s.rate = 0;
   s.base = 0;
   s.samples = 0;
-  s.discont = true;
+  s.audio_discont = true;
+  s.pfap_discont = true;
   gst_segment_init(&s.input_segment, GST_FORMAT_TIME);
   s.warned_phonemes.clear();
   gst_flow_combiner_reset(self->flow_combiner);
@@ -204,8 +206,8 @@ static GstFlowReturn push_audio(GstPfapTts* self, const int16_t* data, size_t n)
     s.samples += chunk;
     GST_BUFFER_OFFSET_END(buffer) = s.samples;
     GST_BUFFER_DURATION(buffer) = s.position() - start;
-    if (s.discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
-    s.discont = false;
+    if (s.audio_discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
+    s.audio_discont = false;
     ret = combine(self, self->audiopad, gst_pad_push(self->audiopad, buffer));
     if (data != nullptr) data += chunk;
     n -= chunk;
@@ -294,6 +296,8 @@ static GstFlowReturn speak(GstPfapTts* self, std::string_view input, GstClockTim
         s.base + gst_util_uint64_scale(first + p.start + p.n_samples, GST_SECOND, s.rate);
     GST_BUFFER_PTS(buffer) = start;
     GST_BUFFER_DURATION(buffer) = end - start;
+    if (s.pfap_discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
+    s.pfap_discont = false;
     ret = combine(self, self->pfappad, gst_pad_push(self->pfappad, buffer));
     if (ret == GST_FLOW_OK) ret = push_audio(self, speech.samples.data() + p.start, p.n_samples);
   }

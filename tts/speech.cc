@@ -39,13 +39,17 @@ bool speak(const Utterance& utterance, const VoiceSettings& settings, Speech& ou
   if (!syn.phonemes.empty() && syn.phonemes[0].sample > 0) {
     segments.push_back({0, std::min(syn.phonemes[0].sample, total), SIZE_MAX, 0});
   }
+  // espeak-ng's positions may step back a little at high rates: each start is taken no
+  // earlier than the one before, so that the segments tile the audio whatever it reports.
+  std::vector<size_t> starts(syn.phonemes.size() + 1, total);
+  for (size_t i = 0, floor = 0; i < syn.phonemes.size(); ++i) {
+    floor = std::min(std::max(syn.phonemes[i].sample, floor), total);
+    starts[i] = floor;
+  }
   for (size_t i = 0; i < syn.phonemes.size(); ++i) {
-    const size_t start = std::min(syn.phonemes[i].sample, total);
-    const size_t end =
-        i + 1 < syn.phonemes.size() ? std::min(syn.phonemes[i + 1].sample, total) : total;
-    if (end <= start) continue;
+    if (starts[i + 1] <= starts[i]) continue;
     segment_of[i] = segments.size();
-    segments.push_back({start, end, i, syn.phonemes[i].sentence});
+    segments.push_back({starts[i], starts[i + 1], i, syn.phonemes[i].sentence});
   }
   if (segments.empty()) segments.push_back({0, total, SIZE_MAX, 0});
 

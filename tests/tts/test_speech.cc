@@ -41,24 +41,27 @@ std::string describe(const Speech& s) {
 }
 
 TEST(Speech, PhonemesCoverTheAudio) {
-  for (const char* voice : {"en", "en-us"}) {
-    for (const char* sentence : kCorpus) {
-      SCOPED_TRACE(std::string(voice) + ": " + sentence);
-      const Speech s = say(sentence, {voice, 260, 50, 100});
-      ASSERT_EQ(s.sample_rate, 22050u);
-      ASSERT_FALSE(s.phonemes.empty());
-      uint64_t sum_ms = 0;
-      size_t expected_start = 0;
-      for (size_t i = 0; i < s.phonemes.size(); ++i) {
-        const SpokenPhoneme& p = s.phonemes[i];
-        EXPECT_EQ(p.start, expected_start) << "phoneme " << i;
-        EXPECT_GT(p.n_samples, 0u) << "phoneme " << i;  // so starts strictly increase
-        expected_start = p.start + p.n_samples;
-        sum_ms += p.event.phoneme.duration_ms;
+  // At the highest rate espeak-ng's positions step back now and then.
+  for (const int rate : {175, 450}) {
+    for (const char* voice : {"en", "en-us"}) {
+      for (const char* sentence : kCorpus) {
+        SCOPED_TRACE(std::string(voice) + " at " + std::to_string(rate) + ": " + sentence);
+        const Speech s = say(sentence, {voice, rate, 50, 100});
+        ASSERT_EQ(s.sample_rate, 22050u);
+        ASSERT_FALSE(s.phonemes.empty());
+        uint64_t sum_ms = 0;
+        size_t expected_start = 0;
+        for (size_t i = 0; i < s.phonemes.size(); ++i) {
+          const SpokenPhoneme& p = s.phonemes[i];
+          EXPECT_EQ(p.start, expected_start) << "phoneme " << i;
+          EXPECT_GT(p.n_samples, 0u) << "phoneme " << i;  // so starts strictly increase
+          expected_start = p.start + p.n_samples;
+          sum_ms += p.event.phoneme.duration_ms;
+        }
+        EXPECT_EQ(expected_start, s.samples.size());
+        const double audio_ms = 1000.0 * static_cast<double>(s.samples.size()) / s.sample_rate;
+        EXPECT_NEAR(static_cast<double>(sum_ms), audio_ms, 20.0);
       }
-      EXPECT_EQ(expected_start, s.samples.size());
-      const double audio_ms = 1000.0 * static_cast<double>(s.samples.size()) / s.sample_rate;
-      EXPECT_NEAR(static_cast<double>(sum_ms), audio_ms, 20.0);
     }
   }
 }
