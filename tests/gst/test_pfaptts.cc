@@ -4,12 +4,17 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <iostream>
+#include <mutex>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <vector>
 
+#include "lip_sync.h"
 #include "pfap/markup.h"
 #include "pfap_buffers.h"
 #include "pipeline.h"
@@ -419,6 +424,169 @@ TEST(PfapTts, TextPropertySpeaksAndEnds) {
   EXPECT_EQ(faps, 1);
   for (GstSample* s : audio) gst_sample_unref(s);
   for (GstSample* s : pfap) gst_sample_unref(s);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Loopback: pfaptts ! rtpL16pay and rtppfappay through one rtpbin, over UDP on 127.0.0.1, into
+// another rtpbin ! rtpL16depay and rtppfapdepay. The measurement is LoopbackUdp's
+// (test_pipeline.cc, lip_sync.h): each received phoneme's offset (receiver minus sender running
+// time) against the offset of the audio sent at the same time, within 1 ms once rtpbin's RTCP
+// sync is in place. The sender is not live: its udpsinks send both streams in real time.
+
+// What reaches a payloader's sink pad: the phonemes with their running times, and EOS.
+struct SentPhonemes {
+  std::mutex mutex;
+  std::vector<Event> events;
+  std::atomic<int> eos{0};  // payloaders (audio and PFAP) that have had EOS
+
+  static GstPadProbeReturn on_pfap(GstPad*, GstPadProbeInfo* info, gpointer data) {
+    auto* sent = static_cast<SentPhonemes*>(data);
+    std::lock_guard lock(sent->mutex);
+    sent->events.push_back(pfap::testing::read_event(GST_PAD_PROBE_INFO_BUFFER(info)));
+    return GST_PAD_PROBE_OK;
+  }
+  static GstPadProbeReturn on_event(GstPad*, GstPadProbeInfo* info, gpointer data) {
+    if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) == GST_EVENT_EOS) {
+      static_cast<SentPhonemes*>(data)->eos++;
+    }
+    return GST_PAD_PROBE_OK;
+  }
+};
+
+TEST(PfapTtsLoopback, ReceivedPhonemesLineUpWithTheAudio) {
+  pfap::testing::SentAudio sent_audio(kRate);
+  SentPhonemes sent;
+  pfap::testing::Received received;
+  pfap::testing::ReceiverLinks links{nullptr, nullptr, &received};
+
+  pfap::testing::Pipeline receiver(
+      "rtpbin name=rtpbin buffer-mode=none "
+      "udpsrc name=audio_rtp address=127.0.0.1 port=0 caps=\"application/x-rtp,media=audio,"
+      "clock-rate=22050,encoding-name=L16,channels=1,payload=96\" ! rtpbin.recv_rtp_sink_0 "
+      "udpsrc name=audio_rtcp address=127.0.0.1 port=0 ! rtpbin.recv_rtcp_sink_0 "
+      "rtpbin.send_rtcp_src_0 ! udpsink name=audio_rr host=127.0.0.1 sync=false async=false "
+      "udpsrc name=pfap_rtp address=127.0.0.1 port=0 caps=\"application/x-rtp,"
+      "media=application,clock-rate=44100,encoding-name=PFAP,payload=97\" "
+      "! rtpbin.recv_rtp_sink_1 "
+      "udpsrc name=pfap_rtcp address=127.0.0.1 port=0 ! rtpbin.recv_rtcp_sink_1 "
+      "rtpbin.send_rtcp_src_1 ! udpsink name=pfap_rr host=127.0.0.1 sync=false async=false "
+      "rtpL16depay name=audio_depay ! appsink name=audio_sink sync=false emit-signals=true "
+      "rtppfapdepay name=pfap_depay ! appsink name=pfap_sink sync=false emit-signals=true");
+  ASSERT_TRUE(receiver.ok()) << receiver.error();
+  pfap::testing::Pipeline sender(
+      "rtpbin name=rtpbin sdes=\"application/x-rtp-source-sdes,cname=(string)pfaptts-test\" "
+      "pfaptts name=tts rate=220 text=\"Hello <FAP 2 1 40 0 0 500 1> world. This talking head "
+      "speaks over RTP, <FAP 48 20000 800 3> and its lips move with the sound.\" "
+      "tts.audio ! queue ! audioconvert ! rtpL16pay name=audio_pay pt=96 "
+      "! rtpbin.send_rtp_sink_0 "
+      "rtpbin.send_rtp_src_0 ! udpsink name=audio_rtp host=127.0.0.1 async=false "
+      "rtpbin.send_rtcp_src_0 ! udpsink name=audio_rtcp host=127.0.0.1 sync=false async=false "
+      "udpsrc name=audio_rr address=127.0.0.1 port=0 ! rtpbin.recv_rtcp_sink_0 "
+      "tts.pfap ! queue ! rtppfappay name=pfap_pay pt=97 ! rtpbin.send_rtp_sink_1 "
+      "rtpbin.send_rtp_src_1 ! udpsink name=pfap_rtp host=127.0.0.1 async=false "
+      "rtpbin.send_rtcp_src_1 ! udpsink name=pfap_rtcp host=127.0.0.1 sync=false async=false "
+      "udpsrc name=pfap_rr address=127.0.0.1 port=0 ! rtpbin.recv_rtcp_sink_1");
+  ASSERT_TRUE(sender.ok()) << sender.error();
+
+  links.audio_depay = receiver.by_name("audio_depay");
+  links.pfap_depay = receiver.by_name("pfap_depay");
+  GstElement* receiver_rtpbin = receiver.by_name("rtpbin");
+  g_signal_connect(receiver_rtpbin, "pad-added", G_CALLBACK(pfap::testing::on_rtpbin_pad), &links);
+  g_signal_connect(receiver_rtpbin, "new-jitterbuffer",
+                   G_CALLBACK(pfap::testing::on_new_jitterbuffer), &received);
+  g_signal_connect(receiver.by_name("audio_sink"), "new-sample",
+                   G_CALLBACK(pfap::testing::on_audio), &received);
+  g_signal_connect(receiver.by_name("pfap_sink"), "new-sample",
+                   G_CALLBACK(pfap::testing::on_phoneme), &received);
+  for (const char* name : {"audio_pay", "pfap_pay"}) {
+    GstPad* pad = gst_element_get_static_pad(sender.by_name(name), "sink");
+    if (std::string_view(name) == "audio_pay") {
+      gst_pad_add_probe(pad, GST_PAD_PROBE_TYPE_BUFFER, pfap::testing::record_sent_audio,
+                        &sent_audio, nullptr);
+    } else {
+      gst_pad_add_probe(pad, GST_PAD_PROBE_TYPE_BUFFER, SentPhonemes::on_pfap, &sent, nullptr);
+    }
+    gst_pad_add_probe(pad, GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM, SentPhonemes::on_event, &sent,
+                      nullptr);
+    gst_object_unref(pad);
+  }
+
+  ASSERT_EQ(receiver.set_state(GST_STATE_READY), "");
+  ASSERT_EQ(sender.set_state(GST_STATE_READY), "");
+  for (const char* name : {"audio_rtp", "audio_rtcp", "pfap_rtp", "pfap_rtcp"}) {
+    const guint port = pfap::testing::bound_port(receiver.by_name(name));
+    ASSERT_NE(port, 0u) << name;
+    g_object_set(sender.by_name(name), "port", port, nullptr);
+  }
+  for (const char* name : {"audio_rr", "pfap_rr"}) {
+    const guint port = pfap::testing::bound_port(sender.by_name(name));
+    ASSERT_NE(port, 0u) << name;
+    g_object_set(receiver.by_name(name), "port", port, nullptr);
+  }
+  pfap::testing::fast_rtcp(sender.by_name("rtpbin"));
+  pfap::testing::fast_rtcp(receiver_rtpbin);
+  ASSERT_EQ(receiver.set_state(GST_STATE_PLAYING), "");
+  ASSERT_EQ(sender.set_state(GST_STATE_PLAYING), "");
+
+  // Until both payloaders have had EOS and everything sent has arrived (or a deadline).
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  std::string failure;
+  for (;;) {
+    bool done = false;
+    if (sent.eos == 2) {
+      std::scoped_lock lock(sent.mutex, sent_audio.mutex, received.mutex);
+      size_t samples = 0;
+      for (const pfap::testing::Received::Audio& a : received.audio) samples += a.bytes.size();
+      done = received.phonemes.size() >= sent.events.size() && samples >= sent_audio.bytes.size();
+      if (!received.link_errors.empty()) failure = received.link_errors.front();
+    }
+    if (done || !failure.empty()) break;
+    failure = sender.poll_error();
+    if (failure.empty()) failure = receiver.poll_error();
+    if (!failure.empty()) break;
+    if (std::chrono::steady_clock::now() > deadline) {
+      failure = "timed out: " + std::to_string(received.phonemes.size()) + " phonemes of " +
+                std::to_string(sent.events.size()) + " received";
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  sender.set_state(GST_STATE_NULL);
+  receiver.set_state(GST_STATE_NULL);
+  ASSERT_EQ(failure, "");
+
+  // Every phoneme arrives once, in order, with its fields and FAPs.
+  ASSERT_GT(sent.events.size(), 30u);
+  ASSERT_EQ(received.phonemes.size(), sent.events.size());
+  std::vector<GstClockTime> sent_times;
+  int faps = 0;
+  for (size_t i = 0; i < sent.events.size(); ++i) {
+    Event got = received.phonemes[i].event;
+    Event want = sent.events[i];
+    sent_times.push_back(want.pts);
+    faps += static_cast<int>(want.faps.size());
+    got.discont = want.discont = false;
+    got.pts = want.pts;
+    got.duration = want.duration = 0;  // the receiver's come from the whole ms
+    EXPECT_EQ(got, want) << "phoneme " << i;
+  }
+  EXPECT_EQ(faps, 2);
+
+  size_t unmatched = 0;
+  const std::vector<pfap::testing::AudioOffset> audio =
+      pfap::testing::audio_offsets(sent_audio, received, unmatched);
+  // Buffers that start in silence cannot be found by their bytes.
+  ASSERT_GT(audio.size(), received.audio.size() / 3)
+      << unmatched << " of " << received.audio.size() << " received audio buffers not found";
+  const pfap::testing::LipSync sync =
+      pfap::testing::compare_offsets(audio, sent_times, received.phonemes, GST_MSECOND);
+  SCOPED_TRACE("per phoneme (syncs < 2: before RTCP sync, not counted):\n" + sync.table);
+  EXPECT_GE(sync.compared, 10) << "too few phonemes after RTCP sync";
+  EXPECT_EQ(sync.out_of_tolerance, 0)
+      << "worst |R_p - R_a| " << sync.worst / 1000 << " us over " << sync.compared << " phonemes";
+  if (g_getenv("PFAP_TEST_VERBOSE") != nullptr) {
+    std::cout << sync.table << "worst " << sync.worst << " ns over " << sync.compared << "\n";
+  }
 }
 
 }  // namespace
