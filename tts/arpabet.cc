@@ -111,7 +111,7 @@ std::optional<ArpabetSymbol> arpabet_symbol(std::string_view mnemonic) {
   if (std::optional<uint8_t> s = lookup(mnemonic)) return ArpabetSymbol{*s, true};
   std::string_view base = mnemonic;
   while (base.size() > 1 &&
-         std::string_view("0123456789#-/;").find(base.back()) != std::string_view::npos) {
+         std::string_view("0123456789#-/;:").find(base.back()) != std::string_view::npos) {
     base.remove_suffix(1);
   }
   if (base != mnemonic) {

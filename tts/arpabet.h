@@ -23,8 +23,8 @@ struct ArpabetSymbol {
 };
 
 // The x-pfap-arpabet symbol of an espeak-ng mnemonic: from the table, else from its base
-// (the mnemonic without trailing digits, '#', '-', '/' or ';', as in "@5" or "l/2"), else
-// nullopt. Mnemonics starting with '_' are pauses.
+// (the mnemonic without trailing digits, '#', '-', '/', ';' or ':', as in "l/2" or "e:"),
+// else nullopt. Mnemonics starting with '_' are pauses.
 std::optional<ArpabetSymbol> arpabet_symbol(std::string_view mnemonic);
 
 }  // namespace pfap::tts

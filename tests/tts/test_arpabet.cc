@@ -42,6 +42,7 @@ TEST(Arpabet, SomeMappings) {
   EXPECT_EQ(name("l/2"), "L");
   EXPECT_FALSE(arpabet_symbol("l/2")->exact);
   EXPECT_EQ(name("@7"), "AH");
+  EXPECT_EQ(name("e:"), "EH");  // German's long e
   // Nothing to go by.
   EXPECT_EQ(name("Q"), "none");
   EXPECT_EQ(name("y"), "none");
