@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <vector>
 
@@ -33,6 +34,7 @@ TEST(F0, KnownPitchesAndSilence) {
   const std::vector<size_t> bounds = {0, a, b, samples.size()};
   const std::vector<double> f0 = segment_f0(samples, kRate, bounds);
   ASSERT_EQ(f0.size(), 3u);
+  std::printf("measured: 110 Hz as %.2f, silence as %.2f, 220 Hz as %.2f\n", f0[0], f0[1], f0[2]);
   EXPECT_NEAR(f0[0], 110, 2);
   EXPECT_EQ(f0[1], 0);
   EXPECT_NEAR(f0[2], 220, 3);
