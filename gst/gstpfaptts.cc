@@ -387,10 +387,9 @@ static void speak_text_task(GstPfapTts* self) {
   const GstFlowReturn ret = speak(self, text, GST_CLOCK_TIME_NONE);
   gst_pad_pause_task(self->audiopad);
   if (ret == GST_FLOW_FLUSHING) return;
-  if (ret != GST_FLOW_OK && ret != GST_FLOW_EOS) {
-    if (ret == GST_FLOW_NOT_LINKED || ret < GST_FLOW_EOS) {
-      GST_ELEMENT_FLOW_ERROR(self, ret);
-    }
+  // GST_FLOW_ERROR has been posted, by us or downstream.
+  if (ret == GST_FLOW_NOT_LINKED || (ret < GST_FLOW_EOS && ret != GST_FLOW_ERROR)) {
+    GST_ELEMENT_FLOW_ERROR(self, ret);
   }
   push_eos(self);
 }

@@ -25,6 +25,34 @@ uint64_t to_ms(size_t sample, unsigned rate) {
 
 }  // namespace
 
+void add_phoneme(const MarkupEvent& event, size_t start, size_t end, unsigned rate,
+                 const std::string& mnemonic, std::vector<SpokenPhoneme>& out) {
+  const uint64_t ms = to_ms(end, rate) - to_ms(start, rate);
+  std::vector<Phoneme> pieces;
+  split_long_phoneme(event.phoneme, static_cast<uint32_t>(ms), pieces);
+  size_t piece_start = start;
+  for (size_t i = 0; i < pieces.size(); ++i) {
+    // Every piece but the last is 4095 ms on the ms grid.
+    const size_t piece_end =
+        i + 1 < pieces.size()
+            ? static_cast<size_t>(
+                  ((to_ms(piece_start, rate) + kMaxPhonemeDurationMs) * rate + 500) / 1000)
+            : end;
+    SpokenPhoneme p;
+    p.event = event;
+    p.event.phoneme = pieces[i];
+    if (i > 0) {
+      p.event.faps.clear();
+      p.event.sentence_start = false;
+    }
+    p.start = piece_start;
+    p.n_samples = piece_end - piece_start;
+    p.mnemonic = mnemonic;
+    out.push_back(std::move(p));
+    piece_start = piece_end;
+  }
+}
+
 bool speak(const Utterance& utterance, const VoiceSettings& settings, Speech& out,
            std::string& error) {
   Synthesis syn;
@@ -101,32 +129,11 @@ bool speak(const Utterance& utterance, const VoiceSettings& settings, Speech& ou
     events[at].faps.insert(events[at].faps.end(), b.faps.begin(), b.faps.end());
   }
 
-  const unsigned rate = syn.sample_rate;
-  std::vector<Phoneme> pieces;
   for (size_t k = 0; k < segments.size(); ++k) {
-    const Segment& s = segments[k];
-    const uint64_t ms = to_ms(s.end, rate) - to_ms(s.start, rate);
-    pieces.clear();
-    split_long_phoneme(events[k].phoneme, static_cast<uint32_t>(ms), pieces);
-    size_t piece_start = s.start;
-    for (size_t i = 0; i < pieces.size(); ++i) {
-      const size_t piece_end =
-          i + 1 < pieces.size()
-              ? piece_start + static_cast<size_t>(uint64_t{kMaxPhonemeDurationMs} * rate / 1000)
-              : s.end;
-      SpokenPhoneme p;
-      p.event = events[k];
-      p.event.phoneme = pieces[i];
-      if (i > 0) {
-        p.event.faps.clear();
-        p.event.sentence_start = false;
-      }
-      p.start = piece_start;
-      p.n_samples = piece_end - piece_start;
-      p.mnemonic = s.espeak_index != SIZE_MAX ? syn.phonemes[s.espeak_index].mnemonic : "";
-      out.phonemes.push_back(std::move(p));
-      piece_start = piece_end;
-    }
+    const Segment& seg = segments[k];
+    add_phoneme(events[k], seg.start, seg.end, syn.sample_rate,
+                seg.espeak_index != SIZE_MAX ? syn.phonemes[seg.espeak_index].mnemonic : "",
+                out.phonemes);
   }
   out.samples = std::move(syn.samples);
   return true;

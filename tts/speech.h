@@ -34,6 +34,12 @@ struct Speech {
   std::vector<Inexact> inexact;
 };
 
+// Appends the phoneme `event` that lasts samples [start, end) of an utterance at `rate`, with
+// its duration_ms on the utterance's ms grid (below); longer than 4095 ms, as the pieces of
+// pfap::split_long_phoneme, the FAPs and sentence start on the first.
+void add_phoneme(const MarkupEvent& event, size_t start, size_t end, unsigned rate,
+                 const std::string& mnemonic, std::vector<SpokenPhoneme>& out);
+
 // Speaks `utterance`. False with `error` when espeak-ng cannot (no such voice).
 //  - A phoneme lasts from its start to the next one's; the last to the end of the audio. The
 //    audio before espeak-ng's first phoneme (about 12 ms) is a pause; phonemes of no samples

@@ -175,6 +175,43 @@ TEST(Speech, F0FollowsThePitchSetting) {
   EXPECT_EQ(low.phonemes.front().event.phoneme.f0, 0);
 }
 
+// A phoneme of 10 s (from 1 s into the utterance) goes as 4095 + 4095 + 1810 ms, contiguous.
+TEST(Speech, LongPhonemesAreSplit) {
+  MarkupEvent e;
+  e.phoneme = {22, 0, 60, true, true, true};
+  e.sentence_start = true;
+  e.faps = {{69, 40, 500, Curve::kLinear}};
+  std::vector<SpokenPhoneme> out;
+  add_phoneme(e, 22050, 11 * 22050, 22050, "m", out);
+  ASSERT_EQ(out.size(), 3u);
+  EXPECT_EQ(out[0].event.phoneme.duration_ms, 4095);
+  EXPECT_EQ(out[1].event.phoneme.duration_ms, 4095);
+  EXPECT_EQ(out[2].event.phoneme.duration_ms, 1810);
+  size_t at = 22050;
+  for (const SpokenPhoneme& p : out) {
+    EXPECT_EQ(p.start, at);
+    at += p.n_samples;
+    // Each piece's start is on the ms grid of its duration.
+    EXPECT_NEAR(static_cast<double>(p.n_samples) * 1000 / 22050, p.event.phoneme.duration_ms, 0.5);
+  }
+  EXPECT_EQ(at, 11u * 22050);
+  EXPECT_EQ(out[0].event.faps.size(), 1u);
+  EXPECT_TRUE(out[0].event.sentence_start && out[0].event.phoneme.word_begin);
+  EXPECT_TRUE(out[1].event.faps.empty() && !out[1].event.sentence_start);
+  EXPECT_FALSE(out[1].event.phoneme.end_of_text);
+  EXPECT_TRUE(out[2].event.phoneme.end_of_text && !out[2].event.phoneme.stress);
+}
+
+// A short one: from 0.41 ms to 80.59 ms is from 0 to 81 on the utterance's ms grid.
+TEST(Speech, DurationsOnTheUtterancesMsGrid) {
+  MarkupEvent e;
+  std::vector<SpokenPhoneme> out;
+  add_phoneme(e, 9, 1777, 22050, "a", out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].event.phoneme.duration_ms, 81);
+  EXPECT_EQ(out[0].n_samples, 1768u);
+}
+
 TEST(Speech, UnknownVoiceIsAnError) {
   Speech s;
   std::string error;
