@@ -72,8 +72,9 @@ enum {
 // The output timeline: a position is `base` plus `samples` at `rate`, so that a change of rate
 // (another voice) starts a new count and no rounding accumulates.
 struct Stream {
-  bool need_events = true;  // stream-start, caps and segment still to send
-  unsigned rate = 0;        // of the audio caps sent
+  bool need_start = true;    // stream-start and caps still to send
+  bool need_segment = true;  // a segment still to send
+  unsigned rate = 0;         // of the audio caps sent
   GstClockTime base = 0;
   uint64_t samples = 0;
   bool audio_discont = true;  // the next buffer on each pad is the first since a start or flush
@@ -122,11 +123,15 @@ static GstStaticPadTemplate pfap_template = GST_STATIC_PAD_TEMPLATE(
 G_DEFINE_TYPE(GstPfapTts, gst_pfap_tts, GST_TYPE_ELEMENT)
 GST_ELEMENT_REGISTER_DEFINE(pfaptts, "pfaptts", GST_RANK_NONE, GST_TYPE_PFAP_TTS)
 
-// Back to the start of a stream (READY to PAUSED, FLUSH_STOP).
-static void reset(GstPfapTts* self) {
+// Back to the start of the timeline: a new stream (READY to PAUSED), or after FLUSH_STOP the
+// same stream, whose stream-start and caps stay.
+static void reset(GstPfapTts* self, bool new_stream) {
   Stream& s = *self->stream;
-  s.need_events = true;
-  s.rate = 0;
+  if (new_stream) {
+    s.need_start = true;
+    s.rate = 0;
+  }
+  s.need_segment = true;
   s.base = 0;
   s.samples = 0;
   s.audio_discont = true;
@@ -151,12 +156,13 @@ static void push_audio_caps(GstPfapTts* self, unsigned rate) {
   gst_caps_unref(caps);
 }
 
-// Before the first output: stream-start (one group; `pfap` sparse), caps and a segment on both
-// pads. Then new audio caps whenever the rate changes (another voice).
+// Before the first output: stream-start (one group; `pfap` sparse) and caps on both pads;
+// new audio caps whenever the rate changes (another voice); a segment at the start and after a
+// flush.
 static void send_events(GstPfapTts* self, unsigned rate) {
   Stream& s = *self->stream;
-  if (s.need_events) {
-    s.need_events = false;
+  if (s.need_start) {
+    s.need_start = false;
     const guint group = gst_util_group_id_next();
     for (GstPad* pad : {self->audiopad, self->pfappad}) {
       gchar* id = gst_pad_create_stream_id(pad, GST_ELEMENT(self), GST_PAD_NAME(pad));
@@ -169,18 +175,20 @@ static void send_events(GstPfapTts* self, unsigned rate) {
     GstCaps* caps = gst_static_pad_template_get_caps(&pfap_template);
     gst_pad_push_event(self->pfappad, gst_event_new_caps(caps));
     gst_caps_unref(caps);
-    push_audio_caps(self, rate);
+  }
+  if (rate != s.rate) {
+    s.base = s.position();
+    s.samples = 0;
     s.rate = rate;
+    push_audio_caps(self, rate);
+  }
+  if (s.need_segment) {
+    s.need_segment = false;
     GstSegment segment;
     gst_segment_init(&segment, GST_FORMAT_TIME);
     for (GstPad* pad : {self->audiopad, self->pfappad}) {
       gst_pad_push_event(pad, gst_event_new_segment(&segment));
     }
-  } else if (rate != s.rate) {
-    s.base = s.position();
-    s.samples = 0;
-    s.rate = rate;
-    push_audio_caps(self, rate);
   }
 }
 
@@ -323,18 +331,18 @@ static GstFlowReturn gst_pfap_tts_chain(GstPad*, GstObject* parent, GstBuffer* b
   return ret;
 }
 
-// EOS on both pads, after the events a stream needs (a stream with no speech has the caps of
+// EOS on both pads, after the events a stream needs (a stream with no speech gets the caps of
 // the rate espeak-ng starts with).
 static gboolean push_eos(GstPfapTts* self) {
-  if (self->stream->need_events) {
-    unsigned rate = 0;
+  unsigned rate = self->stream->rate;
+  if (rate == 0) {
     std::string error;
     if (!pfap::tts::check_voice(voice_settings(self), rate, error)) {
       GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));
       return FALSE;
     }
-    send_events(self, rate);
   }
+  send_events(self, rate);
   gboolean ok = gst_pad_push_event(self->audiopad, gst_event_new_eos());
   ok &= gst_pad_push_event(self->pfappad, gst_event_new_eos());
   return ok;
@@ -362,7 +370,7 @@ static gboolean gst_pfap_tts_sink_event(GstPad* pad, GstObject* parent, GstEvent
       gst_event_unref(event);
       return push_eos(self);
     case GST_EVENT_FLUSH_STOP:
-      reset(self);
+      reset(self, false);
       break;
     default:
       break;
@@ -404,7 +412,7 @@ static GstStateChangeReturn gst_pfap_tts_change_state(GstElement* element,
                                                       GstStateChange transition) {
   GstPfapTts* self = GST_PFAP_TTS(element);
   if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) {
-    reset(self);
+    reset(self, true);
     unsigned rate = 0;
     std::string error;
     if (!pfap::tts::check_voice(voice_settings(self), rate, error)) {

@@ -271,6 +271,15 @@ TEST(PfapTts, FlushStartsTheTimelineAgain) {
   EXPECT_EQ(audio[0].offset, 0u);
   EXPECT_EQ(phonemes[0].pts, 0u);
   EXPECT_TRUE(phonemes[0].discont);
+  // The same stream goes on: a new segment, no new stream-start.
+  for (GstHarness* h : {t.harness(), t.pfap_harness()}) {
+    std::vector<GstEvent*> starts = Tts::events(h, GST_EVENT_STREAM_START);
+    EXPECT_TRUE(starts.empty());
+    unref_all(starts);
+    GstEvent* segment_event = gst_pad_get_sticky_event(h->sinkpad, GST_EVENT_SEGMENT, 0);
+    EXPECT_NE(segment_event, nullptr);
+    if (segment_event != nullptr) gst_event_unref(segment_event);
+  }
 }
 
 TEST(PfapTts, BadBookmarkIsAnErrorNamingItsCharacter) {
