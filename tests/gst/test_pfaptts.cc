@@ -396,6 +396,34 @@ TEST(PfapTts, LongSessionDoesNotDrift) {
   EXPECT_GT(samples, 50u * kRate / 2);
 }
 
+// What gst-inspect-1.0 shows: every property of its own has a blurb, and the defaults.
+TEST(PfapTts, PropertiesAreDocumented) {
+  GstElement* tts = gst_element_factory_make("pfaptts", nullptr);
+  ASSERT_NE(tts, nullptr);
+  guint n = 0;
+  GParamSpec** specs = g_object_class_list_properties(G_OBJECT_GET_CLASS(tts), &n);
+  std::vector<std::string> own;
+  for (guint i = 0; i < n; ++i) {
+    if (specs[i]->owner_type != G_OBJECT_TYPE(tts)) continue;
+    own.push_back(g_param_spec_get_name(specs[i]));
+    const gchar* blurb = g_param_spec_get_blurb(specs[i]);
+    EXPECT_TRUE(blurb != nullptr && *blurb != '\0') << own.back();
+  }
+  g_free(specs);
+  std::sort(own.begin(), own.end());
+  EXPECT_EQ(own, (std::vector<std::string>{"pitch", "rate", "skip-bad-bookmarks", "text", "voice",
+                                           "volume"}));
+  gchar* voice = nullptr;
+  gint rate = 0, pitch = 0, volume = 0;
+  g_object_get(tts, "voice", &voice, "rate", &rate, "pitch", &pitch, "volume", &volume, nullptr);
+  EXPECT_STREQ(voice, "en");
+  EXPECT_EQ(rate, 175);
+  EXPECT_EQ(pitch, 50);
+  EXPECT_EQ(volume, 100);
+  g_free(voice);
+  gst_object_unref(tts);
+}
+
 TEST(PfapTts, UnknownVoiceFailsTheStateChange) {
   GstElement* tts = gst_element_factory_make("pfaptts", nullptr);
   ASSERT_NE(tts, nullptr);
