@@ -3,6 +3,7 @@
 
 #include "gstpfapparse.h"
 #include "gstpfaptextenc.h"
+#include "gstpfaptts.h"
 #include "gstrtppfapdepay.h"
 #include "gstrtppfappay.h"
 
@@ -12,9 +13,11 @@ static gboolean plugin_init(GstPlugin* plugin) {
   ok &= GST_ELEMENT_REGISTER(rtppfapdepay, plugin);
   ok &= GST_ELEMENT_REGISTER(pfapparse, plugin);
   ok &= GST_ELEMENT_REGISTER(pfaptextenc, plugin);
+  ok &= GST_ELEMENT_REGISTER(pfaptts, plugin);
   return ok;
 }
 
 GST_PLUGIN_DEFINE(GST_VERSION_MAJOR, GST_VERSION_MINOR, pfap,
-                  "Phoneme and facial animation parameter (PFAP) streams: RTP payloading and text markup",
+                  "Phoneme and facial animation parameter (PFAP) streams: RTP payloading, text "
+                  "markup and text-to-speech",
                   plugin_init, VERSION, "LGPL", GST_PACKAGE_NAME, GST_PACKAGE_ORIGIN)

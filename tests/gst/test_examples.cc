@@ -9,6 +9,7 @@
 //    SDP and the caps carry the alphabet, audio arrives, every phoneme arrives.
 //  - DocumentedLines.*: each command block of that docs section, run as written but with free
 //    ports, the source tree's docs/examples/ and temporary output files.
+//  - Readme.*: the pfaptts commands of README.md, "Text to speech", run the same way.
 //
 // meson passes PFAP_SOURCE_DIR, PFAP_LOOPBACK and PFAP_RTSP_SERVER, and GST_PLUGIN_PATH in the
 // environment (the subprocesses inherit it). Everything is on 127.0.0.1, on port 0 or on free
@@ -24,9 +25,11 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <csignal>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <map>
 #include <mutex>
@@ -299,9 +302,9 @@ struct Tap {
   size_t buffers = 0;
   size_t size = 0;
 
-  void attach(GstElement* element) {
+  void attach(GstElement* element, const char* pad_name = "src") {
     ASSERT_NE(element, nullptr);
-    GstPad* pad = gst_element_get_static_pad(element, "src");
+    GstPad* pad = gst_element_get_static_pad(element, pad_name);
     gst_pad_add_probe(pad, GST_PAD_PROBE_TYPE_BUFFER, on_buffer, this, nullptr);
     gst_object_unref(pad);
   }
@@ -372,14 +375,15 @@ template <typename Done>
 // ---------------------------------------------------------------------------------------------
 // The documented commands
 
-// The commands in the ```sh blocks under `heading` (to the next heading) in the docs section:
-// comment lines dropped, lines ending in '\' joined.
-std::vector<std::string> documented_commands(const std::string& heading) {
-  const std::vector<std::string> lines = lines_of(read_file(source_path("docs/elements.md")));
+// The commands in the ```sh blocks under `heading` (to the next heading) in `section` of `file`
+// (a source path): comment lines dropped, lines ending in '\' joined.
+std::vector<std::string> documented_commands(const std::string& file, const std::string& section,
+                                             const std::string& heading) {
+  const std::vector<std::string> lines = lines_of(read_file(source_path(file)));
   std::vector<std::string> commands;
   bool in_section = false, in_heading = false, in_block = false, continued = false;
   for (const std::string& line : lines) {
-    if (!in_block && line.rfind("## ", 0) == 0) in_section = line == kSection;
+    if (!in_block && line.rfind("## ", 0) == 0) in_section = line == section;
     if (!in_section) continue;
     if (!in_block && line.rfind("### ", 0) == 0) in_heading = line == heading;
     if (!in_heading) continue;
@@ -404,6 +408,11 @@ std::vector<std::string> documented_commands(const std::string& heading) {
   return commands;
 }
 
+// Those of docs/elements.md, "Text markup: sending and receiving a session".
+std::vector<std::string> documented_commands(const std::string& heading) {
+  return documented_commands("docs/elements.md", kSection, heading);
+}
+
 const std::vector<std::string> kHeadings = {
     "### One process", "### Over UDP", "### Next to audio: one rtpbin on each side", "### RTSP"};
 
@@ -419,6 +428,8 @@ class Substitution {
     replace_all(command, "docs/examples/", source_path("docs/examples/"));
     replace_all(command, "received.pfap", dir_.file("received.pfap"));
     replace_all(command, "received.wav", dir_.file("received.wav"));
+    replace_all(command, "speech.pfap", dir_.file("speech.pfap"));
+    replace_all(command, "speech.wav", dir_.file("speech.wav"));
     if (!rtsp_url_.empty()) replace_all(command, "rtsp://127.0.0.1:8554/pfap", rtsp_url_);
     static const std::regex port("port=([0-9]+)");
     std::string out;
@@ -756,6 +767,121 @@ TEST(DocumentedLines, Rtsp) {
   EXPECT_GT(wav.size(), 44u + 4410u * 2) << "at least 0.1 s of audio";
   gst_element_set_state(client.get(), GST_STATE_NULL);  // TEARDOWN while the server is there
   EXPECT_EQ(server.stop(), 0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Readme: README.md, "Text to speech"
+
+constexpr const char* kReadmeSection = "## Text to speech";
+
+std::vector<std::string> readme_commands(const std::string& heading) {
+  return documented_commands("README.md", kReadmeSection, heading);
+}
+
+// The .pfap lines as (start ms, duration ms, number of bookmarked FAPs).
+struct PfapLine {
+  long start_ms;
+  long duration_ms;
+  int faps;
+};
+std::vector<PfapLine> pfap_lines(const std::string& text) {
+  std::vector<PfapLine> out;
+  for (const std::string& line : lines_of(text)) {
+    long start = 0, symbol = 0, duration = 0;
+    if (std::sscanf(line.c_str(), "%ld %ld %ld", &start, &symbol, &duration) != 3) continue;
+    int faps = 0;
+    for (size_t at = line.find("<FAP"); at != std::string::npos; at = line.find("<FAP", at + 1)) {
+      ++faps;
+    }
+    out.push_back({start, duration, faps});
+  }
+  return out;
+}
+
+TEST(Readme, EveryCommandIsTested) {
+  const std::string readme = read_file(source_path("README.md"));
+  size_t launch_lines = 0;
+  bool in_block = false;
+  for (const std::string& line : lines_of(readme)) {
+    if (line.rfind("```", 0) == 0) in_block = !in_block;
+    if (in_block && line.rfind("gst-launch-1.0", 0) == 0) ++launch_lines;
+  }
+  EXPECT_EQ(readme_commands("### Into files").size() + readme_commands("### Over RTP").size(),
+            launch_lines);
+}
+
+// Speech into a WAV file and its phonemes into a .pfap file: the phonemes cover the audio.
+TEST(Readme, SpeaksIntoFiles) {
+  ASSERT_TRUE(plugin_available());
+  const std::vector<std::string> commands = readme_commands("### Into files");
+  ASSERT_EQ(commands.size(), 1u);
+  TempDir dir;
+  Substitution substitute(dir);
+  Pipeline p(substitute.launch(commands[0]));
+  ASSERT_TRUE(p.error().empty()) << p.error();
+  ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+  ASSERT_EQ(p.wait_eos(10s), "");
+  const std::string wav = read_file(dir.file("speech.wav"));
+  ASSERT_EQ(wav.rfind("RIFF", 0), 0u);
+  const double audio_ms = (static_cast<double>(wav.size()) - 44) / 2 / 22050 * 1000;
+  const std::vector<PfapLine> lines = pfap_lines(read_file(dir.file("speech.pfap")));
+  ASSERT_GT(lines.size(), 10u);
+  int faps = 0;
+  long end = 0;
+  for (const PfapLine& l : lines) {
+    EXPECT_EQ(l.start_ms, end) << "phonemes follow each other";
+    end = l.start_ms + l.duration_ms;
+    faps += l.faps;
+  }
+  EXPECT_NEAR(static_cast<double>(end), audio_ms, 20.0);
+  EXPECT_EQ(faps, 1);
+}
+
+// The same speech served over RTP, and a receiver writing both streams to files.
+TEST(Readme, ServesOverRtp) {
+  ASSERT_TRUE(plugin_available());
+  const std::vector<std::string> commands = readme_commands("### Over RTP");
+  ASSERT_EQ(commands.size(), 2u);
+  TempDir dir;
+  Substitution substitute(dir);
+  Pipeline receiver(substitute.launch(commands[0]));
+  Pipeline sender(substitute.launch(commands[1]));
+  ASSERT_TRUE(receiver.error().empty()) << receiver.error();
+  ASSERT_TRUE(sender.error().empty()) << sender.error();
+  Tap sent, text;
+  sent.attach(sender.find("pfaptts"), "pfap");
+  text.attach(receiver.find("pfaptextenc"));
+  // The end of the speech is EOS out of pfaptts, not the sender's EOS message: GStreamer
+  // 1.22's rtpbin now and then never ends the PFAP session's RTCP (README.md).
+  std::atomic<bool> spoken{false};
+  GstPad* pfap_pad = gst_element_get_static_pad(sender.find("pfaptts"), "pfap");
+  gst_pad_add_probe(
+      pfap_pad, GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM,
+      [](GstPad*, GstPadProbeInfo* info, gpointer data) {
+        if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) == GST_EVENT_EOS) {
+          static_cast<std::atomic<bool>*>(data)->store(true);
+        }
+        return GST_PAD_PROBE_OK;
+      },
+      &spoken, nullptr);
+  gst_object_unref(pfap_pad);
+  ASSERT_EQ(receiver.set_state(GST_STATE_PLAYING), "");
+  ASSERT_EQ(sender.set_state(GST_STATE_PLAYING), "");
+  ASSERT_TRUE(wait_until(
+      {&receiver, &sender}, [&] { return spoken && text.lines() >= sent.count(); }, 20s,
+      "all of the speech"))
+      << text.lines() << " of " << sent.count();
+  ASSERT_EQ(receiver.end(5s), "");
+  gst_element_set_state(sender.get(), GST_STATE_NULL);
+
+  const std::vector<PfapLine> lines = pfap_lines(read_file(dir.file("received.pfap")));
+  EXPECT_EQ(lines.size(), sent.count());
+  int faps = 0;
+  for (const PfapLine& l : lines) faps += l.faps;
+  EXPECT_EQ(faps, 1);
+  const std::string wav = read_file(dir.file("received.wav"));
+  EXPECT_EQ(wav.rfind("RIFF", 0), 0u);
+  EXPECT_GT(wav.size(), 44u + 22050u * 2 / 2) << "at least 0.5 s of speech";
 }
 
 }  // namespace

@@ -29,6 +29,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "lip_sync.h"
 #include "pfap/markup.h"
 #include "pfap/model.h"
 #include "pfap_buffers.h"
@@ -85,12 +86,6 @@ using pfap::testing::fast_rtcp;
 using pfap::testing::Pipeline;
 using pfap::testing::pull_all;
 using pfap::testing::push;
-
-GstClockTime running_time(GstSample* sample) {
-  const GstSegment* segment = gst_sample_get_segment(sample);
-  GstBuffer* buffer = gst_sample_get_buffer(sample);
-  return gst_segment_to_running_time(segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
-}
 
 // Fails the test unless the plugin's elements can be made.
 ::testing::AssertionResult plugin_available() {
@@ -479,7 +474,7 @@ TEST(GstInspect, PluginListsAllElements) {
   SCOPED_TRACE("gst-inspect-1.0 pfap:\n" + r.out);
   const std::vector<std::string> lines = lines_of(r.out);
   EXPECT_EQ(detail(lines, "Name"), "pfap");
-  for (const char* name : {kPay, kDepay, "pfapparse", "pfaptextenc"}) {
+  for (const char* name : {kPay, kDepay, "pfapparse", "pfaptextenc", "pfaptts"}) {
     SCOPED_TRACE(name);
     GstElementFactory* factory = gst_element_factory_find(name);
     ASSERT_NE(factory, nullptr);
@@ -489,8 +484,8 @@ TEST(GstInspect, PluginListsAllElements) {
     gst_object_unref(factory);
     EXPECT_NE(std::find(lines.begin(), lines.end(), line), lines.end()) << "no line: " << line;
   }
-  EXPECT_NE(r.out.find("4 features:"), std::string::npos);
-  EXPECT_NE(r.out.find("+-- 4 elements"), std::string::npos);
+  EXPECT_NE(r.out.find("5 features:"), std::string::npos);
+  EXPECT_NE(r.out.find("+-- 5 elements"), std::string::npos);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -538,143 +533,17 @@ TEST(GstInspect, PluginListsAllElements) {
 // the per-phoneme table.
 
 constexpr int kAudioRate = 44100;
-constexpr size_t kAudioKeyBytes = 8;  // 4 samples of white noise identify a position
 constexpr GstClockTime kTolerance = GST_MSECOND;
 
-struct SentAudio {
-  std::mutex mutex;
-  std::vector<uint8_t> bytes;  // every sample sent, S16BE mono, in order
-  struct Chunk {
-    size_t first_sample;
-    GstClockTime running_time;
-  };
-  std::vector<Chunk> chunks;  // where each sent buffer starts
-
-  // The sender running time of sample j.
-  GstClockTime time_of(size_t j) const {
-    auto it = std::upper_bound(chunks.begin(), chunks.end(), j,
-                               [](size_t v, const Chunk& c) { return v < c.first_sample; });
-    const Chunk& c = *(it - 1);
-    return c.running_time + gst_util_uint64_scale_round(j - c.first_sample, GST_SECOND, kAudioRate);
-  }
-};
-
-GstPadProbeReturn record_sent_audio(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
-  auto* sent = static_cast<SentAudio*>(data);
-  GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
-  GstEvent* segment_event = gst_pad_get_sticky_event(pad, GST_EVENT_SEGMENT, 0);
-  if (segment_event == nullptr || !GST_BUFFER_PTS_IS_VALID(buffer)) {
-    if (segment_event != nullptr) gst_event_unref(segment_event);
-    return GST_PAD_PROBE_OK;
-  }
-  const GstSegment* segment = nullptr;
-  gst_event_parse_segment(segment_event, &segment);
-  const GstClockTime rt =
-      gst_segment_to_running_time(segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
-  gst_event_unref(segment_event);
-  GstMapInfo map;
-  gst_buffer_map(buffer, &map, GST_MAP_READ);
-  {
-    std::lock_guard lock(sent->mutex);
-    sent->chunks.push_back({sent->bytes.size() / 2, rt});
-    sent->bytes.insert(sent->bytes.end(), map.data, map.data + map.size);
-  }
-  gst_buffer_unmap(buffer, &map);
-  return GST_PAD_PROBE_OK;
-}
-
-struct Received {
-  std::mutex mutex;
-  std::condition_variable changed;
-  std::atomic<int> syncs[2] = {0, 0};  // handle-sync calls per session (0 audio, 1 PFAP)
-
-  struct Audio {
-    GstClockTime running_time;
-    std::vector<uint8_t> bytes;
-  };
-  std::vector<Audio> audio;
-  struct Phoneme {
-    Event event;
-    GstClockTime running_time;
-    int syncs;  // the fewer of the two sessions' sync counts when it arrived
-  };
-  std::vector<Phoneme> phonemes;
-  std::vector<std::string> link_errors;
-};
-
-GstFlowReturn on_audio(GstElement* sink, gpointer data) {
-  auto* r = static_cast<Received*>(data);
-  GstSample* sample = nullptr;
-  g_signal_emit_by_name(sink, "pull-sample", &sample);
-  if (sample == nullptr) return GST_FLOW_EOS;
-  GstMapInfo map;
-  GstBuffer* buffer = gst_sample_get_buffer(sample);
-  gst_buffer_map(buffer, &map, GST_MAP_READ);
-  Received::Audio a{running_time(sample), std::vector<uint8_t>(map.data, map.data + map.size)};
-  gst_buffer_unmap(buffer, &map);
-  gst_sample_unref(sample);
-  {
-    std::lock_guard lock(r->mutex);
-    r->audio.push_back(std::move(a));
-  }
-  r->changed.notify_all();
-  return GST_FLOW_OK;
-}
-
-GstFlowReturn on_phoneme(GstElement* sink, gpointer data) {
-  auto* r = static_cast<Received*>(data);
-  GstSample* sample = nullptr;
-  g_signal_emit_by_name(sink, "pull-sample", &sample);
-  if (sample == nullptr) return GST_FLOW_EOS;
-  const int syncs = std::min(r->syncs[0].load(), r->syncs[1].load());
-  Received::Phoneme p{pfap::testing::read_event(gst_sample_get_buffer(sample)),
-                      running_time(sample), syncs};
-  gst_sample_unref(sample);
-  {
-    std::lock_guard lock(r->mutex);
-    r->phonemes.push_back(std::move(p));
-  }
-  r->changed.notify_all();
-  return GST_FLOW_OK;
-}
-
-void on_handle_sync(GstElement*, GstStructure*, gpointer data) {
-  static_cast<std::atomic<int>*>(data)->fetch_add(1);
-}
-
-void on_new_jitterbuffer(GstElement*, GstElement* jitterbuffer, guint session, guint,
-                         gpointer data) {
-  auto* r = static_cast<Received*>(data);
-  if (session > 1) return;
-  // After rtpbin's own handler, which applies the sync.
-  g_signal_connect_after(jitterbuffer, "handle-sync", G_CALLBACK(on_handle_sync),
-                         &r->syncs[session]);
-}
-
-struct ReceiverLinks {
-  GstElement* audio_depay;
-  GstElement* pfap_depay;
-  Received* received;
-};
-
-void on_rtpbin_pad(GstElement*, GstPad* pad, gpointer data) {
-  auto* links = static_cast<ReceiverLinks*>(data);
-  gchar* name = gst_pad_get_name(pad);
-  const std::string pad_name = name;
-  g_free(name);
-  GstElement* depay = nullptr;
-  if (pad_name.rfind("recv_rtp_src_0_", 0) == 0) depay = links->audio_depay;
-  if (pad_name.rfind("recv_rtp_src_1_", 0) == 0) depay = links->pfap_depay;
-  if (depay == nullptr) return;
-  GstPad* sink = gst_element_get_static_pad(depay, "sink");
-  const GstPadLinkReturn ret = gst_pad_link(pad, sink);
-  gst_object_unref(sink);
-  if (ret != GST_PAD_LINK_OK) {
-    std::lock_guard lock(links->received->mutex);
-    links->received->link_errors.push_back("cannot link " + pad_name + ": " +
-                                           gst_pad_link_get_name(ret));
-  }
-}
+using pfap::testing::AudioOffset;
+using pfap::testing::on_audio;
+using pfap::testing::on_new_jitterbuffer;
+using pfap::testing::on_phoneme;
+using pfap::testing::on_rtpbin_pad;
+using pfap::testing::Received;
+using pfap::testing::ReceiverLinks;
+using pfap::testing::record_sent_audio;
+using pfap::testing::SentAudio;
 
 // The phonemes the sender sends: sentences of contiguous phonemes with pauses between them,
 // from 300 ms (plus a fraction of a ms) for about 4 s. Each is numbered by symbol + 256 * f0.
@@ -733,7 +602,7 @@ TEST(LoopbackUdp, PhonemesKeepLipSyncWithAudio) {
   const std::vector<Event> sent = live_phonemes();
   const Event& last = sent.back();
   // What the pipelines' callbacks write to outlives the pipelines.
-  SentAudio sent_audio;
+  SentAudio sent_audio(kAudioRate);
   Received received;
   ReceiverLinks links{nullptr, nullptr, &received};
 
@@ -869,72 +738,24 @@ TEST(LoopbackUdp, PhonemesKeepLipSyncWithAudio) {
                             << describe(received.phonemes[i].event);
   }
 
-  // Where each received audio buffer was in the sent audio: a map from 4-sample keys to
-  // their position, then a check of the whole buffer's bytes.
-  std::unordered_map<uint64_t, int64_t> positions;  // -1: key not unique
-  const std::vector<uint8_t>& bytes = sent_audio.bytes;
-  for (size_t j = 0; j + kAudioKeyBytes / 2 <= bytes.size() / 2; ++j) {
-    uint64_t key;
-    std::memcpy(&key, &bytes[2 * j], sizeof key);
-    auto [it, fresh] = positions.emplace(key, static_cast<int64_t>(j));
-    if (!fresh) it->second = -1;
-  }
-  struct AudioOffset {
-    GstClockTime sent;        // sender running time of the buffer's first sample
-    GstClockTimeDiff offset;  // receiver running time - sender running time
-  };
-  std::vector<AudioOffset> audio_offsets;
+  // Where each received audio buffer was in the sent audio, by its bytes.
   size_t unmatched = 0;
-  for (const Received::Audio& a : received.audio) {
-    if (a.bytes.size() < kAudioKeyBytes || !GST_CLOCK_TIME_IS_VALID(a.running_time)) continue;
-    uint64_t key;
-    std::memcpy(&key, a.bytes.data(), sizeof key);
-    auto it = positions.find(key);
-    const bool found = it != positions.end() && it->second >= 0 &&
-                       2 * static_cast<size_t>(it->second) + a.bytes.size() <= bytes.size() &&
-                       std::memcmp(&bytes[2 * it->second], a.bytes.data(), a.bytes.size()) == 0;
-    if (!found) {
-      ++unmatched;
-      continue;
-    }
-    const GstClockTime t = sent_audio.time_of(static_cast<size_t>(it->second));
-    audio_offsets.push_back({t, GST_CLOCK_DIFF(t, a.running_time)});
-  }
+  const std::vector<AudioOffset> audio_offsets =
+      pfap::testing::audio_offsets(sent_audio, received, unmatched);
   ASSERT_GT(audio_offsets.size(), received.audio.size() / 2)
       << unmatched << " of " << received.audio.size()
       << " received audio buffers not found in the sent audio";
-  std::sort(audio_offsets.begin(), audio_offsets.end(),
-            [](const AudioOffset& a, const AudioOffset& b) { return a.sent < b.sent; });
 
-  // Phoneme by phoneme: its offset against the offset of the audio sent at the same time.
-  std::ostringstream table;
-  table << "index  sent_ms  offset_pfap_us  offset_audio_us  diff_us  syncs\n";
-  int compared = 0;
-  int out_of_tolerance = 0;
-  GstClockTimeDiff worst = 0;
-  for (size_t i = 0; i < sent.size(); ++i) {
-    const Received::Phoneme& p = received.phonemes[i];
-    const GstClockTime t = sent[i].pts;
-    auto it = std::upper_bound(audio_offsets.begin(), audio_offsets.end(), t,
-                               [](GstClockTime v, const AudioOffset& a) { return v < a.sent; });
-    if (it == audio_offsets.begin()) continue;
-    const AudioOffset& a = *(it - 1);
-    if (t - a.sent > 50 * GST_MSECOND) continue;  // no audio received around T
-    const GstClockTimeDiff offset_p = GST_CLOCK_DIFF(t, p.running_time);
-    const GstClockTimeDiff diff = offset_p - a.offset;
-    table << i << "  " << t / GST_MSECOND << "  " << offset_p / 1000 << "  " << a.offset / 1000
-          << "  " << diff / 1000 << "  " << p.syncs << "\n";
-    if (p.syncs < 2) continue;
-    ++compared;
-    if (std::abs(diff) > static_cast<GstClockTimeDiff>(kTolerance)) ++out_of_tolerance;
-    if (std::abs(diff) > std::abs(worst)) worst = diff;
-  }
-  SCOPED_TRACE("per phoneme (syncs < 2: before RTCP sync, not counted):\n" + table.str());
-  EXPECT_GE(compared, 10) << "too few phonemes after RTCP sync";
-  EXPECT_EQ(out_of_tolerance, 0) << "worst |R_p - R_a| " << worst / 1000 << " us over " << compared
-                                 << " phonemes";
+  std::vector<GstClockTime> sent_times;
+  for (const Event& e : sent) sent_times.push_back(e.pts);
+  const pfap::testing::LipSync sync =
+      pfap::testing::compare_offsets(audio_offsets, sent_times, received.phonemes, kTolerance);
+  SCOPED_TRACE("per phoneme (syncs < 2: before RTCP sync, not counted):\n" + sync.table);
+  EXPECT_GE(sync.compared, 10) << "too few phonemes after RTCP sync";
+  EXPECT_EQ(sync.out_of_tolerance, 0)
+      << "worst |R_p - R_a| " << sync.worst / 1000 << " us over " << sync.compared << " phonemes";
   if (const char* verbose = g_getenv("PFAP_TEST_VERBOSE"); verbose != nullptr) {
-    std::cout << table.str() << "worst " << worst << " ns over " << compared << "\n";
+    std::cout << sync.table << "worst " << sync.worst << " ns over " << sync.compared << "\n";
   }
 }
 

@@ -1,0 +1,52 @@
+// espeak-ng 1.51 as a function: text in, audio and its events out. espeak-ng is one
+// process-wide synthesizer that is not reentrant (its voice, parameters and callback are
+// global), so every call runs under one mutex, synchronously, and sets all of them.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace pfap::tts {
+
+struct VoiceSettings {
+  std::string voice = "en";  // an espeak-ng voice name, e.g. "en", "en-us", "de"
+  int rate = 175;            // words per minute, 80..450
+  int pitch = 50;            // 0..100
+  int volume = 100;          // 0..200
+};
+
+struct Synthesis {
+  unsigned sample_rate = 0;      // from espeak-ng's sample rate event
+  std::vector<int16_t> samples;  // mono
+
+  struct Phoneme {
+    std::string mnemonic;  // espeak-ng's name, as in its -x transcription
+    size_t sample = 0;     // where it starts in `samples`
+    size_t sentence = 0;   // counted from 0
+  };
+  std::vector<Phoneme> phonemes;
+
+  struct Word {
+    size_t start = 0;  // code point of the text, from 0
+    size_t sentence = 0;
+    size_t first_phoneme = 0;  // index of its first phoneme; == end_phoneme when it has none
+    size_t end_phoneme = 0;
+  };
+  std::vector<Word> words;
+
+  std::string transcription;  // espeak_TextToPhonemes, with stress marks
+};
+
+// Whether espeak-ng starts and has the voice; `sample_rate` is the rate espeak-ng starts with
+// (a synthesis reports its own, which is the one to use).
+bool check_voice(const VoiceSettings& settings, unsigned& sample_rate, std::string& error);
+
+// Speaks plain UTF-8 `text` (no SSML). False with `error` set when espeak-ng cannot start or
+// has no such voice.
+bool synthesize(std::string_view text, const VoiceSettings& settings, Synthesis& out,
+                std::string& error);
+
+}  // namespace pfap::tts
