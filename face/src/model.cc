@@ -230,10 +230,10 @@ FacePose pose_from_faps(const FapValues& f) {
   outer[0].y -= f[60] * kMns;
   outer[4].x += f[53] * kMw;
   outer[4].y -= f[59] * kMns;
-  outer[1].y += f[56] * kMns - 0.5 * f[17] * kMns;
-  outer[2].y += f[51] * kMns - 0.5 * f[17] * kMns;
-  outer[3].y += f[55] * kMns - 0.5 * f[17] * kMns;
-  const double lower_out = 0.5 * f[16] * kMns + 0.3 * jaw_thrust - 0.5 * f[18] * kMns;
+  outer[1].y += f[56] * kMns - 0.25 * f[17] * kMns;
+  outer[2].y += f[51] * kMns - 0.25 * f[17] * kMns;
+  outer[3].y += f[55] * kMns - 0.25 * f[17] * kMns;
+  const double lower_out = 0.25 * f[16] * kMns + 0.3 * jaw_thrust - 0.5 * f[18] * kMns;
   outer[5].y += -f[57] * kMns + lower_out;
   outer[6].y += -f[52] * kMns + lower_out;
   outer[7].y += -f[58] * kMns + lower_out;
