@@ -191,46 +191,10 @@ static GstClockTime frame_time(const GstPfapFace* self, const GstSegment& segmen
                                                static_cast<guint64>(info.fps_n));
 }
 
-static GstFlowReturn gst_pfap_face_aggregate(GstAggregator* agg, gboolean timeout) {
-  GstPfapFace* self = GST_PFAP_FACE(agg);
+// Draws frame number s.frame at output time `pts` and pushes it.
+static GstFlowReturn push_frame(GstPfapFace* self, GstClockTime pts, GstClockTime next,
+                                int64_t at) {
   Stream& s = *self->stream;
-  if (!s.negotiated) return GST_FLOW_NOT_NEGOTIATED;
-
-  GstAggregatorPad* srcpad = GST_AGGREGATOR_PAD(agg->srcpad);
-  GST_OBJECT_LOCK(self);
-  const GstSegment segment = srcpad->segment;
-  GST_OBJECT_UNLOCK(self);
-  const GstClockTime pts = frame_time(self, segment, s.frame);
-  const GstClockTime next = frame_time(self, segment, s.frame + 1);
-  const auto at = static_cast<int64_t>(gst_segment_to_running_time(&segment, GST_FORMAT_TIME, pts));
-
-  // Apply everything up to this frame's time; a later buffer shows that nothing before it
-  // can still come.
-  bool later_input = false;
-  while (GstBuffer* buffer = gst_aggregator_pad_peek_buffer(self->sinkpad)) {
-    const int64_t start = input_running_time(self, GST_BUFFER_PTS(buffer));
-    if (start > at) {
-      later_input = true;
-      gst_buffer_unref(buffer);
-      break;
-    }
-    if (GST_BUFFER_FLAG_IS_SET(buffer, GST_BUFFER_FLAG_GAP) && gst_buffer_get_size(buffer) == 0) {
-      if (start >= 0 && GST_BUFFER_DURATION_IS_VALID(buffer)) {
-        s.covered_until =
-            std::max(s.covered_until, start + static_cast<int64_t>(GST_BUFFER_DURATION(buffer)));
-      }
-    } else {
-      apply_event(self, buffer, start);
-    }
-    gst_buffer_unref(buffer);
-    gst_aggregator_pad_drop_buffer(self->sinkpad);
-  }
-
-  if (!later_input && !timeout && s.covered_until <= at) {
-    if (!gst_aggregator_pad_is_eos(self->sinkpad)) return GST_AGGREGATOR_FLOW_NEED_DATA;
-    if (at >= s.animator.end_ns()) return GST_FLOW_EOS;
-  }
-
   GST_OBJECT_LOCK(self);
   const face::Style style = self->style;
   const bool overlay = self->debug_overlay;
@@ -253,10 +217,61 @@ static GstFlowReturn gst_pfap_face_aggregate(GstAggregator* agg, gboolean timeou
 
   ++s.frame;
   GST_OBJECT_LOCK(self);
-  srcpad->segment.position = next;
+  GST_AGGREGATOR_PAD(GST_AGGREGATOR_SRC_PAD(self))->segment.position = next;
   GST_OBJECT_UNLOCK(self);
+  GstAggregator* agg = GST_AGGREGATOR(self);
   gst_aggregator_selected_samples(agg, pts, GST_CLOCK_TIME_NONE, next - pts, nullptr);
   return gst_aggregator_finish_buffer(agg, out);
+}
+
+// Draws every frame whose markup is known: all of it has come when a later buffer is
+// queued, a GAP covers the frame's time, or the input ended. The base class calls this only
+// while input is queued or has ended, so one call draws all the frames a GAP covers. A
+// live timeout draws the frame that is due whether or not its markup is known.
+static GstFlowReturn gst_pfap_face_aggregate(GstAggregator* agg, gboolean timeout) {
+  GstPfapFace* self = GST_PFAP_FACE(agg);
+  Stream& s = *self->stream;
+  if (!s.negotiated) return GST_FLOW_NOT_NEGOTIATED;
+
+  for (;;) {
+    GST_OBJECT_LOCK(self);
+    const GstSegment segment = GST_AGGREGATOR_PAD(agg->srcpad)->segment;
+    GST_OBJECT_UNLOCK(self);
+    const GstClockTime pts = frame_time(self, segment, s.frame);
+    const GstClockTime next = frame_time(self, segment, s.frame + 1);
+    const auto at =
+        static_cast<int64_t>(gst_segment_to_running_time(&segment, GST_FORMAT_TIME, pts));
+
+    // Apply everything up to this frame's time.
+    bool later_input = false;
+    while (GstBuffer* buffer = gst_aggregator_pad_peek_buffer(self->sinkpad)) {
+      const int64_t start = input_running_time(self, GST_BUFFER_PTS(buffer));
+      if (start > at) {
+        later_input = true;
+        gst_buffer_unref(buffer);
+        break;
+      }
+      if (GST_BUFFER_FLAG_IS_SET(buffer, GST_BUFFER_FLAG_GAP) && gst_buffer_get_size(buffer) == 0) {
+        if (start >= 0 && GST_BUFFER_DURATION_IS_VALID(buffer)) {
+          s.covered_until =
+              std::max(s.covered_until, start + static_cast<int64_t>(GST_BUFFER_DURATION(buffer)));
+        }
+      } else {
+        apply_event(self, buffer, start);
+      }
+      gst_buffer_unref(buffer);
+      gst_aggregator_pad_drop_buffer(self->sinkpad);
+    }
+
+    const bool ended = gst_aggregator_pad_is_eos(self->sinkpad);
+    const bool known = later_input || s.covered_until > at || (ended && at < s.animator.end_ns());
+    if (!known && (ended || !timeout)) {
+      return ended ? GST_FLOW_EOS : GST_AGGREGATOR_FLOW_NEED_DATA;
+    }
+
+    const GstFlowReturn ret = push_frame(self, pts, next, at);
+    if (ret != GST_FLOW_OK || !known) return ret;
+  }
 }
 
 static gboolean gst_pfap_face_sink_event(GstAggregator* agg, GstAggregatorPad* pad,
