@@ -37,7 +37,7 @@
  * ]| Shows a talking head saying "Hello there. How are you?" (drawn as fast as it can go,
  * the sink paces it).
  * |[
- * gst-launch-1.0 -e filesrc location=docs/examples/face.pfap ! pfapparse alphabet=x-pfap-arpabet ! pfapface style=line debug-overlay=true ! video/x-raw,width=320,height=240 ! videoconvert ! x264enc ! mp4mux ! filesink location=face.mp4
+ * gst-launch-1.0 -e filesrc location=docs/examples/face.pfap ! pfapparse alphabet=x-pfap-arpabet ! pfapface style=line debug-overlay=true ! video/x-raw,width=320,height=240 ! videoconvert ! vp8enc deadline=1 ! webmmux ! filesink location=face.webm
  * ]| Renders the session to a 320x240 video file with the phoneme and active FAPs written on
  * each frame.
  */

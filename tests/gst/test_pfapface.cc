@@ -8,6 +8,7 @@
 //   PFAP_UPDATE_GOLDEN=1 meson test -C build pfapface
 // and look at the new pictures before committing them.
 #include <cairo.h>
+#include <glib/gstdio.h>
 #include <gst/check/gstharness.h>
 #include <gst/video/video.h>
 #include <gtest/gtest.h>
@@ -663,6 +664,144 @@ TEST(PfapFaceGolden, ReferencesDiffer) {
   const std::vector<Picture> pictures = render_session(g.session, g.style, g.frames);
   ASSERT_EQ(pictures.size(), g.frames.size());
   for (size_t i = 1; i < pictures.size(); ++i) EXPECT_NE(pictures[i - 1], pictures[i]) << i;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The commands of docs/elements.md, "pfapface"
+
+std::string read_text(const std::string& path) {
+  gchar* contents = nullptr;
+  gsize length = 0;
+  if (!g_file_get_contents(path.c_str(), &contents, &length, nullptr)) return "";
+  std::string text(contents, length);
+  g_free(contents);
+  return text;
+}
+
+// The gst-launch-1.0 lines of the section's ```sh blocks, without the program and -e.
+std::vector<std::string> documented_commands() {
+  const std::string doc = read_text(source_path("docs/elements.md"));
+  const size_t start = doc.find("\n## pfapface\n");
+  EXPECT_NE(start, std::string::npos);
+  const size_t end = doc.find("\n## ", start + 1);
+  std::vector<std::string> commands;
+  bool in_block = false;
+  size_t at = start + 1;
+  while (at < end) {
+    size_t eol = doc.find('\n', at);
+    if (eol == std::string::npos) eol = doc.size();
+    std::string line = doc.substr(at, eol - at);
+    at = eol + 1;
+    if (line.rfind("```", 0) == 0) in_block = !in_block;
+    if (!in_block) continue;
+    for (const char* prefix : {"gst-launch-1.0 ", "-e "}) {
+      if (line.rfind(prefix, 0) == 0) line = line.substr(std::string(prefix).size());
+    }
+    if (line.rfind("filesrc", 0) == 0 || line.rfind("udpsrc", 0) == 0) commands.push_back(line);
+  }
+  return commands;
+}
+
+void replace_all(std::string& s, const std::string& from, const std::string& to) {
+  for (size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size())) {
+    s.replace(at, from.size(), to);
+  }
+}
+
+// A temporary directory, removed with the files in it.
+class TempDir {
+ public:
+  TempDir() : path_(g_dir_make_tmp("pfapface-XXXXXX", nullptr)) {}
+  ~TempDir() {
+    if (GDir* dir = g_dir_open(path_.c_str(), 0, nullptr)) {
+      while (const gchar* name = g_dir_read_name(dir)) g_remove(file(name).c_str());
+      g_dir_close(dir);
+    }
+    g_rmdir(path_.c_str());
+  }
+  std::string file(const std::string& name) const { return path_ + "/" + name; }
+  int count() const {
+    int n = 0;
+    if (GDir* dir = g_dir_open(path_.c_str(), 0, nullptr)) {
+      while (g_dir_read_name(dir) != nullptr) ++n;
+      g_dir_close(dir);
+    }
+    return n;
+  }
+
+ private:
+  std::string path_;
+};
+
+// A documented command made runnable here: the source tree's examples, output files in
+// `dir`, a fakesink named "out" for the display.
+std::string runnable(std::string command, const TempDir& dir) {
+  replace_all(command, "docs/examples/", source_path("docs/examples/"));
+  replace_all(command, "face.webm", dir.file("face.webm"));
+  replace_all(command, "frame-%04d.png", dir.file("frame-%04d.png"));
+  replace_all(command, "autovideosink", "fakesink name=out sync=false");
+  return command;
+}
+
+TEST(PfapFaceDocumented, EveryCommandIsHere) { EXPECT_EQ(documented_commands().size(), 6u); }
+
+// The four file commands run to EOS; the one without an alphabet warns once.
+TEST(PfapFaceDocumented, FilesRenderToTheEnd) {
+  const std::vector<std::string> commands = documented_commands();
+  ASSERT_EQ(commands.size(), 6u);
+  for (size_t i = 0; i < 4; ++i) {
+    TempDir dir;
+    Pipeline p(runnable(commands[i], dir));
+    ASSERT_TRUE(p.ok()) << p.error();
+    ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "") << commands[i];
+    if (commands[i].find("alphabet=") == std::string::npos) {
+      EXPECT_NE(p.wait_eos(std::chrono::seconds(60), true).find("mouth"), std::string::npos)
+          << "a warning first: " << commands[i];
+    }
+    EXPECT_EQ(p.wait_eos(std::chrono::seconds(60), true), "") << commands[i];
+    if (commands[i].find("face.webm") != std::string::npos) {
+      EXPECT_GT(read_text(dir.file("face.webm")).size(), 10000u);
+    }
+    if (commands[i].find("pngenc") != std::string::npos) {
+      EXPECT_EQ(dir.count(), 59) << "hello.pfap: its smile fades until 2.33 s";
+      EXPECT_EQ(read_png(dir.file("frame-0000.png")).width, 640);
+    }
+  }
+}
+
+// Received over UDP, live: frames come while the session is sent, and keep coming after it.
+TEST(PfapFaceDocumented, LiveOverRtp) {
+  const std::vector<std::string> commands = documented_commands();
+  ASSERT_EQ(commands.size(), 6u);
+  std::atomic<int> frames{0};  // outlives the receiver, which counts into it
+  TempDir dir;
+  std::string receive = runnable(commands[4], dir);
+  replace_all(receive, "port=5004", "port=0 name=udp");
+  replace_all(receive, "sync=false", "sync=false signal-handoffs=true");
+  Pipeline receiver(receive);
+  ASSERT_TRUE(receiver.ok()) << receiver.error();
+  g_signal_connect(receiver.by_name("out"), "handoff",
+                   G_CALLBACK(+[](GstElement*, GstBuffer*, GstPad*, gpointer count) {
+                     ++*static_cast<std::atomic<int>*>(count);
+                   }),
+                   &frames);
+  ASSERT_EQ(receiver.set_state(GST_STATE_PLAYING), "");
+  std::string send = runnable(commands[5], dir);
+  replace_all(send, "port=5004",
+              "port=" + std::to_string(pfap::testing::bound_port(receiver.by_name("udp"))));
+  Pipeline sender(send);
+  ASSERT_TRUE(sender.ok()) << sender.error();
+  ASSERT_EQ(sender.set_state(GST_STATE_PLAYING), "");
+  ASSERT_EQ(sender.wait_eos(std::chrono::seconds(10)), "") << "sent in real time";
+  const int at_end = frames;
+  EXPECT_GT(at_end, 0);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (frames < at_end + 10 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_GE(frames.load(), at_end + 10) << "frames go on in the silence after the session";
+  EXPECT_EQ(receiver.poll_error(true), "");
+  ASSERT_EQ(receiver.set_state(GST_STATE_NULL), "");
 }
 
 }  // namespace
