@@ -496,9 +496,11 @@ constexpr int kMouthX0 = 60, kMouthX1 = 100, kMouthY0 = 75, kMouthY1 = 100;
 
 TEST(PfapFacePictures, ClosedVisemeAndOpenVowelDifferInTheMouthOnly) {
   for (const char* style : {"cartoon", "line"}) {
-    const Picture m = still("M", {}, 5, style), b = still("B", {}, 5, style);
+    const Picture m = still("M", {}, 5, style), b = still("B", {}, 5, style),
+                  p = still("P", {}, 5, style);
     const Picture aa = still("AA", {}, 5, style);
     EXPECT_EQ(m, b) << "p, b, m share a viseme";
+    EXPECT_EQ(m, p);
     EXPECT_GT(mean_difference(m, aa, kMouthX0, kMouthY0, kMouthX1, kMouthY1), 10) << style;
     // Rows 0..62 hold the eyes (row 54) and all above; the head's sides (which a dropped
     // jaw moves a little) are outside columns 55..105.
