@@ -474,7 +474,8 @@ TEST(GstInspect, PluginListsAllElements) {
   SCOPED_TRACE("gst-inspect-1.0 pfap:\n" + r.out);
   const std::vector<std::string> lines = lines_of(r.out);
   EXPECT_EQ(detail(lines, "Name"), "pfap");
-  for (const char* name : {kPay, kDepay, "pfapparse", "pfaptextenc", "pfaptts"}) {
+  for (const char* name :
+       {kPay, kDepay, "pfapparse", "pfaptextenc", "pfaptts", "pfapface"}) {
     SCOPED_TRACE(name);
     GstElementFactory* factory = gst_element_factory_find(name);
     ASSERT_NE(factory, nullptr);
@@ -484,8 +485,8 @@ TEST(GstInspect, PluginListsAllElements) {
     gst_object_unref(factory);
     EXPECT_NE(std::find(lines.begin(), lines.end(), line), lines.end()) << "no line: " << line;
   }
-  EXPECT_NE(r.out.find("5 features:"), std::string::npos);
-  EXPECT_NE(r.out.find("+-- 5 elements"), std::string::npos);
+  EXPECT_NE(r.out.find("6 features:"), std::string::npos);
+  EXPECT_NE(r.out.find("+-- 6 elements"), std::string::npos);
 }
 
 // ---------------------------------------------------------------------------------------------
