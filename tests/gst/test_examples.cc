@@ -10,10 +10,11 @@
 //  - DocumentedLines.*: each command block of that docs section, run as written but with free
 //    ports, the source tree's docs/examples/ and temporary output files.
 //  - Readme.*: the pfaptts commands of README.md, "Text to speech", run the same way.
+//  - Story.*: pfap-story, the main job: speech over RTP with loss, rendered and muxed.
 //
-// meson passes PFAP_SOURCE_DIR, PFAP_LOOPBACK and PFAP_RTSP_SERVER, and GST_PLUGIN_PATH in the
-// environment (the subprocesses inherit it). Everything is on 127.0.0.1, on port 0 or on free
-// ports found by binding port 0; every wait is bounded.
+// meson passes PFAP_SOURCE_DIR, PFAP_LOOPBACK, PFAP_RTSP_SERVER and PFAP_STORY, and GST_PLUGIN_PATH
+// in the environment (the subprocesses inherit it). Everything is on 127.0.0.1, on port 0 or on
+// free ports found by binding port 0; every wait is bounded.
 #include <arpa/inet.h>
 #include <gst/gst.h>
 #include <gst/sdp/gstsdpmessage.h>
@@ -142,6 +143,7 @@ class TempDir {
   TempDir& operator=(const TempDir&) = delete;
 
   std::string file(const std::string& name) const { return path_ + "/" + name; }
+  const std::string& path() const { return path_; }
 
  private:
   std::string path_;
@@ -882,6 +884,58 @@ TEST(Readme, ServesOverRtp) {
   const std::string wav = read_file(dir.file("received.wav"));
   EXPECT_EQ(wav.rfind("RIFF", 0), 0u);
   EXPECT_GT(wav.size(), 44u + 22050u * 2 / 2) << "at least 0.5 s of speech";
+}
+
+// ---------------------------------------------------------------------------------------------
+// The main job (scripts/demo): pfap-story speaks, sends with loss, recovers, renders and muxes.
+
+// The number after `label` in `text`, or -1.
+long long number_after(const std::string& text, const std::string& label) {
+  const size_t at = text.find(label);
+  return at == std::string::npos ? -1 : std::atoll(text.c_str() + at + label.size());
+}
+
+TEST(Story, SpeaksSendsWithLossRendersAndMuxes) {
+  ASSERT_TRUE(plugin_available());
+  TempDir dir;
+  const ProcessResult r = run(
+      {PFAP_STORY, "--text=Hello <FAP 2 1 40 0 0 500 1> world. How are you today?", "--drop=0.3",
+       "--size=160x120", "--out=" + dir.file("story.webm"), "--frames=" + dir.path()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const long long sent = number_after(r.out, "PFAP packets sent: ");
+  const long long dropped = number_after(r.out, "dropped on the way: ");
+  const long long lost = number_after(r.out, "phonemes, ");
+  const long long frames = number_after(r.out, "story.webm: ");
+  ASSERT_GT(sent, 5) << r.out;
+  // netsim drops; the receiver counts by sequence number what did not come, the same packets
+  // unless the last ones are dropped, which nothing after them reveals.
+  EXPECT_GT(dropped, 0) << r.out;
+  EXPECT_LE(lost, dropped) << r.out;
+  EXPECT_GE(lost, dropped - 2) << r.out;
+
+  // About 2.5 s of speech at 25 fps, each frame also written as a PNG file.
+  EXPECT_GE(frames, 50) << r.out;
+  int pngs = 0;
+  for (int i = 0; i < frames + 5; ++i) {
+    char name[16];
+    std::snprintf(name, sizeof name, "%04d.png", i);
+    if (g_file_test(dir.file(name).c_str(), G_FILE_TEST_EXISTS)) ++pngs;
+  }
+  EXPECT_EQ(pngs, frames);
+
+  // The file holds both: the video frames and the speech, decoded back.
+  Pipeline check("filesrc location=\"" + dir.file("story.webm") +
+                 "\" ! matroskademux name=d "
+                 "d.video_0 ! queue ! vp8dec ! fakesink name=video "
+                 "d.audio_0 ! queue ! vorbisdec ! fakesink name=audio");
+  ASSERT_TRUE(check.ok()) << check.error();
+  Tap video, audio;
+  video.attach(check.by_name("video"), "sink");
+  audio.attach(check.by_name("audio"), "sink");
+  ASSERT_EQ(check.set_state(GST_STATE_PLAYING), "");
+  ASSERT_EQ(check.wait_eos(10s), "");
+  EXPECT_EQ(static_cast<long long>(video.count()), frames);
+  EXPECT_GT(audio.count(), 10u);
 }
 
 }  // namespace
