@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "pfap/markup.h"
+#include "pfap/markup_event.h"
 #include "pfap/model.h"
 
 namespace pfap::testing {
@@ -49,6 +50,22 @@ inline GstBuffer* phoneme_buffer(const Phoneme& p, const std::vector<Fap>& faps,
   gst_buffer_unmap(buffer, &map);
   GST_BUFFER_PTS(buffer) = pts;
   GST_BUFFER_DURATION(buffer) = p.duration_ms * GST_MSECOND;
+  return buffer;
+}
+
+// A buffer of any event at `pts`, made through the library's writer; a phoneme lasts its
+// duration.
+inline GstBuffer* markup_buffer(const MarkupEvent& event, GstClockTime pts) {
+  const size_t size = markup_size(event);
+  GstBuffer* buffer = gst_buffer_new_allocate(nullptr, size, nullptr);
+  GstMapInfo map;
+  gst_buffer_map(buffer, &map, GST_MAP_WRITE);
+  EXPECT_TRUE(write_markup(event, {map.data, map.size}));
+  gst_buffer_unmap(buffer, &map);
+  GST_BUFFER_PTS(buffer) = pts;
+  if (event.kind == PFAP_EVENT_PHONEME) {
+    GST_BUFFER_DURATION(buffer) = event.phoneme.duration_ms * GST_MSECOND;
+  }
   return buffer;
 }
 

@@ -149,6 +149,23 @@ inline void end_of_stream(GstElement* appsrc) {
   g_signal_emit_by_name(appsrc, "end-of-stream", &ret);
 }
 
+// The messages of the errors (or warnings) posted on `bus` so far, taken off it.
+inline std::vector<std::string> pop_messages(GstBus* bus, GstMessageType type) {
+  std::vector<std::string> out;
+  while (GstMessage* message = gst_bus_pop_filtered(bus, type)) {
+    GError* error = nullptr;
+    if (type == GST_MESSAGE_ERROR) {
+      gst_message_parse_error(message, &error, nullptr);
+    } else {
+      gst_message_parse_warning(message, &error, nullptr);
+    }
+    out.emplace_back(error->message);
+    g_error_free(error);
+    gst_message_unref(message);
+  }
+  return out;
+}
+
 // Every sample an appsink (emit-signals=false) holds now; the caller unrefs them.
 inline std::vector<GstSample*> pull_all(GstElement* appsink) {
   std::vector<GstSample*> samples;

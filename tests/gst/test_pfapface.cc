@@ -34,6 +34,7 @@ using pfap::Curve;
 using pfap::Fap;
 using pfap::MarkupEvent;
 using pfap::Phoneme;
+using pfap::testing::markup_buffer;
 using pfap::testing::Pipeline;
 
 constexpr GstClockTime kMs = GST_MSECOND;
@@ -47,26 +48,12 @@ uint8_t symbol(const char* name) {
   return *pfap::find_symbol(*pfap::find_alphabet(pfap::kArpabetAlphabet), name);
 }
 
-GstBuffer* event_buffer(const MarkupEvent& event, GstClockTime pts) {
-  const size_t size = pfap::markup_size(event);
-  GstBuffer* buffer = gst_buffer_new_allocate(nullptr, size, nullptr);
-  GstMapInfo map;
-  gst_buffer_map(buffer, &map, GST_MAP_WRITE);
-  EXPECT_TRUE(pfap::write_markup(event, {map.data, map.size}));
-  gst_buffer_unmap(buffer, &map);
-  GST_BUFFER_PTS(buffer) = pts;
-  if (event.kind == PFAP_EVENT_PHONEME) {
-    GST_BUFFER_DURATION(buffer) = event.phoneme.duration_ms * kMs;
-  }
-  return buffer;
-}
-
 GstBuffer* phoneme(const char* name, GstClockTime pts, uint16_t duration_ms,
                    std::vector<Fap> faps = {}) {
   MarkupEvent event;
   event.phoneme = Phoneme{symbol(name), duration_ms, 60};
   event.faps = std::move(faps);
-  return event_buffer(event, pts);
+  return markup_buffer(event, pts);
 }
 
 Fap fap(int index, int32_t amplitude, uint16_t transition_ms = 0, Curve curve = Curve::kLinear) {
@@ -421,7 +408,7 @@ TEST(PfapFace, StateEventsApply) {
   complete.kind = PFAP_EVENT_COMPLETE;
   complete.faps = {fap(49, 30000)};
   face.push(phoneme("M", 0, 100, {fap(69, 63)}));
-  face.push(event_buffer(complete, 100 * kMs));  // joy to 0, yaw set
+  face.push(markup_buffer(complete, 100 * kMs));  // joy to 0, yaw set
   face.push(phoneme("M", 200 * kMs, 200));
   face.eos();
   std::vector<GstBuffer*> frames = face.frames_until_eos();

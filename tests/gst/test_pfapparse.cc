@@ -14,12 +14,14 @@
 #include "pfap/markup.h"
 #include "pfap/model.h"
 #include "pfap_buffers.h"
+#include "pipeline.h"
 
 namespace {
 
 using pfap::Curve;
 using pfap::Fap;
 using pfap::testing::Event;
+using pfap::testing::pop_messages;
 
 constexpr GstClockTime kMs = GST_MSECOND;
 
@@ -35,23 +37,6 @@ constexpr std::string_view kText =
     "240 12 40 100 W\n"
     "280 state recovered\n"
     "300 1 20 90 -\n";
-
-// The messages of the errors or warnings posted on `bus`.
-std::vector<std::string> pop_messages(GstBus* bus, GstMessageType type) {
-  std::vector<std::string> out;
-  while (GstMessage* message = gst_bus_pop_filtered(bus, type)) {
-    GError* error = nullptr;
-    if (type == GST_MESSAGE_ERROR) {
-      gst_message_parse_error(message, &error, nullptr);
-    } else {
-      gst_message_parse_warning(message, &error, nullptr);
-    }
-    out.emplace_back(error->message);
-    g_error_free(error);
-    gst_message_unref(message);
-  }
-  return out;
-}
 
 bool contains(const std::string& text, std::string_view part) {
   return text.find(part) != std::string::npos;

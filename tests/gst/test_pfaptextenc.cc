@@ -18,25 +18,13 @@ using pfap::Curve;
 using pfap::Fap;
 using pfap::MarkupEvent;
 using pfap::Phoneme;
+using pfap::testing::markup_buffer;
 using pfap::testing::phoneme_buffer;
 
 constexpr GstClockTime kMs = GST_MSECOND;
 constexpr GstClockTime kNone = GST_CLOCK_TIME_NONE;
 
 Phoneme phoneme(uint8_t symbol, uint16_t duration_ms) { return {symbol, duration_ms, 60}; }
-
-// A buffer of any event, made through the library's writer (phoneme_buffer makes phonemes
-// through the C API).
-GstBuffer* markup_buffer(const MarkupEvent& event, GstClockTime pts) {
-  const size_t size = pfap::markup_size(event);
-  GstBuffer* buffer = gst_buffer_new_allocate(nullptr, size, nullptr);
-  GstMapInfo map;
-  gst_buffer_map(buffer, &map, GST_MAP_WRITE);
-  EXPECT_TRUE(pfap::write_markup(event, {map.data, map.size}));
-  gst_buffer_unmap(buffer, &map);
-  GST_BUFFER_PTS(buffer) = pts;
-  return buffer;
-}
 
 MarkupEvent state_event(PfapEventKind kind, std::vector<Fap> faps) {
   MarkupEvent event;

@@ -22,24 +22,9 @@
 namespace {
 
 using pfap::testing::Event;
+using pfap::testing::pop_messages;
 
 constexpr int kRate = 22050;  // Debian's espeak-ng voices
-
-std::vector<std::string> pop_messages(GstBus* bus, GstMessageType type) {
-  std::vector<std::string> out;
-  while (GstMessage* message = gst_bus_pop_filtered(bus, type)) {
-    GError* error = nullptr;
-    if (type == GST_MESSAGE_ERROR) {
-      gst_message_parse_error(message, &error, nullptr);
-    } else {
-      gst_message_parse_warning(message, &error, nullptr);
-    }
-    out.emplace_back(error->message);
-    g_error_free(error);
-    gst_message_unref(message);
-  }
-  return out;
-}
 
 GstBuffer* text_buffer(std::string_view text, GstClockTime pts = GST_CLOCK_TIME_NONE) {
   GstBuffer* buffer = gst_buffer_new_memdup(text.data(), text.size());

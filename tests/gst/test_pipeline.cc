@@ -474,8 +474,7 @@ TEST(GstInspect, PluginListsAllElements) {
   SCOPED_TRACE("gst-inspect-1.0 pfap:\n" + r.out);
   const std::vector<std::string> lines = lines_of(r.out);
   EXPECT_EQ(detail(lines, "Name"), "pfap");
-  for (const char* name :
-       {kPay, kDepay, "pfapparse", "pfaptextenc", "pfaptts", "pfapface"}) {
+  for (const char* name : {kPay, kDepay, "pfapparse", "pfaptextenc", "pfaptts", "pfapface"}) {
     SCOPED_TRACE(name);
     GstElementFactory* factory = gst_element_factory_find(name);
     ASSERT_NE(factory, nullptr);
