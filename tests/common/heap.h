@@ -17,7 +17,8 @@
 #endif
 #endif
 #ifdef PFAP_HEAP_FROM_ASAN
-#include <sanitizer/allocator_interface.h>
+// From <sanitizer/allocator_interface.h>, which gcc does not install.
+extern "C" size_t __sanitizer_get_current_allocated_bytes();
 #endif
 
 namespace pfap::testing {
