@@ -837,6 +837,9 @@ struct Reorderer {
   std::atomic<size_t> reordered{0};
 };
 
+// Runs under rtppfappay's stream lock, complete states sent from the depayloader's thread
+// included (rtppfapdepay asks, rtppfappay answers from that thread only when its stream lock
+// is free), so never in two threads at once.
 GstPadProbeReturn reorder(GstPad*, GstPadProbeInfo* info, gpointer data) {
   auto* r = static_cast<Reorderer*>(data);
   if (GST_PAD_PROBE_INFO_TYPE(info) & GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM) {
