@@ -9,6 +9,11 @@
 //    appsrc ! rtppfappay ! (drop) ! rtppfapdepay ! appsink in one process, where sequence
 //    numbers are consecutive so every drop is a gap. Whenever the depayloader does not flag a
 //    phoneme uncertain, the FAP state built from its output equals a lossless receiver's.
+//  - RecoverySoak.AnHourThroughNetsimAndRtpjitterbuffer: an hour of stream time of speech
+//    with FAPs through rtppfappay ! netsim ! (reorder) ! rtpjitterbuffer ! rtppfapdepay in a
+//    GstHarness on a GstTestClock, run as fast as the elements go; random loss, duplicates and
+//    reordering; every phoneme not flagged uncertain has the sender's state, the session ends
+//    with the sender's state, and the heap does not grow after the first minutes.
 //
 // A receiver's FAP state is built from the depayloader's events as an application would:
 // a phoneme's FAPs at its PTS, a recovered event's entries at its PTS, a complete event as
@@ -16,6 +21,8 @@
 // which depend only on the order of bookmarks, not on their times.
 //
 // The plugin comes from GST_PLUGIN_PATH, which meson sets to the build's gst/ directory.
+#include <gst/check/gstharness.h>
+#include <gst/check/gsttestclock.h>
 #include <gst/gst.h>
 #include <gst/rtp/gstrtpbuffer.h>
 #include <gtest/gtest.h>
@@ -35,6 +42,7 @@
 #include <thread>
 #include <vector>
 
+#include "heap.h"
 #include "pfap/fap_state.h"
 #include "pfap/markup.h"
 #include "pfap/model.h"
@@ -181,6 +189,12 @@ GstFlowReturn push(GstElement* appsrc, const Event& e) {
   g_signal_emit_by_name(appsrc, "push-buffer", buffer, &ret);
   gst_buffer_unref(buffer);
   return ret;
+}
+
+GstFlowReturn push_harness(GstHarness* h, const Event& e) {
+  return gst_harness_push(h,
+                          pfap::testing::phoneme_buffer(e.phoneme, e.faps, e.pts,
+                                                        (e.flags & PFAP_FLAG_SENTENCE_START) != 0));
 }
 
 // A guint64 field of an element's stats property (0 when there is no such field).
@@ -790,6 +804,304 @@ TEST_F(RecoveryRandomLoss, WithoutRecoveryTheStateDiffers) {
     EXPECT_EQ(c.differing, 0) << "a phoneme with a wrong state was not flagged: "
                               << c.first_difference;
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Soak: an hour of stream time through netsim and rtpjitterbuffer.
+//
+// netsim drops and duplicates packets at random (it has no seed: every run differs, and what
+// the test asserts holds for any pattern). Its reordering needs real-time delays, which a
+// test running an hour in seconds cannot give, so a pad probe after it reorders instead:
+// now and then it holds a packet back until 1 to 3 later ones have gone. rtpjitterbuffer
+// runs on a GstTestClock that the test moves to each phoneme's start before pushing it, so
+// that packets arrive as from a sender in real time and the jitterbuffer's timers (its start
+// deadline, lost packets) fire at their stream times. Requests for a complete state go
+// upstream from rtppfapdepay through the jitterbuffer and netsim to rtppfappay, whose
+// complete-recovery-interval is 0: it sends a complete state at the start and on request only.
+
+struct Reorderer {
+  explicit Reorderer(GstPad* peer) : peer(peer) {}
+
+  // Sends the held packet on, if any.
+  void release() {
+    if (held == nullptr) return;
+    gst_pad_chain(peer, held);
+    held = nullptr;
+  }
+
+  std::mt19937 rng{6};
+  std::atomic<double> chance{0.02};
+  GstPad* peer;               // rtpjitterbuffer's sink pad
+  GstBuffer* held = nullptr;  // the packet held back
+  int behind = 0;             // how many later packets go before it
+  std::atomic<size_t> reordered{0};
+};
+
+// Runs under rtppfappay's stream lock, complete states sent from the depayloader's thread
+// included (rtppfapdepay asks, rtppfappay answers from that thread only when its stream lock
+// is free), so never in two threads at once.
+GstPadProbeReturn reorder(GstPad*, GstPadProbeInfo* info, gpointer data) {
+  auto* r = static_cast<Reorderer*>(data);
+  if (GST_PAD_PROBE_INFO_TYPE(info) & GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM) {
+    // Nothing held crosses an event (EOS above all).
+    const auto type = static_cast<unsigned>(GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)));
+    if (type & GST_EVENT_TYPE_SERIALIZED) r->release();
+    return GST_PAD_PROBE_OK;
+  }
+  GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+  if (r->held == nullptr) {
+    if (!std::bernoulli_distribution(r->chance)(r->rng)) return GST_PAD_PROBE_OK;
+    r->held = gst_buffer_ref(buffer);
+    r->behind = std::uniform_int_distribution<int>(1, 3)(r->rng);
+    ++r->reordered;
+    return GST_PAD_PROBE_DROP;
+  }
+  // This packet overtakes the held one: straight to the jitterbuffer.
+  gst_pad_chain(r->peer, gst_buffer_ref(buffer));
+  if (--r->behind > 0) return GST_PAD_PROBE_DROP;
+  // Then the held one, in this packet's place.
+  GST_PAD_PROBE_INFO_DATA(info) = r->held;
+  r->held = nullptr;
+  gst_buffer_unref(buffer);
+  return GST_PAD_PROBE_OK;
+}
+
+// Releases every clock wait due by `t`, in time order, then sets the clock to `t`. A wait
+// that a thread makes just after this looks is released by the next call.
+void advance_to(GstTestClock* clock, GstClockTime t) {
+  for (;;) {
+    const GstClockTime next = gst_test_clock_get_next_entry_time(clock);
+    if (!GST_CLOCK_TIME_IS_VALID(next) || next > t) break;
+    if (next > gst_clock_get_time(GST_CLOCK(clock))) gst_test_clock_set_time(clock, next);
+    if (GstClockID id = gst_test_clock_process_next_clock_id(clock)) gst_clock_id_unref(id);
+  }
+  if (t > gst_clock_get_time(GST_CLOCK(clock))) gst_test_clock_set_time(clock, t);
+}
+
+GstElement* harness_element(GstHarness* h, const char* name) {
+  GstElement* e = gst_bin_get_by_name(GST_BIN(h->element), name);
+  if (e != nullptr) gst_object_unref(e);  // the bin keeps it
+  return e;
+}
+
+guint64 jitterbuffer_stat(GstHarness* h, const char* field) {
+  GstStructure* s = nullptr;
+  g_object_get(harness_element(h, "jb"), "stats", &s, nullptr);
+  guint64 value = 0;
+  gst_structure_get_uint64(s, field, &value);
+  gst_structure_free(s);
+  return value;
+}
+
+guint64 jitterbuffer_pushed(GstHarness* h) { return jitterbuffer_stat(h, "num-pushed"); }
+
+// What the receiver made of the session, phoneme by phoneme, counted as it came: nothing
+// grows with the session's length, so that the heap measures the elements.
+struct SoakCount {
+  int phonemes = 0, uncertain = 0, compared = 0, differing = 0, out_of_order = 0;
+  int previous = -1;
+  Received last;
+  std::string first_difference;
+};
+
+void take_output(GstHarness* h, ReceiverState& state, const std::vector<Settled>& lossless,
+                 SoakCount& c, bool& eos) {
+  while (GstBuffer* b = gst_harness_try_pull(h)) {
+    const Received r = state.apply(pfap::testing::read_event(b));
+    gst_buffer_unref(b);
+    if (r.number < 0) continue;
+    ++c.phonemes;
+    c.last = r;
+    if (r.number <= c.previous || r.number >= static_cast<int>(lossless.size())) {
+      ++c.out_of_order;
+      continue;
+    }
+    c.previous = r.number;
+    if (r.uncertain) {
+      ++c.uncertain;
+      continue;
+    }
+    ++c.compared;
+    if (r.settled != lossless[r.number]) {
+      ++c.differing;
+      if (c.first_difference.empty()) {
+        c.first_difference = "phoneme " + std::to_string(r.number) + ":" +
+                             differences(r.settled, lossless[r.number]);
+      }
+    }
+  }
+  while (GstEvent* e = gst_harness_try_pull_event(h)) {
+    eos = eos || GST_EVENT_TYPE(e) == GST_EVENT_EOS;
+    gst_event_unref(e);
+  }
+  while (GstEvent* e = gst_harness_try_pull_upstream_event(h)) gst_event_unref(e);
+}
+
+GstPadProbeReturn count_buffer(GstPad*, GstPadProbeInfo*, gpointer data) {
+  static_cast<std::atomic<guint64>*>(data)->fetch_add(1);
+  return GST_PAD_PROBE_OK;
+}
+
+// Packets that reached rtpjitterbuffer, and those it dropped without counting them.
+struct JitterbufferInput {
+  std::atomic<guint64> arrived{0};
+  guint64 uncounted = 0;
+};
+
+// Waits until rtpjitterbuffer has handled every packet that reached it, or waits on the clock
+// behind a gap, which only moving time on releases, or has done nothing for a while (it
+// dropped a packet without counting it); takes the output as it comes. Without this the test
+// thread would run seconds of stream time ahead of the jitterbuffer's, and a complete state
+// asked for would queue behind all of it: a receiver does not lag its sender so in real time.
+void catch_up(GstHarness* h, GstTestClock* clock, JitterbufferInput& in, ReceiverState& state,
+              const std::vector<Settled>& lossless, SoakCount& c, bool& eos) {
+  guint64 last = G_MAXUINT64;
+  for (int still = 0;; g_usleep(20)) {
+    take_output(h, state, lossless, c, eos);
+    const guint64 handled = jitterbuffer_pushed(h) + jitterbuffer_stat(h, "num-late") +
+                            jitterbuffer_stat(h, "num-duplicates") + in.uncounted;
+    const guint64 arrived = in.arrived.load();
+    if (handled >= arrived) return;
+    still = handled == last ? still + 1 : 0;
+    last = handled;
+    if (gst_test_clock_peek_id_count(clock) > 0 && still >= 3) return;
+    if (still >= 100) {
+      in.uncounted += arrived - handled;
+      return;
+    }
+  }
+}
+
+// PFAP_SOAK_MINUTES sets the stream time (default 60).
+TEST(RecoverySoak, AnHourThroughNetsimAndRtpjitterbuffer) {
+  ASSERT_TRUE(plugin_available());
+  const char* minutes_env = g_getenv("PFAP_SOAK_MINUTES");
+  const int minutes = minutes_env != nullptr ? std::atoi(minutes_env) : 60;
+  ASSERT_GT(minutes, 1);
+  const GstClockTime length = static_cast<GstClockTime>(minutes) * 60 * GST_SECOND;
+  // About 11 phonemes per second of stream time; one phoneme in three moves FAPs.
+  const int n = static_cast<int>(minutes * 60 * 12);
+  ASSERT_LT(n, 65536) << "phoneme numbers are 16 bits";
+  const std::vector<Event> sent = speech_session(60, n, 0.35);
+  ASSERT_GE(sent.back().pts, length);
+  const std::vector<Settled> lossless = sender_states(sent);
+
+  // Coverage 1: a single loss is repaired, two in a row are not (about one packet in a
+  // hundred at 10 % loss): the test sees both.
+  GstHarness* h = gst_harness_new_parse(
+      "rtppfappay name=pay recovery-depth=1 complete-recovery-interval=0 "
+      "! netsim name=net drop-probability=0.1 duplicate-probability=0.02 "
+      "! rtpjitterbuffer name=jb latency=200 do-lost=true "
+      "! rtppfapdepay name=depay");
+  ASSERT_NE(h, nullptr);
+  gst_harness_use_testclock(h);
+  GstTestClock* clock = gst_harness_get_testclock(h);
+  gst_harness_set_src_caps_str(h, "application/x-pfap");
+  GstPad* net_src = gst_element_get_static_pad(harness_element(h, "net"), "src");
+  GstPad* jb_sink = gst_element_get_static_pad(harness_element(h, "jb"), "sink");
+  Reorderer reorderer(jb_sink);
+  JitterbufferInput jb_input;
+  gst_pad_add_probe(jb_sink, GST_PAD_PROBE_TYPE_BUFFER, count_buffer, &jb_input.arrived, nullptr);
+  const gulong reorder_probe = gst_pad_add_probe(
+      net_src,
+      static_cast<GstPadProbeType>(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM),
+      reorder, &reorderer, nullptr);
+
+  // The last 30 s are without loss, duplicates or reordering: the session ends whole.
+  const GstClockTime calm = sent.back().pts - 30 * GST_SECOND;
+  const GstClockTime warm_up = std::min<GstClockTime>(length / 10, 5 * 60 * GST_SECOND);
+  ReceiverState state;
+  SoakCount count;
+  bool eos = false;
+  size_t heap_warm = 0, heap_most = 0;
+  std::vector<std::pair<GstClockTime, size_t>> heap_samples;  // reserved: no growth here
+  heap_samples.reserve(64);
+  GstClockTime next_sample = warm_up;
+  bool calm_set = false;
+  const auto started = Clock::now();
+  for (const Event& e : sent) {
+    advance_to(clock, e.pts);
+    if (!calm_set && e.pts >= calm) {
+      g_object_set(harness_element(h, "net"), "drop-probability", 0.0f, "duplicate-probability",
+                   0.0f, nullptr);
+      reorderer.chance = 0;
+      calm_set = true;
+    }
+    ASSERT_EQ(push_harness(h, e), GST_FLOW_OK);
+    catch_up(h, clock, jb_input, state, lossless, count, eos);
+    if (e.pts >= next_sample) {
+      const size_t heap = pfap::testing::heap_bytes();
+      if (heap_warm == 0) heap_warm = heap;
+      heap_most = std::max(heap_most, heap);
+      heap_samples.emplace_back(e.pts, heap);
+      next_sample += length / 12;
+    }
+  }
+  gst_harness_push_event(h, gst_event_new_eos());
+  // The jitterbuffer pushes what it holds, then EOS; move time on until it has.
+  const auto deadline = Clock::now() + std::chrono::seconds(30);
+  GstClockTime t = gst_clock_get_time(GST_CLOCK(clock));
+  while (!eos && Clock::now() < deadline) {
+    t += 100 * GST_MSECOND;
+    advance_to(clock, t);
+    g_usleep(1000);
+    take_output(h, state, lossless, count, eos);
+  }
+  const double seconds = std::chrono::duration<double>(Clock::now() - started).count();
+  EXPECT_TRUE(eos) << "no EOS out of the jitterbuffer";
+
+  GstElement* depay = harness_element(h, "depay");
+  const std::string stats = stats_text(depay);
+  SCOPED_TRACE("depayloader " + stats);
+  const guint64 lost = stat(depay, "lost"), recovered = stat(depay, "recovered"),
+                requests = stat(depay, "requests");
+  const guint64 duplicates = jitterbuffer_stat(h, "num-duplicates");
+  const guint64 pushed = jitterbuffer_pushed(h);
+
+  // Every phoneme not flagged uncertain has the sender's state, in order.
+  EXPECT_EQ(count.differing, 0) << count.first_difference;
+  EXPECT_EQ(count.out_of_order, 0);
+  EXPECT_GT(count.compared, n / 2);
+  // Loss within the coverage was repaired, loss beyond it flagged and asked about...
+  EXPECT_GT(lost, 0u);
+  EXPECT_GT(recovered, 0u);
+  EXPECT_GT(count.uncertain, 0);
+  EXPECT_GT(requests, 0u);
+  EXPECT_GT(state.complete_events, 0);
+  EXPECT_GT(duplicates, 0u);
+  EXPECT_GT(reorderer.reordered.load(), 0u);
+  // ... and the session ends with the sender's state.
+  EXPECT_EQ(count.last.number, n - 1);
+  EXPECT_FALSE(count.last.uncertain);
+  EXPECT_EQ(count.last.settled, lossless.back())
+      << differences(count.last.settled, lossless.back());
+
+  // No growth of the heap after the warm-up (the harness drops nothing: the test takes each
+  // buffer and event as it comes). The bound allows for what is in flight at a sample.
+  constexpr size_t kGrowthBound = 64 * 1024;
+  EXPECT_LE(heap_most - heap_warm, kGrowthBound);
+  if (g_getenv("PFAP_TEST_VERBOSE") != nullptr) {
+    std::cout << minutes << " min of stream time, " << n << " phonemes in " << seconds
+              << " s; received " << count.phonemes << ", uncertain " << count.uncertain
+              << ", compared " << count.compared << "; netsim/reorder: jitterbuffer pushed "
+              << pushed << ", duplicates " << duplicates << ", reordered "
+              << reorderer.reordered.load() << "; depayloader lost " << lost << ", recovered "
+              << recovered << ", requests " << requests << ", complete events "
+              << state.complete_events << ", packets the jitterbuffer dropped uncounted "
+              << jb_input.uncounted << "\nheap (stream time: bytes):";
+    for (const auto& [at, bytes] : heap_samples) {
+      std::cout << " " << at / GST_SECOND << " s: " << bytes;
+    }
+    std::cout << "\nheap growth after warm-up: " << heap_most - heap_warm << " bytes, RSS "
+              << (pfap::testing::rss_bytes() >> 10) << " KiB\n";
+  }
+
+  gst_pad_remove_probe(net_src, reorder_probe);
+  reorderer.release();  // nothing, unless EOS never came
+  gst_object_unref(net_src);
+  gst_object_unref(jb_sink);
+  gst_object_unref(clock);
+  gst_harness_teardown(h);
 }
 
 }  // namespace
