@@ -1,13 +1,13 @@
 // Drawing: a face on a background, the styles differ, the alpha format stays opaque, the
 // overlay writes text. Pictures themselves are compared in tests/gst/test_pfapface.cc.
 #include <cairo.h>
-#include <fontconfig/fontconfig.h>
 #include <gtest/gtest.h>
 
 #include <cstdint>
 #include <vector>
 
 #include "face/renderer.h"
+#include "release_fonts.h"
 
 namespace face {
 namespace {
@@ -36,18 +36,6 @@ int differing_pixels(const Picture& a, const Picture& b, int y0 = 0, int y1 = kH
   }
   return count;
 }
-
-// The overlay's text loads cairo's font cache and fontconfig's configuration, which live as
-// long as the process; released at the end so that LeakSanitizer reports only real leaks.
-class ReleaseFonts : public testing::Environment {
- public:
-  void TearDown() override {
-    cairo_debug_reset_static_data();
-    FcFini();
-  }
-};
-const testing::Environment* const kReleaseFonts =
-    testing::AddGlobalTestEnvironment(new ReleaseFonts);
 
 TEST(Renderer, FaceOnBackground) {
   const Picture picture = draw(pose_from_faps({}), Style::kCartoon);

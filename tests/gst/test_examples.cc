@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "pipeline.h"
+#include "temp_dir.h"
 
 namespace {
 
@@ -125,32 +126,6 @@ std::vector<std::string> round_trip_samples() {
   }
   return samples;
 }
-
-// A directory removed with its files on destruction.
-class TempDir {
- public:
-  TempDir() {
-    gchar* path = g_dir_make_tmp("pfap-examples-XXXXXX", nullptr);
-    path_ = path != nullptr ? path : "";
-    g_free(path);
-  }
-  ~TempDir() {
-    GDir* d = g_dir_open(path_.c_str(), 0, nullptr);
-    if (d != nullptr) {
-      while (const gchar* name = g_dir_read_name(d)) std::remove((path_ + "/" + name).c_str());
-      g_dir_close(d);
-    }
-    rmdir(path_.c_str());
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  std::string file(const std::string& name) const { return path_ + "/" + name; }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
-};
 
 // Sessions compared line by line: the same events, times within `tolerance_ms`.
 ::testing::AssertionResult same_session(const std::string& got, const std::string& want,
@@ -309,6 +284,7 @@ class RtspServer {
 
 // A pipeline from a launch description, set to NULL and released on destruction.
 using pfap::testing::Pipeline;
+using pfap::testing::TempDir;
 
 // What flows out of an element's src pad: the bytes (text from pfaptextenc) and a count.
 struct Tap {
@@ -916,19 +892,19 @@ TEST(Story, SpeaksSendsWithLossRendersAndMuxes) {
   ASSERT_TRUE(plugin_available());
   TempDir dir;
   const ProcessResult r = run(
-      {PFAP_STORY, "--text=Hello <FAP 2 1 40 0 0 500 1> world. How are you today?", "--drop=0.3",
+      {PFAP_STORY, "--text=Hello <FAP 2 1 40 0 0 500 1> world. How are you today?", "--drop=0.5",
        "--size=160x120", "--out=" + dir.file("story.webm"), "--frames=" + dir.path()});
   ASSERT_EQ(r.status, 0) << r.err;
   const long long sent = number_after(r.out, "PFAP packets sent: ");
   const long long dropped = number_after(r.out, "dropped on the way: ");
-  const long long lost = number_after(r.out, "phonemes, ");
+  const long long lost = number_after(r.out, "phonemes, ");  // packets found lost
   const long long frames = number_after(r.out, "story.webm: ");
   ASSERT_GT(sent, 5) << r.out;
-  // netsim drops; the receiver counts by sequence number what did not come, the same packets
-  // unless the last ones are dropped, which nothing after them reveals.
+  // netsim drops; the receiver counts by sequence number what did not come: the dropped
+  // packets but those before the first and after the last to arrive, which nothing reveals.
   EXPECT_GT(dropped, 0) << r.out;
   EXPECT_LE(lost, dropped) << r.out;
-  EXPECT_GE(lost, dropped - 2) << r.out;
+  EXPECT_GT(number_after(r.out, "receiver: "), 0) << "no phoneme arrived: " << r.out;
 
   // About 2.5 s of speech at 25 fps, each frame also written as a PNG file.
   EXPECT_GE(frames, 50) << r.out;

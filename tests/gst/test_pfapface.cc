@@ -27,6 +27,8 @@
 #include "pfap/phoneme_table.h"
 #include "pfap_buffers.h"
 #include "pipeline.h"
+#include "release_fonts.h"
+#include "temp_dir.h"
 
 namespace {
 
@@ -36,6 +38,7 @@ using pfap::MarkupEvent;
 using pfap::Phoneme;
 using pfap::testing::markup_buffer;
 using pfap::testing::Pipeline;
+using pfap::testing::TempDir;
 
 constexpr GstClockTime kMs = GST_MSECOND;
 constexpr const char* kSmallCaps = "video/x-raw,format=BGRx,width=160,height=120,framerate=25/1";
@@ -696,31 +699,6 @@ void replace_all(std::string& s, const std::string& from, const std::string& to)
     s.replace(at, from.size(), to);
   }
 }
-
-// A temporary directory, removed with the files in it.
-class TempDir {
- public:
-  TempDir() : path_(g_dir_make_tmp("pfapface-XXXXXX", nullptr)) {}
-  ~TempDir() {
-    if (GDir* dir = g_dir_open(path_.c_str(), 0, nullptr)) {
-      while (const gchar* name = g_dir_read_name(dir)) g_remove(file(name).c_str());
-      g_dir_close(dir);
-    }
-    g_rmdir(path_.c_str());
-  }
-  std::string file(const std::string& name) const { return path_ + "/" + name; }
-  int count() const {
-    int n = 0;
-    if (GDir* dir = g_dir_open(path_.c_str(), 0, nullptr)) {
-      while (g_dir_read_name(dir) != nullptr) ++n;
-      g_dir_close(dir);
-    }
-    return n;
-  }
-
- private:
-  std::string path_;
-};
 
 // A documented command made runnable here: the source tree's examples, output files in
 // `dir`, a fakesink named "out" for the display.
