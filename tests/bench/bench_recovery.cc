@@ -66,7 +66,7 @@
 #include "pfap/fap_state.h"
 #include "pfap/markup.h"
 #include "pfap/model.h"
-#include "random_markup.h"
+#include "speech_session.h"
 
 namespace {
 
@@ -83,52 +83,8 @@ constexpr int kFecPt = 122;
 // ---------------------------------------------------------------------------------------------
 // The session and the lossless receiver
 
-struct Phoneme {
-  pfap::Phoneme phoneme;  // symbol + 256 * f0 is its number
-  bool sentence_start = false;
-  std::vector<pfap::Fap> faps;
-  GstClockTime pts = 0;
-};
-
-std::vector<Phoneme> speech_session(uint32_t seed, int n_phonemes) {
-  pfap::testing::RandomMarkup random(seed);
-  std::vector<Phoneme> out;
-  GstClockTime t = 0;
-  bool sentence_start = true;
-  int in_sentence = 0;
-  int sentence_length = random.uniform(6, 14);
-  for (int i = 0; i < n_phonemes; ++i) {
-    Phoneme p;
-    p.phoneme.symbol = static_cast<uint8_t>(i & 0xff);
-    p.phoneme.f0 = static_cast<uint8_t>(i >> 8);
-    p.phoneme.duration_ms = static_cast<uint16_t>(random.uniform(40, 100));
-    p.phoneme.stress = random.chance(0.3);
-    p.phoneme.word_begin = random.chance(0.3);
-    p.phoneme.end_of_text = ++in_sentence >= sentence_length || i + 1 == n_phonemes;
-    if (random.chance(0.45)) {
-      for (int k = random.uniform(1, 3); k > 0; --k) {
-        pfap::Fap f;
-        f.index = static_cast<uint8_t>(random.chance(0.25) ? random.uniform(69, 74)
-                                                           : random.uniform(3, 12));
-        f.amplitude = random.uniform(-2000, 2000);
-        f.transition_ms = static_cast<uint16_t>(random.chance(0.2) ? 0 : random.uniform(1, 1500));
-        f.curve = static_cast<pfap::Curve>(random.uniform(1, 3));
-        p.faps.push_back(f);
-      }
-    }
-    p.sentence_start = sentence_start;
-    p.pts = t;
-    out.push_back(p);
-    t += p.phoneme.duration_ms * GST_MSECOND;
-    sentence_start = p.phoneme.end_of_text;
-    if (sentence_start) {
-      in_sentence = 0;
-      sentence_length = random.uniform(6, 14);
-      t += static_cast<GstClockTime>(random.uniform(100, 300)) * GST_MSECOND;
-    }
-  }
-  return out;
-}
+using Phoneme = pfap::testing::SpeechPhoneme;
+using pfap::testing::speech_session;
 
 GstBuffer* phoneme_buffer(const Phoneme& p) {
   const pfap::Phoneme& ph = p.phoneme;
@@ -152,7 +108,7 @@ GstBuffer* phoneme_buffer(const Phoneme& p) {
   gst_buffer_map(buffer, &map, GST_MAP_WRITE);
   if (pfap_markup_write(&header, records.data(), map.data, size) != 0) fail("bad phoneme");
   gst_buffer_unmap(buffer, &map);
-  GST_BUFFER_PTS(buffer) = p.pts;
+  GST_BUFFER_PTS(buffer) = p.start_ns;
   GST_BUFFER_DURATION(buffer) = ph.duration_ms * GST_MSECOND;
   return buffer;
 }
@@ -168,7 +124,7 @@ std::vector<Settled> lossless_states(const std::vector<Phoneme>& session) {
   pfap::FapState state;
   std::vector<Settled> out;
   for (const Phoneme& p : session) {
-    for (const pfap::Fap& f : p.faps) state.apply(f, static_cast<int64_t>(p.pts));
+    for (const pfap::Fap& f : p.faps) state.apply(f, p.start_ns);
     out.push_back(settled_of(state));
   }
   return out;
@@ -814,9 +770,10 @@ int main(int argc, char** argv) {
     gst_object_unref(f);
   }
 
-  const std::vector<Phoneme> session = speech_session(1, n);
+  const std::vector<Phoneme> session = speech_session(1, n, 0.45);
   const std::vector<Settled> lossless = lossless_states(session);
-  const GstClockTime length = session.back().pts + session.back().phoneme.duration_ms * GST_MSECOND;
+  const GstClockTime length =
+      session.back().start_ns + session.back().phoneme.duration_ms * GST_MSECOND;
   int with_faps = 0;
   for (const Phoneme& p : session) with_faps += !p.faps.empty();
   std::printf("session: %d phonemes over %.1f s of stream time (%.1f per s), %d with FAPs\n", n,

@@ -48,66 +48,31 @@
 #include "pfap/model.h"
 #include "pfap_buffers.h"
 #include "pipeline.h"
-#include "random_markup.h"
+#include "speech_session.h"
 
 namespace {
 
 using pfap::testing::Event;
-using pfap::testing::RandomMarkup;
+using pfap::testing::number_of;
 using Clock = std::chrono::steady_clock;
 using Settled = std::array<int32_t, pfap::kFapCount>;
 
 // ---------------------------------------------------------------------------------------------
 // Sessions and FAP states
 
-// Each phoneme of a session carries its number in symbol (low 8 bits) and f0 (high 8 bits),
-// so a receiver can tell which phoneme it got whatever was lost.
-int number_of(const pfap::Phoneme& p) { return p.symbol + 256 * p.f0; }
-
-// A seeded session as a TTS engine gives it: sentences of 6..14 contiguous phonemes of
-// 40..100 ms with pauses of 100..300 ms between them (about 11 phonemes per second of stream
-// time). Before a phoneme, with probability `fap_chance`, 1..3 FAPs of every kind: linear,
-// triangle and spline curves, transitions of 0..1500 ms, amplitudes of both signs, on the
-// indexes 3..12 and the expressions 69..74 only, so that later FAPs start from where earlier
-// ones left their FAP.
+// The seeded speech session of speech_session.h as x-pfap phoneme events.
 std::vector<Event> speech_session(uint32_t seed, int n_phonemes, double fap_chance,
                                   GstClockTime start = 0) {
-  RandomMarkup random(seed);
   std::vector<Event> events;
-  GstClockTime t = start;
-  bool sentence_start = true;
-  int in_sentence = 0;
-  int sentence_length = random.uniform(6, 14);
-  for (int i = 0; i < n_phonemes; ++i) {
+  for (const pfap::testing::SpeechPhoneme& p :
+       pfap::testing::speech_session(seed, n_phonemes, fap_chance, start)) {
     Event e;
-    e.phoneme.symbol = static_cast<uint8_t>(i & 0xff);
-    e.phoneme.f0 = static_cast<uint8_t>(i >> 8);
-    e.phoneme.duration_ms = static_cast<uint16_t>(random.uniform(40, 100));
-    e.phoneme.stress = random.chance(0.3);
-    e.phoneme.word_begin = random.chance(0.3);
-    e.phoneme.end_of_text = ++in_sentence >= sentence_length || i + 1 == n_phonemes;
-    if (random.chance(fap_chance)) {
-      for (int k = random.uniform(1, 3); k > 0; --k) {
-        pfap::Fap f;
-        f.index = static_cast<uint8_t>(random.chance(0.25) ? random.uniform(69, 74)
-                                                           : random.uniform(3, 12));
-        f.amplitude = random.uniform(-2000, 2000);
-        f.transition_ms = static_cast<uint16_t>(random.chance(0.2) ? 0 : random.uniform(1, 1500));
-        f.curve = static_cast<pfap::Curve>(random.uniform(1, 3));
-        e.faps.push_back(f);
-      }
-    }
-    e.flags = pfap::testing::phoneme_flags(e.phoneme, sentence_start);
-    e.pts = t;
-    e.duration = e.phoneme.duration_ms * GST_MSECOND;
+    e.phoneme = p.phoneme;
+    e.faps = p.faps;
+    e.flags = pfap::testing::phoneme_flags(p.phoneme, p.sentence_start);
+    e.pts = p.start_ns;
+    e.duration = p.phoneme.duration_ms * GST_MSECOND;
     events.push_back(e);
-    t += e.duration;
-    sentence_start = e.phoneme.end_of_text;
-    if (sentence_start) {
-      in_sentence = 0;
-      sentence_length = random.uniform(6, 14);
-      t += static_cast<GstClockTime>(random.uniform(100, 300)) * GST_MSECOND;
-    }
   }
   return events;
 }
