@@ -31,10 +31,14 @@
 #include <utility>
 #include <vector>
 
+#include "clocks.h"
 #include "pfap/markup.h"
 #include "random_markup.h"
 
 namespace {
+
+using pfap::testing::cpu_seconds;
+using pfap::testing::wall_seconds;
 
 // The phoneme events of N phonemes of speech: contiguous, 40..150 ms each, sentences of
 // 6..14 phonemes with a pause after each, one phoneme in four with two FAPs.
@@ -117,18 +121,6 @@ std::vector<GstBuffer*> klv_units(const std::vector<GstBuffer*>& buffers) {
     out.push_back(unit);
   }
   return out;
-}
-
-double cpu_seconds() {
-  timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
-}
-
-double wall_seconds() {
-  timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
 }
 
 struct Timing {

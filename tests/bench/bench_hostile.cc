@@ -31,6 +31,7 @@
 #include <utility>
 #include <vector>
 
+#include "clocks.h"
 #include "heap.h"
 #include "pfap/markup_event.h"
 #include "pfap/payload.h"
@@ -183,12 +184,6 @@ std::vector<Case> make_cases() {
 // ---------------------------------------------------------------------------------------------
 // Timing
 
-double cpu_ns() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) * 1e9 + static_cast<double>(ts.tv_nsec);
-}
-
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const size_t n = v.size();
@@ -239,7 +234,7 @@ class LibraryDepay {
 double run_library(LibraryDepay& depay, const Case& c, uint16_t& seqnum, int64_t& time_ns,
                    size_t total) {
   size_t bytes = 0, events = 0;
-  const double t0 = cpu_ns();
+  const double t0 = pfap::testing::thread_cpu_seconds() * 1e9;
   while (bytes < total) {
     for (const auto& payload : c.payloads) {
       seqnum = static_cast<uint16_t>(seqnum + c.seqnum_step);
@@ -248,7 +243,7 @@ double run_library(LibraryDepay& depay, const Case& c, uint16_t& seqnum, int64_t
       bytes += payload.size();
     }
   }
-  const double ns = cpu_ns() - t0;
+  const double ns = pfap::testing::thread_cpu_seconds() * 1e9 - t0;
   if (events == 0 && std::string(c.name).find("malformed") == std::string::npos) {
     fail(std::string("no event from ") + c.name);
   }
@@ -300,11 +295,11 @@ double run_element(GstHarness* h, const Case& c, uint16_t& seqnum, GstClockTime&
       bytes += payload.size();
     }
   }
-  const double t0 = cpu_ns();
+  const double t0 = pfap::testing::thread_cpu_seconds() * 1e9;
   for (GstBuffer* b : buffers) {
     if (gst_harness_push(h, b) != GST_FLOW_OK) fail(std::string("push failed: ") + c.name);
   }
-  const double ns = cpu_ns() - t0;
+  const double ns = pfap::testing::thread_cpu_seconds() * 1e9 - t0;
   drain_events(h);
   return ns / static_cast<double>(bytes);
 }
@@ -326,11 +321,11 @@ void reference_per_packet(int packets) {
       buffers.push_back(rtp_packet(samples, static_cast<guint16>(n), n * 2, 0x5eed, false,
                                    n * 2 * GST_SECOND / 44100));
     }
-    const double t0 = cpu_ns();
+    const double t0 = pfap::testing::thread_cpu_seconds() * 1e9;
     for (GstBuffer* b : buffers) {
       if (gst_harness_push(h, b) != GST_FLOW_OK) fail("push failed: rtpL16depay");
     }
-    runs.push_back((cpu_ns() - t0) / (packets / 5));
+    runs.push_back((pfap::testing::thread_cpu_seconds() * 1e9 - t0) / (packets / 5));
     drain_events(h);
   }
   gst_harness_teardown(h);

@@ -54,12 +54,16 @@
 #include <string>
 #include <vector>
 
+#include "clocks.h"
 #include "pfap/fap_state.h"
 #include "pfap/markup_event.h"
 #include "pfap/model.h"
 #include "random_markup.h"
 
 namespace {
+
+using pfap::testing::cpu_seconds;
+using pfap::testing::wall_seconds;
 
 [[noreturn]] void fail(const std::string& what) {
   std::fprintf(stderr, "bench_scale: %s\n", what.c_str());
@@ -207,18 +211,6 @@ void receive(Pair& pair, pfap::MarkupEvent& event) {
 }
 
 // ---- Measures ----
-
-double cpu_seconds() {
-  timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
-}
-
-double wall_seconds() {
-  timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
-}
 
 struct Memory {
   double rss = 0;   // bytes resident
