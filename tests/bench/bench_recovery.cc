@@ -63,6 +63,7 @@
 #include <string>
 #include <vector>
 
+#include "element_stats.h"
 #include "pfap/fap_state.h"
 #include "pfap/markup.h"
 #include "pfap/model.h"
@@ -85,6 +86,7 @@ constexpr int kFecPt = 122;
 
 using Phoneme = pfap::testing::SpeechPhoneme;
 using pfap::testing::speech_session;
+using pfap::testing::stat;
 
 GstBuffer* phoneme_buffer(const Phoneme& p) {
   const pfap::Phoneme& ph = p.phoneme;
@@ -246,17 +248,6 @@ struct Outcome {
   guint64 depay_lost = 0;         // packets rtppfapdepay counted as lost
   guint64 depay_lost_events = 0;  // packet-lost events rtppfapdepay received
 };
-
-guint64 stat(GstElement* element, const char* field) {
-  GstStructure* s = nullptr;
-  g_object_get(element, "stats", &s, nullptr);
-  guint64 value = 0;
-  if (s != nullptr) {
-    gst_structure_get_uint64(s, field, &value);
-    gst_structure_free(s);
-  }
-  return value;
-}
 
 // Reads the depayloader's output as an application would and compares it phoneme by phoneme.
 class Judge {

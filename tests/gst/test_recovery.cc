@@ -42,6 +42,7 @@
 #include <thread>
 #include <vector>
 
+#include "element_stats.h"
 #include "heap.h"
 #include "pfap/fap_state.h"
 #include "pfap/markup.h"
@@ -54,6 +55,8 @@ namespace {
 
 using pfap::testing::Event;
 using pfap::testing::number_of;
+using pfap::testing::stat;
+using pfap::testing::stats_text;
 using Clock = std::chrono::steady_clock;
 using Settled = std::array<int32_t, pfap::kFapCount>;
 
@@ -160,29 +163,6 @@ GstFlowReturn push_harness(GstHarness* h, const Event& e) {
   return gst_harness_push(h,
                           pfap::testing::phoneme_buffer(e.phoneme, e.faps, e.pts,
                                                         (e.flags & PFAP_FLAG_SENTENCE_START) != 0));
-}
-
-// A guint64 field of an element's stats property (0 when there is no such field).
-guint64 stat(GstElement* element, const char* field) {
-  GstStructure* s = nullptr;
-  g_object_get(element, "stats", &s, nullptr);
-  guint64 value = 0;
-  if (s != nullptr) {
-    gst_structure_get_uint64(s, field, &value);
-    gst_structure_free(s);
-  }
-  return value;
-}
-
-std::string stats_text(GstElement* element) {
-  GstStructure* s = nullptr;
-  g_object_get(element, "stats", &s, nullptr);
-  if (s == nullptr) return "(no stats)";
-  gchar* text = gst_structure_to_string(s);
-  std::string out = text;
-  g_free(text);
-  gst_structure_free(s);
-  return out;
 }
 
 // Whether an RTP packet is a complete recovery (C = 1 in the payload's first byte).
