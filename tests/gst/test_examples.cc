@@ -897,14 +897,18 @@ TEST(Story, SpeaksSendsWithLossRendersAndMuxes) {
   ASSERT_EQ(r.status, 0) << r.err;
   const long long sent = number_after(r.out, "PFAP packets sent: ");
   const long long dropped = number_after(r.out, "dropped on the way: ");
+  const long long arrived = number_after(r.out, "receiver: ");
   const long long lost = number_after(r.out, "phonemes, ");  // packets found lost
   const long long frames = number_after(r.out, "story.webm: ");
   ASSERT_GT(sent, 5) << r.out;
-  // netsim drops; the receiver counts by sequence number what did not come: the dropped
-  // packets but those before the first and after the last to arrive, which nothing reveals.
+  // netsim drops, and rtpbin may keep back a packet more (a source on probation). The
+  // depayloader counts by sequence number what did not reach it: all of that but the packets
+  // before the first and after the last to arrive, which nothing reveals.
   EXPECT_GT(dropped, 0) << r.out;
-  EXPECT_LE(lost, dropped) << r.out;
-  EXPECT_GT(number_after(r.out, "receiver: "), 0) << "no phoneme arrived: " << r.out;
+  EXPECT_GT(arrived, 0) << r.out;
+  EXPECT_LE(arrived, sent - dropped) << r.out;
+  EXPECT_GT(lost, 0) << r.out;
+  EXPECT_LE(lost, sent - arrived) << r.out;
 
   // About 2.5 s of speech at 25 fps, each frame also written as a PNG file.
   EXPECT_GE(frames, 50) << r.out;
