@@ -892,7 +892,7 @@ TEST(Story, SpeaksSendsWithLossRendersAndMuxes) {
   ASSERT_TRUE(plugin_available());
   TempDir dir;
   const ProcessResult r = run(
-      {PFAP_STORY, "--text=Hello <FAP 2 1 40 0 0 500 1> world. How are you today?", "--drop=0.5",
+      {PFAP_STORY, "--text=Hello <FAP 2 1 40 0 0 500 1> world. How are you today?", "--drop=0.4",
        "--size=160x120", "--out=" + dir.file("story.webm"), "--frames=" + dir.path()});
   ASSERT_EQ(r.status, 0) << r.err;
   const long long sent = number_after(r.out, "PFAP packets sent: ");
@@ -901,13 +901,12 @@ TEST(Story, SpeaksSendsWithLossRendersAndMuxes) {
   const long long lost = number_after(r.out, "phonemes, ");  // packets found lost
   const long long frames = number_after(r.out, "story.webm: ");
   ASSERT_GT(sent, 5) << r.out;
-  // netsim drops, and rtpbin may keep back a packet more (a source on probation). The
-  // depayloader counts by sequence number what did not reach it: all of that but the packets
-  // before the first and after the last to arrive, which nothing reveals.
+  // netsim drops (at 40 %, all of 15 packets pass once in 2000 runs), and rtpbin may keep
+  // back more: a new source is on probation until two packets follow each other, and heavy
+  // loss can keep it there. The depayloader counts by sequence number what did not reach it:
+  // all of that but the packets before the first and after the last to arrive.
   EXPECT_GT(dropped, 0) << r.out;
-  EXPECT_GT(arrived, 0) << r.out;
   EXPECT_LE(arrived, sent - dropped) << r.out;
-  EXPECT_GT(lost, 0) << r.out;
   EXPECT_LE(lost, sent - arrived) << r.out;
 
   // About 2.5 s of speech at 25 fps, each frame also written as a PNG file.
