@@ -75,8 +75,8 @@ struct Stream {
   bool negotiated = false;
   uint64_t frame = 0;          // the next frame's number since the output segment's start
   int64_t covered_until = -1;  // running time up to which a GAP said no markup comes
-  int64_t last_event = 0;      // the running time of the last event applied
   bool warned_mouth = false;   // the warning for phonemes without a mouth shape was posted
+  pfap::MarkupEvent event;     // reused, so that steady streaming does not allocate
 };
 
 }  // namespace
@@ -134,7 +134,6 @@ static void reset(GstPfapFace* self) {
   s.animator.reset();
   s.frame = 0;
   s.covered_until = -1;
-  s.last_event = 0;
   s.warned_mouth = false;
   GstAggregatorPad* srcpad = GST_AGGREGATOR_PAD(GST_AGGREGATOR_SRC_PAD(self));
   GST_OBJECT_LOCK(self);
@@ -155,25 +154,23 @@ static int64_t input_running_time(GstPfapFace* self, GstClockTime time) {
 // none).
 static void apply_event(GstPfapFace* self, GstBuffer* buffer, int64_t at) {
   Stream& s = *self->stream;
-  pfap::MarkupEvent event;
+  pfap::MarkupEvent& event = s.event;
   if (!pfap_buffer_read(buffer, event)) {
-    GST_ELEMENT_WARNING(self, STREAM, DECODE, ("Dropped a malformed PFAP event."),
-                        ("%" G_GSIZE_FORMAT " bytes at %" GST_TIME_FORMAT
-                         " are not a valid application/x-pfap event",
-                         gst_buffer_get_size(buffer), GST_TIME_ARGS(GST_BUFFER_PTS(buffer))));
+    PFAP_WARN_MALFORMED_EVENT(self, buffer);
     return;
   }
+  // The animator takes an earlier time as its last one.
+  const int64_t last = s.animator.last_ns();
   if (at < 0) {
-    at = s.last_event;
-  } else if (at < s.last_event) {
+    at = last;
+  } else if (at < last) {
     GST_ELEMENT_WARNING(self, STREAM, FORMAT,
                         ("A PFAP event is earlier than the one before it; applied at that "
                          "one's time."),
                         ("running time %" GST_STIME_FORMAT " is before %" GST_STIME_FORMAT,
-                         GST_STIME_ARGS(at), GST_STIME_ARGS(s.last_event)));
+                         GST_STIME_ARGS(at), GST_STIME_ARGS(last)));
   }
-  s.last_event = std::max(at, s.last_event);
-  if (!s.animator.apply(event, s.last_event) && !s.warned_mouth) {
+  if (!s.animator.apply(event, at) && !s.warned_mouth) {
     s.warned_mouth = true;
     GST_ELEMENT_WARNING(self, STREAM, FORMAT,
                         ("Phonemes without a known mouth shape: the mouth only opens and "

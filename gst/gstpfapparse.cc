@@ -103,16 +103,6 @@ static void reset(GstPfapParse* self) {
   s.discont = true;
 }
 
-// Phonemes come only while someone speaks: sparse tells queues, muxers and aggregators
-// downstream not to wait for our data.
-static GstEvent* make_sparse(GstEvent* event) {
-  event = gst_event_make_writable(event);
-  GstStreamFlags flags;
-  gst_event_parse_stream_flags(event, &flags);
-  gst_event_set_stream_flags(event, static_cast<GstStreamFlags>(flags | GST_STREAM_FLAG_SPARSE));
-  return event;
-}
-
 // The sticky events a buffer or EOS needs before it: upstream's stream-start was forwarded
 // if there was one; caps stay across a flush, the segment does not.
 static void send_events(GstPfapParse* self) {
@@ -123,7 +113,7 @@ static void send_events(GstPfapParse* self) {
     gst_event_unref(start);
   } else {
     gchar* id = gst_pad_create_stream_id(self->srcpad, GST_ELEMENT(self), nullptr);
-    gst_pad_push_event(self->srcpad, make_sparse(gst_event_new_stream_start(id)));
+    gst_pad_push_event(self->srcpad, pfap_make_sparse(gst_event_new_stream_start(id)));
     g_free(id);
   }
   if (!gst_pad_has_current_caps(self->srcpad)) {
@@ -255,7 +245,7 @@ static gboolean gst_pfap_parse_sink_event(GstPad* pad, GstObject* parent, GstEve
   Stream& s = *self->stream;
   switch (GST_EVENT_TYPE(event)) {
     case GST_EVENT_STREAM_START:
-      return gst_pad_push_event(self->srcpad, make_sparse(event));
+      return gst_pad_push_event(self->srcpad, pfap_make_sparse(event));
     // Text caps and upstream times say nothing about the output: our caps and segment go
     // before the first buffer.
     case GST_EVENT_CAPS:

@@ -130,10 +130,7 @@ static GstFlowReturn gst_pfap_text_enc_chain(GstPad*, GstObject* parent, GstBuff
   GstPfapTextEnc* self = GST_PFAP_TEXT_ENC(parent);
   Stream& s = *self->stream;
   if (!pfap_buffer_read(buffer, s.text.event)) {
-    GST_ELEMENT_WARNING(self, STREAM, DECODE, ("Dropped a malformed PFAP event."),
-                        ("%" G_GSIZE_FORMAT " bytes at %" GST_TIME_FORMAT
-                         " are not a valid application/x-pfap event",
-                         gst_buffer_get_size(buffer), GST_TIME_ARGS(GST_BUFFER_PTS(buffer))));
+    PFAP_WARN_MALFORMED_EVENT(self, buffer);
     gst_buffer_unref(buffer);
     return GST_FLOW_OK;
   }

@@ -82,9 +82,11 @@ struct Stream {
   GstSegment input_segment;               // the sink pad's, for utterance running times
   std::set<std::string> warned_phonemes;  // inexact mnemonics already warned about
 
-  GstClockTime position() const {
-    return base + (rate == 0 ? 0 : gst_util_uint64_scale(samples, GST_SECOND, rate));
+  // The time of sample number `n` of the current count.
+  GstClockTime time_at(uint64_t n) const {
+    return base + (rate == 0 ? 0 : gst_util_uint64_scale(n, GST_SECOND, rate));
   }
+  GstClockTime position() const { return time_at(samples); }
 };
 
 }  // namespace
@@ -202,12 +204,21 @@ static GstFlowReturn push_audio(GstPfapTts* self, const int16_t* data, size_t n)
   GstFlowReturn ret = GST_FLOW_OK;
   while (n > 0 && ret == GST_FLOW_OK) {
     const size_t chunk = std::min(n, kMaxBufferSamples);
-    GstBuffer* buffer = gst_buffer_new_allocate(nullptr, chunk * 2, nullptr);
-    GstMapInfo map;
-    gst_buffer_map(buffer, &map, GST_MAP_WRITE);
-    auto* out = reinterpret_cast<int16_t*>(map.data);
-    for (size_t i = 0; i < chunk; ++i) out[i] = data != nullptr ? GINT16_TO_LE(data[i]) : 0;
-    gst_buffer_unmap(buffer, &map);
+    const size_t bytes = chunk * sizeof(int16_t);
+    GstBuffer* buffer = gst_buffer_new_allocate(nullptr, bytes, nullptr);
+    if (data == nullptr) {
+      gst_buffer_memset(buffer, 0, 0, bytes);
+    } else {
+#if G_BYTE_ORDER == G_LITTLE_ENDIAN
+      gst_buffer_fill(buffer, 0, data, bytes);  // native samples are already S16LE
+#else
+      GstMapInfo map;
+      gst_buffer_map(buffer, &map, GST_MAP_WRITE);
+      auto* out = reinterpret_cast<int16_t*>(map.data);
+      for (size_t i = 0; i < chunk; ++i) out[i] = GINT16_TO_LE(data[i]);
+      gst_buffer_unmap(buffer, &map);
+#endif
+    }
     const GstClockTime start = s.position();
     GST_BUFFER_PTS(buffer) = start;
     GST_BUFFER_OFFSET(buffer) = s.samples;
@@ -299,9 +310,8 @@ static GstFlowReturn speak(GstPfapTts* self, std::string_view input, GstClockTim
       GST_ELEMENT_ERROR(self, STREAM, FAILED, (nullptr), ("a phoneme x-pfap cannot hold"));
       return GST_FLOW_ERROR;
     }
-    const GstClockTime start = s.base + gst_util_uint64_scale(first + p.start, GST_SECOND, s.rate);
-    const GstClockTime end =
-        s.base + gst_util_uint64_scale(first + p.start + p.n_samples, GST_SECOND, s.rate);
+    const GstClockTime start = s.time_at(first + p.start);
+    const GstClockTime end = s.time_at(first + p.start + p.n_samples);
     GST_BUFFER_PTS(buffer) = start;
     GST_BUFFER_DURATION(buffer) = end - start;
     if (s.pfap_discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);

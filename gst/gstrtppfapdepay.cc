@@ -124,12 +124,6 @@ struct Stats {
   guint64 packet_lost_events = 0;
 };
 
-// Every warning cannot go to the bus (a broken sender could flood it), so warn at the 1st,
-// 2nd, 4th, 8th, ... malformed packet: a fault shows at once, a lasting one costs log2(n)
-// messages, and the stats property has every count. It needs no running time, which a
-// stream of bad packets may not give.
-bool warn_at(guint64 malformed) { return (malformed & (malformed - 1)) == 0; }
-
 }  // namespace
 
 struct _GstRtpPfapDepay {
@@ -207,16 +201,9 @@ static gboolean gst_rtp_pfap_depay_set_caps(GstRTPBaseDepayload* depay, GstCaps*
 
 static gboolean gst_rtp_pfap_depay_handle_event(GstRTPBaseDepayload* depay, GstEvent* event) {
   switch (GST_EVENT_TYPE(event)) {
-    case GST_EVENT_STREAM_START: {
-      // Phonemes come only while someone speaks; sparse tells queues, muxers and
-      // aggregators downstream not to wait for our data.
-      event = gst_event_make_writable(event);
-      GstStreamFlags flags;
-      gst_event_parse_stream_flags(event, &flags);
-      gst_event_set_stream_flags(event,
-                                 static_cast<GstStreamFlags>(flags | GST_STREAM_FLAG_SPARSE));
+    case GST_EVENT_STREAM_START:
+      event = pfap_make_sparse(event);
       break;
-    }
     case GST_EVENT_FLUSH_STOP:
       reset(GST_RTP_PFAP_DEPAY(depay));
       break;
@@ -234,7 +221,9 @@ static void drop_malformed(GstRtpPfapDepay* self, pfap::DecodeResult result, gui
   });
   GST_DEBUG_OBJECT(self, "dropped packet %u: %s at byte %u", seqnum, pfap::to_string(result.status),
                    result.offset);
-  if (warn_at(malformed)) {
+  // A broken sender could flood the bus; the stats property has every count. Counting needs
+  // no running time, which a stream of bad packets may not give.
+  if (pfap_warn_at(malformed)) {
     GST_ELEMENT_WARNING(self, STREAM, DECODE,
                         ("Dropped a malformed PFAP packet: %s at byte %u",
                          pfap::to_string(result.status), result.offset),
@@ -248,7 +237,9 @@ static void drop_malformed(GstRtpPfapDepay* self, pfap::DecodeResult result, gui
 // x-pfap counts an event's FAPs in 16 bits, and only a payload over 393 KB holds more in one
 // phoneme or recovery list. Such a packet is dropped before the receiver sees it, so that
 // it counts as lost, like a malformed one.
-static bool fits_x_pfap(GstRtpPfapDepay* self, guint16 seqnum) {
+static bool fits_x_pfap(GstRtpPfapDepay* self, guint16 seqnum, std::span<const uint8_t> payload) {
+  // Every FAP takes a descriptor on the wire: a smaller payload cannot hold too many.
+  if (payload.size() < (G_MAXUINT16 + 1) * pfap::kFapDescriptorBytes) return true;
   const pfap::Packet& packet = self->packet;
   size_t most = packet.recovery.size();
   for (size_t i = 0; i < packet.phonemes.size(); ++i) {
@@ -320,7 +311,7 @@ static GstBuffer* gst_rtp_pfap_depay_process_rtp_packet(GstRTPBaseDepayload* dep
     drop_malformed(self, result, seqnum);
     return nullptr;
   }
-  if (!fits_x_pfap(self, seqnum)) return nullptr;
+  if (!fits_x_pfap(self, seqnum, payload)) return nullptr;
 
   // A new SSRC is a new sender, or one restarted: its sequence numbers and FAP state owe
   // nothing to the last one's.

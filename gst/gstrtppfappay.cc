@@ -66,6 +66,7 @@
 #include <gst/video/video-event.h>
 
 #include <cstdint>
+#include <iterator>
 #include <optional>
 #include <vector>
 
@@ -135,7 +136,7 @@ struct _GstRtpPfapPay {
 
 GType gst_rtp_pfap_recovery_depth_get_type() {
   static gsize type = 0;
-  static const GEnumValue values[] = {
+  static constexpr GEnumValue values[] = {
       {0, "No dynamic recovery", "0"},
       {1, "Recover a loss of the previous packet", "1"},
       {2, "Recover losses within the previous 2 packets", "2"},
@@ -146,6 +147,16 @@ GType gst_rtp_pfap_recovery_depth_get_type() {
       {40, "Recover losses within the previous 40 packets", "40"},
       {0, nullptr, nullptr},
   };
+  // A coverage added to the library without a value here, or a typo, fails to build.
+  static_assert(
+      [] {
+        if (std::size(values) != std::size(pfap::kCoverageSteps) + 2) return false;
+        for (size_t i = 0; i < std::size(pfap::kCoverageSteps); ++i) {
+          if (values[i + 1].value != pfap::kCoverageSteps[i]) return false;
+        }
+        return true;
+      }(),
+      "the recovery depths are 0 and pfap::kCoverageSteps, in order");
   if (g_once_init_enter(&type)) {
     g_once_init_leave(&type, g_enum_register_static("GstRtpPfapRecoveryDepth", values));
   }
@@ -253,8 +264,8 @@ static GstFlowReturn push_complete(GstRtpPfapPay* self, int64_t time_ns) {
     GST_OBJECT_LOCK(self);
     const guint64 too_large = ++self->stats.complete_too_large;
     GST_OBJECT_UNLOCK(self);
-    // At the 1st, 2nd, 4th, 8th, ...: a state that stays too large must not flood the bus.
-    if ((too_large & (too_large - 1)) == 0) {
+    // A state that stays too large must not flood the bus.
+    if (pfap_warn_at(too_large)) {
       GST_ELEMENT_WARNING(
           self, STREAM, ENCODE, ("The complete FAP state does not fit in the MTU."),
           ("%" G_GSIZE_FORMAT " non-zero FAPs at %" GST_TIME_FORMAT " need %" G_GSIZE_FORMAT
@@ -389,12 +400,7 @@ static GstFlowReturn gst_rtp_pfap_pay_handle_buffer(GstRTPBasePayload* payload, 
   GstClockTime start = GST_BUFFER_PTS(buffer);
   pfap::MarkupEvent& event = stream.event;
   const bool ok = pfap_buffer_read(buffer, event);
-  if (!ok) {
-    GST_ELEMENT_WARNING(self, STREAM, DECODE, ("Dropped a malformed PFAP event."),
-                        ("%" G_GSIZE_FORMAT " bytes at %" GST_TIME_FORMAT
-                         " are not a valid application/x-pfap event",
-                         gst_buffer_get_size(buffer), GST_TIME_ARGS(start)));
-  }
+  if (!ok) PFAP_WARN_MALFORMED_EVENT(self, buffer);
   gst_buffer_unref(buffer);
   if (!ok) return GST_FLOW_OK;
   if (event.kind != PFAP_EVENT_PHONEME) {

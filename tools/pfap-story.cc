@@ -163,9 +163,9 @@ GstElement* by_name(GstElement* pipeline, const char* name) {
 }
 
 void add_probe(GstElement* element, const char* pad_name, GstPadProbeType type,
-               GstPadProbeCallback callback, Story* story) {
+               GstPadProbeCallback callback, gpointer data) {
   GstPad* pad = gst_element_get_static_pad(element, pad_name);
-  gst_pad_add_probe(pad, type, callback, story, nullptr);
+  gst_pad_add_probe(pad, type, callback, data, nullptr);
   gst_object_unref(pad);
 }
 
@@ -183,23 +183,9 @@ GstPadProbeReturn on_payloader_eos(GstPad*, GstPadProbeInfo* info, gpointer data
   return GST_PAD_PROBE_OK;
 }
 
-GstPadProbeReturn on_netsim_in(GstPad*, GstPadProbeInfo* info, gpointer data) {
-  static_cast<Story*>(data)->pfap_packets += buffers_in(info);
-  return GST_PAD_PROBE_OK;
-}
-
-GstPadProbeReturn on_netsim_out(GstPad*, GstPadProbeInfo* info, gpointer data) {
-  static_cast<Story*>(data)->pfap_passed += buffers_in(info);
-  return GST_PAD_PROBE_OK;
-}
-
-GstPadProbeReturn on_depay_in(GstPad*, GstPadProbeInfo* info, gpointer data) {
-  static_cast<Story*>(data)->pfap_arrived += buffers_in(info);
-  return GST_PAD_PROBE_OK;
-}
-
-GstPadProbeReturn on_frame(GstPad*, GstPadProbeInfo*, gpointer data) {
-  static_cast<Story*>(data)->frames += 1;
+// Adds the buffers passing to the std::atomic<guint64> `data`.
+GstPadProbeReturn count_buffers(GstPad*, GstPadProbeInfo* info, gpointer data) {
+  *static_cast<std::atomic<guint64>*>(data) += buffers_in(info);
   return GST_PAD_PROBE_OK;
 }
 
@@ -348,10 +334,11 @@ int main(int argc, char** argv) {
             on_payloader_eos, &story);
   const auto buffers =
       static_cast<GstPadProbeType>(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_BUFFER_LIST);
-  add_probe(by_name(story.sender, "loss"), "sink", buffers, on_netsim_in, &story);
-  add_probe(by_name(story.sender, "loss"), "src", buffers, on_netsim_out, &story);
-  add_probe(by_name(story.receiver, "depay"), "sink", buffers, on_depay_in, &story);
-  add_probe(by_name(story.receiver, "face"), "src", GST_PAD_PROBE_TYPE_BUFFER, on_frame, &story);
+  add_probe(by_name(story.sender, "loss"), "sink", buffers, count_buffers, &story.pfap_packets);
+  add_probe(by_name(story.sender, "loss"), "src", buffers, count_buffers, &story.pfap_passed);
+  add_probe(by_name(story.receiver, "depay"), "sink", buffers, count_buffers, &story.pfap_arrived);
+  add_probe(by_name(story.receiver, "face"), "src", GST_PAD_PROBE_TYPE_BUFFER, count_buffers,
+            &story.frames);
 
   bool started =
       gst_element_set_state(story.receiver, GST_STATE_READY) != GST_STATE_CHANGE_FAILURE &&

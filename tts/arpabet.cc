@@ -94,10 +94,9 @@ constexpr MnemonicMapping kEnglish[] = {
 };
 
 std::optional<uint8_t> lookup(std::string_view mnemonic) {
+  static const PhonemeAlphabet& arpabet = *find_alphabet(kArpabetAlphabet);
   for (const MnemonicMapping& m : kEnglish) {
-    if (m.mnemonic == mnemonic) {
-      return find_symbol(*find_alphabet(kArpabetAlphabet), m.arpabet);
-    }
+    if (m.mnemonic == mnemonic) return find_symbol(arpabet, m.arpabet);
   }
   return std::nullopt;
 }

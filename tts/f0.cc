@@ -2,7 +2,6 @@
 
 #include <aubio/aubio.h>
 
-#include <algorithm>
 #include <memory>
 
 namespace pfap::tts {

@@ -26,7 +26,7 @@ uint64_t to_ms(size_t sample, unsigned rate) {
 }  // namespace
 
 void add_phoneme(const MarkupEvent& event, size_t start, size_t end, unsigned rate,
-                 const std::string& mnemonic, std::vector<SpokenPhoneme>& out) {
+                 std::vector<SpokenPhoneme>& out) {
   const uint64_t ms = to_ms(end, rate) - to_ms(start, rate);
   std::vector<Phoneme> pieces;
   split_long_phoneme(event.phoneme, static_cast<uint32_t>(ms), pieces);
@@ -47,7 +47,6 @@ void add_phoneme(const MarkupEvent& event, size_t start, size_t end, unsigned ra
     }
     p.start = piece_start;
     p.n_samples = piece_end - piece_start;
-    p.mnemonic = mnemonic;
     out.push_back(std::move(p));
     piece_start = piece_end;
   }
@@ -63,7 +62,7 @@ bool speak(const Utterance& utterance, const VoiceSettings& settings, Speech& ou
 
   // The segments that tile the audio, and where each espeak-ng phoneme went.
   std::vector<Segment> segments;
-  std::vector<size_t> segment_of(syn.phonemes.size() + 1, SIZE_MAX);
+  std::vector<size_t> segment_of(syn.phonemes.size(), SIZE_MAX);
   if (!syn.phonemes.empty() && syn.phonemes[0].sample > 0) {
     segments.push_back({0, std::min(syn.phonemes[0].sample, total), SIZE_MAX, 0});
   }
@@ -112,9 +111,9 @@ bool speak(const Utterance& utterance, const VoiceSettings& settings, Speech& ou
       const std::string& m = syn.phonemes[s.espeak_index].mnemonic;
       const std::optional<ArpabetSymbol> symbol = arpabet_symbol(m);
       e.phoneme.symbol = symbol ? symbol->symbol : 0;
-      const bool known = std::any_of(out.inexact.begin(), out.inexact.end(),
-                                     [&](const Speech::Inexact& i) { return i.mnemonic == m; });
-      if ((!symbol || !symbol->exact) && !known) {
+      if ((!symbol || !symbol->exact) &&
+          std::none_of(out.inexact.begin(), out.inexact.end(),
+                       [&](const Speech::Inexact& i) { return i.mnemonic == m; })) {
         out.inexact.push_back({m, find_phoneme(arpabet, e.phoneme.symbol)->name});
       }
       e.phoneme.stress = stressed[s.espeak_index];
@@ -131,9 +130,7 @@ bool speak(const Utterance& utterance, const VoiceSettings& settings, Speech& ou
 
   for (size_t k = 0; k < segments.size(); ++k) {
     const Segment& seg = segments[k];
-    add_phoneme(events[k], seg.start, seg.end, syn.sample_rate,
-                seg.espeak_index != SIZE_MAX ? syn.phonemes[seg.espeak_index].mnemonic : "",
-                out.phonemes);
+    add_phoneme(events[k], seg.start, seg.end, syn.sample_rate, out.phonemes);
   }
   out.samples = std::move(syn.samples);
   return true;

@@ -17,7 +17,6 @@ struct SpokenPhoneme {
   MarkupEvent event;     // a phoneme event; duration_ms on the utterance's ms grid
   size_t start = 0;      // first sample
   size_t n_samples = 0;  // its length in samples (a split phoneme: this piece's)
-  std::string mnemonic;  // espeak-ng's; "" for the lead-in pause
 };
 
 struct Speech {
@@ -38,7 +37,7 @@ struct Speech {
 // its duration_ms on the utterance's ms grid (below); longer than 4095 ms, as the pieces of
 // pfap::split_long_phoneme, the FAPs and sentence start on the first.
 void add_phoneme(const MarkupEvent& event, size_t start, size_t end, unsigned rate,
-                 const std::string& mnemonic, std::vector<SpokenPhoneme>& out);
+                 std::vector<SpokenPhoneme>& out);
 
 // Speaks `utterance`. False with `error` when espeak-ng cannot (no such voice).
 //  - A phoneme lasts from its start to the next one's; the last to the end of the audio. The

@@ -1,5 +1,7 @@
 #include "stress.h"
 
+#include <algorithm>
+
 namespace pfap::tts {
 namespace {
 

@@ -1,5 +1,7 @@
 #include "utterance.h"
 
+#include <cassert>
+
 namespace pfap::tts {
 namespace {
 
@@ -56,6 +58,16 @@ Utterance parse_utterance(std::string_view input, std::vector<BadBookmark>& bad)
   size_t pos = 0;
   size_t text_from = 0;  // start of the text not yet copied to u.text
   int consecutive = 0;   // bookmarks in the current run
+  // Code points before byte `counted_bytes`: bookmarks and their errors come in byte order,
+  // so each offset only counts on from the one before.
+  size_t counted_bytes = 0;
+  size_t counted = 0;
+  auto code_point_offset = [&](size_t byte) {
+    assert(byte >= counted_bytes);
+    counted += code_points(input.substr(counted_bytes, byte - counted_bytes));
+    counted_bytes = byte;
+    return counted;
+  };
   auto flush_text = [&](size_t end) {
     append_utf8(input.substr(text_from, end - text_from), u.text);
     text_from = end;
@@ -73,9 +85,9 @@ Utterance parse_utterance(std::string_view input, std::vector<BadBookmark>& bad)
       result = {BookmarkStatus::kTooManyBookmarks, start};
     }
     if (result.ok()) {
-      u.bookmarks.push_back({u.text.size(), code_points(input.substr(0, start)), std::move(faps)});
+      u.bookmarks.push_back({u.text.size(), code_point_offset(start), std::move(faps)});
     } else {
-      bad.push_back({result.status, code_points(input.substr(0, result.position))});
+      bad.push_back({result.status, code_point_offset(result.position)});
       const size_t close = input.find('>', start);
       const size_t next = input.find('<', start + 1);
       pos = close != std::string_view::npos && close < next ? close + 1

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <utility>
 #include <vector>
 
 namespace face {
@@ -189,7 +188,6 @@ FacePose pose_from_faps(const FapValues& f) {
   // Roll (positive: the head tilts to its right, the viewer's left) turns the picture.
   const Head head(f[48] * kAngleUnit, f[49] * kAngleUnit, f[50] * kAngleUnit);
   pose.roll = head.roll();
-  pose.head_center = {0, 0};
   for (int e = 1; e <= 6; ++e) pose.expressions[e - 1] = expression_weight(f, e);
 
   // Jaw: FAP 3 down, 14 forward, 15 to the face's right (-x), 18 the chin up.

@@ -7,11 +7,12 @@
 //      bad field is reported at its first byte, a missing field at the '>'.
 #include "pfap/bookmark.h"
 
-#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cstdint>
 #include <iterator>
+
+#include "number.h"
 
 namespace pfap {
 namespace {
@@ -20,30 +21,11 @@ constexpr std::string_view kKeyword = "FAP";
 constexpr int kExpressionBookmark = 2;  // n = 2: "e1 a1 e2 a2"
 constexpr int kMaxExpression = 6;
 
-// Larger than every field's limit: a longer digit string saturates here instead of
-// overflowing, and the field's range check refuses it.
-constexpr int64_t kSaturated = int64_t{INT32_MAX} + 1;
-
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
 
 size_t skip_space(std::string_view text, size_t i) {
   while (i < text.size() && is_space(text[i])) ++i;
   return i;
-}
-
-// Optional sign, then one or more decimal digits, nothing else.
-bool parse_integer(std::string_view token, int64_t& value) {
-  size_t i = 0;
-  const bool negative = token[0] == '-';
-  if (token[0] == '-' || token[0] == '+') i = 1;
-  if (i == token.size()) return false;
-  int64_t magnitude = 0;
-  for (; i < token.size(); ++i) {
-    if (token[i] < '0' || token[i] > '9') return false;
-    magnitude = std::min(magnitude * 10 + (token[i] - '0'), kSaturated);
-  }
-  value = negative ? -magnitude : magnitude;
-  return true;
 }
 
 enum class Role : uint8_t { kFapNumber, kExpression, kAmplitude, kTransition, kCurve };
@@ -141,7 +123,7 @@ BookmarkResult parse_bookmark(std::string_view text, size_t& pos, std::vector<Fa
     while (i < close && !is_space(text[i])) ++i;
     if (count == roles.size()) return {BookmarkStatus::kBadNumber, token_begin};
     int64_t value = 0;
-    if (!parse_integer(text.substr(token_begin, i - token_begin), value)) {
+    if (!parse_decimal(text.substr(token_begin, i - token_begin), value)) {
       return {BookmarkStatus::kBadNumber, token_begin};
     }
     const BookmarkStatus status = check_range(roles[count], value);
@@ -171,16 +153,16 @@ BookmarkResult parse_bookmark(std::string_view text, size_t& pos, std::vector<Fa
   return {};
 }
 
-BookmarkResult parse_bookmarks(std::string_view text, std::vector<Fap>& out) {
+BookmarkResult parse_bookmarks(std::string_view text, std::vector<Fap>& out, size_t max_bookmarks) {
   const size_t original_size = out.size();
-  int bookmarks = 0;
+  size_t bookmarks = 0;
   for (size_t pos = skip_space(text, 0); pos < text.size(); pos = skip_space(text, pos)) {
     const size_t start = pos;
     BookmarkResult result = parse_bookmark(text, pos, out);
     // Between bookmarks nothing claims that one starts here: what is not one is stray text.
     if (result.status == BookmarkStatus::kNotABookmark) {
       result.status = BookmarkStatus::kUnexpectedText;
-    } else if (result.ok() && ++bookmarks > kMaxBookmarksPerPhoneme) {
+    } else if (result.ok() && ++bookmarks > max_bookmarks) {
       result = {BookmarkStatus::kTooManyBookmarks, start};
     }
     if (!result.ok()) {

@@ -111,11 +111,13 @@ ReceiveResult RecoveryReceiver::receive(const Packet& packet, uint16_t seqnum, i
   last_seqnum_ = seqnum;
 
   if (packet.recovery_kind == RecoveryKind::kComplete) {
-    const FapState before = state_;
+    // Only the settled values are compared, so only they are kept, not the whole state.
+    std::array<int32_t, kFapCount> before{};
+    for (int f = kMinFapIndex; f <= kMaxFapIndex; ++f) before[f] = state_.settled(f);
     state_.reset();
     for (const Fap& entry : packet.recovery) state_.apply(entry, time_ns);
     for (int f = kMinFapIndex; f <= kMaxFapIndex && !result.changed; ++f) {
-      result.changed = state_.settled(f) != before.settled(f);
+      result.changed = state_.settled(f) != before[f];
     }
     whole_ = true;
     result.recovery = ReceiveResult::Recovery::kComplete;

@@ -4,21 +4,21 @@
 // reported at its first byte. Only a whole good line reaches the caller and the reader's state.
 #include "pfap/text.h"
 
-#include <algorithm>
 #include <array>
 #include <charconv>
 #include <iterator>
 #include <utility>
 #include <vector>
 
+#include "number.h"
+
 namespace pfap {
 namespace {
 
 // A time and its phoneme's end, in ns, fit an int64 (and a GstClockTime): about 292 years.
 constexpr int64_t kMaxTimeMs = INT64_MAX / kNsPerMs - kMaxPhonemeDurationMs;
-// Larger than every field's limit: a longer digit string saturates here instead of
-// overflowing, and the field's range check refuses it.
-constexpr int64_t kSaturated = kMaxTimeMs + 1;
+// The largest field limit: a saturated number must still be over it to be refused.
+static_assert(kMaxTimeMs < kSaturatedMagnitude);
 
 constexpr std::string_view kStateKeyword = "state";
 constexpr std::string_view kRecovered = "recovered";
@@ -27,8 +27,6 @@ constexpr std::string_view kComplete = "complete";
 constexpr std::string_view kFlagLetters = "SWE";
 constexpr std::array kFlagMembers = {&Phoneme::stress, &Phoneme::word_begin, &Phoneme::end_of_text};
 constexpr std::string_view kNoFlags = "-";
-// What parse_bookmarks skips between bookmarks; state lines skip the same.
-constexpr std::string_view kBookmarkSpace = " \t\r\n";
 
 bool is_field_space(char c) { return c == ' ' || c == '\t'; }
 
@@ -48,18 +46,9 @@ Field next_field(std::string_view content, size_t& pos) {
 // A decimal integer in 0..max: optional sign, then one or more digits, as in bookmarks.
 // `value` is set only on success.
 bool parse_number(std::string_view text, int64_t max, int64_t& value) {
-  size_t i = 0;
-  const bool negative = !text.empty() && text[0] == '-';
-  if (!text.empty() && (text[0] == '-' || text[0] == '+')) i = 1;
-  if (i == text.size()) return false;
-  int64_t magnitude = 0;
-  for (; i < text.size(); ++i) {
-    if (text[i] < '0' || text[i] > '9') return false;
-    magnitude = std::min(magnitude * 10 + (text[i] - '0'), kSaturated);
-  }
-  const int64_t signed_value = negative ? -magnitude : magnitude;
-  if (signed_value < 0 || signed_value > max) return false;
-  value = signed_value;
+  int64_t parsed = 0;
+  if (!parse_decimal(text, parsed) || parsed < 0 || parsed > max) return false;
+  value = parsed;
   return true;
 }
 
@@ -77,18 +66,10 @@ bool parse_flags(std::string_view text, Phoneme& phoneme) {
 }
 
 // A line's bookmarks, one after the other, with no count limit: the 40 bookmarks MPEG-4
-// allows before a phoneme (parse_bookmarks' limit) can be 80 FAPs, which the canonical form
-// writes as 80 bookmarks, and a state lists up to every FAP. The line length bounds them.
+// allows before a phoneme (parse_bookmarks' default limit) can be 80 FAPs, which the canonical
+// form writes as 80 bookmarks, and a state lists up to every FAP. The line length bounds them.
 BookmarkResult parse_line_bookmarks(std::string_view text, std::vector<Fap>& out) {
-  for (size_t pos = text.find_first_not_of(kBookmarkSpace); pos != std::string_view::npos;
-       pos = text.find_first_not_of(kBookmarkSpace, pos)) {
-    BookmarkResult result = parse_bookmark(text, pos, out);
-    if (result.status == BookmarkStatus::kNotABookmark) {
-      result.status = BookmarkStatus::kUnexpectedText;
-    }
-    if (!result.ok()) return result;
-  }
-  return {};
+  return parse_bookmarks(text, out, SIZE_MAX);
 }
 
 TextResult bad_bookmark(BookmarkResult result, size_t offset) {

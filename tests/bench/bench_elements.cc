@@ -21,7 +21,6 @@
 //  or: GST_PLUGIN_PATH=build/gst build/tests/bench/bench_elements [N [repetitions]]
 #include <gst/gst.h>
 
-#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
@@ -38,6 +37,7 @@
 namespace {
 
 using pfap::testing::cpu_seconds;
+using pfap::testing::median;
 using pfap::testing::wall_seconds;
 
 // The phoneme events of N phonemes of speech: contiguous, 40..150 ms each, sentences of
@@ -201,12 +201,6 @@ Timing run(const char* caps, const char* payloader, const char* depayloader,
   gst_object_unref(sink);
   gst_object_unref(pipeline);
   return t;
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2;
 }
 
 }  // namespace

@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "clocks.h"
+#include "element_stats.h"
 #include "heap.h"
 #include "pfap/markup_event.h"
 #include "pfap/payload.h"
@@ -44,6 +45,7 @@ using pfap::Fap;
 using pfap::Packet;
 using pfap::Phoneme;
 using pfap::RecoveryKind;
+using pfap::testing::median;
 using pfap::testing::RandomMarkup;
 
 constexpr size_t kMaxPayload = 1388;
@@ -183,12 +185,6 @@ std::vector<Case> make_cases() {
 
 // ---------------------------------------------------------------------------------------------
 // Timing
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 == 1 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2;
-}
 
 // rtppfapdepay's work per packet (gst/gstrtppfapdepay.cc) with library types only.
 class LibraryDepay {
@@ -509,12 +505,7 @@ void memory(long packets) {
     std::printf("%10ld %14zu %+14ld %7zu KiB\n", i, heap,
                 static_cast<long>(heap) - static_cast<long>(heap_warm), rss_bytes() >> 10);
   }
-  GstStructure* stats = nullptr;
-  g_object_get(h->element, "stats", &stats, nullptr);
-  gchar* text = gst_structure_to_string(stats);
-  std::printf("stats: %s\n", text);
-  g_free(text);
-  gst_structure_free(stats);
+  std::printf("stats: %s\n", pfap::testing::stats_text(h->element).c_str());
   gst_harness_teardown(h);
   const size_t heap_after = heap_bytes();
   std::printf(

@@ -53,7 +53,6 @@
 #include <gst/rtp/gstrtpbuffer.h>
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <cstdint>
 #include <cstdio>
@@ -71,7 +70,7 @@
 
 namespace {
 
-using Settled = std::array<int32_t, pfap::kFapCount>;
+using pfap::testing::Settled;
 
 constexpr int kRedPt = 122;
 constexpr int kFecPt = 122;
@@ -85,6 +84,8 @@ constexpr int kFecPt = 122;
 // The session and the lossless receiver
 
 using Phoneme = pfap::testing::SpeechPhoneme;
+using pfap::testing::lossless_states;
+using pfap::testing::settled_of;
 using pfap::testing::speech_session;
 using pfap::testing::stat;
 
@@ -113,23 +114,6 @@ GstBuffer* phoneme_buffer(const Phoneme& p) {
   GST_BUFFER_PTS(buffer) = p.start_ns;
   GST_BUFFER_DURATION(buffer) = ph.duration_ms * GST_MSECOND;
   return buffer;
-}
-
-Settled settled_of(const pfap::FapState& state) {
-  Settled s{};
-  for (int f = pfap::kMinFapIndex; f <= pfap::kMaxFapIndex; ++f) s[f] = state.settled(f);
-  return s;
-}
-
-// The settled state of a lossless receiver after each phoneme.
-std::vector<Settled> lossless_states(const std::vector<Phoneme>& session) {
-  pfap::FapState state;
-  std::vector<Settled> out;
-  for (const Phoneme& p : session) {
-    for (const pfap::Fap& f : p.faps) state.apply(f, p.start_ns);
-    out.push_back(settled_of(state));
-  }
-  return out;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -637,17 +621,6 @@ class FecReceiver {
   }
 
  private:
-  guint64 declared_lost() {
-    GstStructure* s = nullptr;
-    g_object_get(jb_, "stats", &s, nullptr);
-    guint64 lost = 0;
-    if (s != nullptr) {
-      gst_structure_get_uint64(s, "num-lost", &lost);
-      gst_structure_free(s);
-    }
-    return lost;
-  }
-
   struct Snapshot {
     bool idle;
     guint pending;
@@ -658,7 +631,7 @@ class FecReceiver {
 
   Snapshot snapshot() {
     const guint pending = gst_test_clock_peek_id_count(clock_);
-    const guint64 lost = declared_lost();  // the timer thread counts them as it declares them
+    const guint64 lost = stat(jb_, "num-lost");  // the timer thread counts them as it declares them
     const guint64 events = counters_.lost_events.load();
     const guint64 handled = counters_.handled.load();
     const long last_out = counters_.last_out.load();

@@ -55,6 +55,7 @@
 #include <vector>
 
 #include "clocks.h"
+#include "heap.h"
 #include "pfap/fap_state.h"
 #include "pfap/markup_event.h"
 #include "pfap/model.h"
@@ -219,13 +220,7 @@ struct Memory {
 
 Memory memory() {
   Memory m;
-  if (FILE* f = std::fopen("/proc/self/statm", "r")) {
-    long size = 0, resident = 0;
-    if (std::fscanf(f, "%ld %ld", &size, &resident) == 2) {
-      m.rss = static_cast<double>(resident) * static_cast<double>(sysconf(_SC_PAGESIZE));
-    }
-    std::fclose(f);
-  }
+  m.rss = static_cast<double>(pfap::testing::rss_bytes());
   const struct mallinfo2 info = mallinfo2();
   m.heap = static_cast<double>(info.uordblks + info.hblkhd);
   return m;

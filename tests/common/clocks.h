@@ -1,7 +1,11 @@
-// CPU and wall-clock time in seconds, for benchmarks that print what they measure.
+// CPU and wall-clock time in seconds, and the median of repeated runs, for benchmarks that
+// print what they measure.
 #pragma once
 
 #include <time.h>
+
+#include <algorithm>
+#include <vector>
 
 namespace pfap::testing {
 
@@ -16,5 +20,12 @@ inline double cpu_seconds() { return seconds_of(CLOCK_PROCESS_CPUTIME_ID); }
 // CPU time of the calling thread only.
 inline double thread_cpu_seconds() { return seconds_of(CLOCK_THREAD_CPUTIME_ID); }
 inline double wall_seconds() { return seconds_of(CLOCK_MONOTONIC); }
+
+// The median of `v`, which must not be empty.
+inline double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2;
+}
 
 }  // namespace pfap::testing

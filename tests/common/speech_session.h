@@ -6,12 +6,15 @@
 // later FAPs start from where earlier ones left their FAP.
 //
 // Each phoneme carries its number in symbol (low 8 bits) and f0 (high 8 bits), so a receiver
-// can tell which phoneme it got whatever was lost.
+// can tell which phoneme it got whatever was lost. lossless_states() is what a receiver that
+// lost none of it holds after each phoneme.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
+#include "pfap/fap_state.h"
 #include "pfap/model.h"
 #include "random_markup.h"
 
@@ -63,6 +66,28 @@ inline std::vector<SpeechPhoneme> speech_session(uint32_t seed, int n_phonemes, 
       sentence_length = random.uniform(6, 14);
       t += int64_t{random.uniform(100, 300)} * kNsPerMs;
     }
+  }
+  return out;
+}
+
+// A FAP state's settled values by FAP index: what receivers are compared by, as they depend
+// only on the order of bookmarks, not on their times.
+using Settled = std::array<int32_t, kFapCount>;
+
+inline Settled settled_of(const FapState& state) {
+  Settled s{};
+  for (int f = kMinFapIndex; f <= kMaxFapIndex; ++f) s[f] = state.settled(f);
+  return s;
+}
+
+// What a receiver that lost nothing holds after each phoneme: the sender's FAPs applied in
+// order.
+inline std::vector<Settled> lossless_states(const std::vector<SpeechPhoneme>& session) {
+  FapState state;
+  std::vector<Settled> out;
+  for (const SpeechPhoneme& p : session) {
+    for (const Fap& f : p.faps) state.apply(f, p.start_ns);
+    out.push_back(settled_of(state));
   }
   return out;
 }

@@ -3,8 +3,10 @@
 #pragma once
 
 #include <gst/gst.h>
+#include <gtest/gtest.h>
 
 #include <chrono>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -136,6 +138,23 @@ class Pipeline {
   GstBus* bus_ = nullptr;
   std::string error_;
 };
+
+// Fails the test unless every named element can be made: the plugin comes from
+// GST_PLUGIN_PATH, which meson sets to the build's gst/ directory.
+inline ::testing::AssertionResult plugin_available(std::span<const char* const> elements) {
+  for (const char* name : elements) {
+    GstElementFactory* factory = gst_element_factory_find(name);
+    if (factory == nullptr) {
+      const char* path = g_getenv("GST_PLUGIN_PATH");
+      return ::testing::AssertionFailure()
+             << "no element " << name
+             << "; GST_PLUGIN_PATH=" << (path != nullptr ? path : "(unset)")
+             << " should be the build's gst/ directory";
+    }
+    gst_object_unref(factory);
+  }
+  return ::testing::AssertionSuccess();
+}
 
 inline GstFlowReturn push(GstElement* appsrc, GstBuffer* buffer) {
   GstFlowReturn ret = GST_FLOW_ERROR;

@@ -47,6 +47,8 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 
+// The plugin's elements the examples use.
+constexpr const char* kElements[] = {"pfapparse", "pfaptextenc", "rtppfappay", "rtppfapdepay"};
 constexpr const char* kSection = "## Text markup: sending and receiving a session";
 constexpr const char* kAlphabet = "x-pfap-arpabet";
 // rtpbin and rtspsrc time phonemes from arrival times and RTCP; they may move a line by a ms
@@ -282,8 +284,8 @@ class RtspServer {
 // ---------------------------------------------------------------------------------------------
 // Pipelines
 
-// A pipeline from a launch description, set to NULL and released on destruction.
 using pfap::testing::Pipeline;
+using pfap::testing::plugin_available;
 using pfap::testing::TempDir;
 
 // What flows out of an element's src pad: the bytes (text from pfaptextenc) and a count.
@@ -345,20 +347,6 @@ template <typename Done>
     }
     if (Clock::now() > deadline) return ::testing::AssertionFailure() << "timed out: " << what;
     std::this_thread::sleep_for(20ms);
-  }
-  return ::testing::AssertionSuccess();
-}
-
-::testing::AssertionResult plugin_available() {
-  for (const char* name : {"pfapparse", "pfaptextenc", "rtppfappay", "rtppfapdepay"}) {
-    GstElementFactory* factory = gst_element_factory_find(name);
-    if (factory == nullptr) {
-      const char* path = g_getenv("GST_PLUGIN_PATH");
-      return ::testing::AssertionFailure()
-             << "no element " << name << "; GST_PLUGIN_PATH=" << (path != nullptr ? path : "")
-             << " should be the build's gst/ directory";
-    }
-    gst_object_unref(factory);
   }
   return ::testing::AssertionSuccess();
 }
@@ -484,7 +472,7 @@ TEST(ExampleFiles, DescribedInReadme) {
 }
 
 TEST(ExampleFiles, EveryFileParses) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   for (const std::string& file : example_files()) {
     SCOPED_TRACE(file);
     Pipeline p("filesrc name=file ! pfapparse name=parse ! fakesink");
@@ -501,7 +489,7 @@ TEST(ExampleFiles, EveryFileParses) {
 
 // Canonical lines read and written back unchanged; comments are not written.
 TEST(ExampleFiles, ReadBackThroughTextEnc) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   for (const std::string& file : example_files()) {
     SCOPED_TRACE(file);
     Pipeline p("filesrc name=file ! pfapparse ! pfaptextenc ! fakesink");
@@ -581,7 +569,7 @@ struct Sdp {
 };
 
 TEST(Rtsp, ServesAudioAndPhonemes) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   const std::string file = source_path("docs/examples/hello.pfap");
   const std::string want = read_file(file);
   RtspServer server(file);
@@ -673,7 +661,7 @@ TEST(DocumentedLines, OneProcess) {
 }
 
 TEST(DocumentedLines, Udp) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   const std::vector<std::string> commands = documented_commands(kHeadings[1]);
   ASSERT_EQ(commands.size(), 2u);
   TempDir dir;
@@ -696,7 +684,7 @@ TEST(DocumentedLines, Udp) {
 }
 
 TEST(DocumentedLines, Rtpbin) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   const std::vector<std::string> commands = documented_commands(kHeadings[2]);
   ASSERT_EQ(commands.size(), 2u);
   TempDir dir;
@@ -727,7 +715,7 @@ TEST(DocumentedLines, Rtpbin) {
 }
 
 TEST(DocumentedLines, Rtsp) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   const std::vector<std::string> commands = documented_commands(kHeadings[3]);
   ASSERT_EQ(commands.size(), 2u);
   // The server command: the program, the file and the port, which becomes 0 (any free port).
@@ -807,7 +795,7 @@ TEST(Readme, EveryCommandIsTested) {
 
 // Speech into a WAV file and its phonemes into a .pfap file: the phonemes cover the audio.
 TEST(Readme, SpeaksIntoFiles) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   const std::vector<std::string> commands = readme_commands("### Into files");
   ASSERT_EQ(commands.size(), 1u);
   TempDir dir;
@@ -834,7 +822,7 @@ TEST(Readme, SpeaksIntoFiles) {
 
 // The same speech served over RTP, and a receiver writing both streams to files.
 TEST(Readme, ServesOverRtp) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   const std::vector<std::string> commands = readme_commands("### Over RTP");
   ASSERT_EQ(commands.size(), 2u);
   TempDir dir;
@@ -889,7 +877,7 @@ long long number_after(const std::string& text, const std::string& label) {
 }
 
 TEST(Story, SpeaksSendsWithLossRendersAndMuxes) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   TempDir dir;
   const ProcessResult r = run(
       {PFAP_STORY, "--text=Hello <FAP 2 1 40 0 0 500 1> world. How are you today?", "--drop=0.4",

@@ -38,6 +38,7 @@ using pfap::MarkupEvent;
 using pfap::Phoneme;
 using pfap::testing::markup_buffer;
 using pfap::testing::Pipeline;
+using pfap::testing::pop_messages;
 using pfap::testing::TempDir;
 
 constexpr GstClockTime kMs = GST_MSECOND;
@@ -61,24 +62,6 @@ GstBuffer* phoneme(const char* name, GstClockTime pts, uint16_t duration_ms,
 
 Fap fap(int index, int32_t amplitude, uint16_t transition_ms = 0, Curve curve = Curve::kLinear) {
   return {static_cast<uint8_t>(index), amplitude, transition_ms, curve};
-}
-
-std::vector<std::string> pop_messages(GstBus* bus, GstMessageType type) {
-  std::vector<std::string> texts;
-  while (GstMessage* m = gst_bus_pop_filtered(bus, type)) {
-    GError* error = nullptr;
-    gchar* debug = nullptr;
-    if (type == GST_MESSAGE_WARNING) {
-      gst_message_parse_warning(m, &error, &debug);
-    } else {
-      gst_message_parse_error(m, &error, &debug);
-    }
-    texts.push_back(std::string(error->message) + " (" + (debug ? debug : "") + ")");
-    g_clear_error(&error);
-    g_free(debug);
-    gst_message_unref(m);
-  }
-  return texts;
 }
 
 // A frame's pixels, 4 bytes each (B, G, R, x on little-endian), rows packed.

@@ -19,14 +19,12 @@
 #include <condition_variable>
 #include <cstdint>
 #include <cstdlib>
-#include <cstring>
 #include <iostream>
 #include <memory>
 #include <mutex>
 #include <sstream>
 #include <string>
 #include <thread>
-#include <unordered_map>
 #include <vector>
 
 #include "lip_sync.h"
@@ -35,15 +33,18 @@
 #include "pfap_buffers.h"
 #include "pipeline.h"
 #include "random_markup.h"
+#include "speech_session.h"
 
 namespace {
 
 using pfap::testing::Event;
+using pfap::testing::number_of;
 using pfap::testing::RandomMarkup;
 using Clock = std::chrono::steady_clock;
 
 constexpr const char* kPay = "rtppfappay";
 constexpr const char* kDepay = "rtppfapdepay";
+constexpr const char* kElements[] = {kPay, kDepay};  // what plugin_available() looks for
 
 // ---------------------------------------------------------------------------------------------
 // Small helpers
@@ -79,29 +80,13 @@ GstBuffer* make_buffer(const Event& e) {
                                        (e.flags & PFAP_FLAG_SENTENCE_START) != 0);
 }
 
-// A pipeline from a gst-launch description, set to NULL and released on destruction.
 using pfap::testing::bound_port;
 using pfap::testing::end_of_stream;
 using pfap::testing::fast_rtcp;
 using pfap::testing::Pipeline;
+using pfap::testing::plugin_available;
 using pfap::testing::pull_all;
 using pfap::testing::push;
-
-// Fails the test unless the plugin's elements can be made.
-::testing::AssertionResult plugin_available() {
-  for (const char* name : {kPay, kDepay}) {
-    GstElementFactory* factory = gst_element_factory_find(name);
-    if (factory == nullptr) {
-      const char* path = g_getenv("GST_PLUGIN_PATH");
-      return ::testing::AssertionFailure()
-             << "no element " << name
-             << "; GST_PLUGIN_PATH=" << (path != nullptr ? path : "(unset)")
-             << " should be the build's gst/ directory";
-    }
-    gst_object_unref(factory);
-  }
-  return ::testing::AssertionSuccess();
-}
 
 // ---------------------------------------------------------------------------------------------
 // Round trip: appsrc ! rtppfappay ! rtppfapdepay ! appsink keeps every field.
@@ -141,7 +126,7 @@ std::vector<Event> random_session(uint32_t seed, int n_phonemes) {
 }
 
 TEST(RoundTrip, KeepsEveryField) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   struct Config {
     unsigned mtu;
     unsigned max_delay_ms;
@@ -197,7 +182,7 @@ TEST(RoundTrip, KeepsEveryField) {
 // SDP: the payloader's caps as an SDP media, and back.
 
 TEST(Sdp, PayloaderCapsGiveFmtpAndBackIntoDepayloader) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   Event e;
   e.phoneme = {42, 80, 60, true, true, true};
   e.faps = {{69, 40, 2000, pfap::Curve::kSpline}};
@@ -468,17 +453,17 @@ void check_element_inspect(const char* name, const char* own_property) {
 }
 
 TEST(GstInspect, Payloader) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   check_element_inspect(kPay, "max-delay");
 }
 
 TEST(GstInspect, Depayloader) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   check_element_inspect(kDepay, "stats");
 }
 
 TEST(GstInspect, PluginListsAllElements) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   const Inspect r = gst_inspect("pfap");
   ASSERT_EQ(r.exit_status, 0) << r.err;
   SCOPED_TRACE("gst-inspect-1.0 pfap:\n" + r.out);
@@ -589,8 +574,6 @@ std::vector<Event> live_phonemes() {
   return events;
 }
 
-int index_of(const Event& e) { return e.phoneme.symbol + 256 * e.phoneme.f0; }
-
 // The sender's side of the phoneme stream: pushes each phoneme when the pipeline's running
 // time reaches its start, as a live TTS source would.
 void push_live(GstElement* appsrc, GstClock* clock, GstClockTime base_time,
@@ -608,7 +591,7 @@ void push_live(GstElement* appsrc, GstClock* clock, GstClockTime base_time,
 }
 
 TEST(LoopbackUdp, PhonemesKeepLipSyncWithAudio) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   const std::vector<Event> sent = live_phonemes();
   const Event& last = sent.back();
   // What the pipelines' callbacks write to outlives the pipelines.
@@ -702,7 +685,8 @@ TEST(LoopbackUdp, PhonemesKeepLipSyncWithAudio) {
     std::unique_lock lock(received.mutex);
     for (;;) {
       const bool all_phonemes =
-          !received.phonemes.empty() && index_of(received.phonemes.back().event) == index_of(last);
+          !received.phonemes.empty() &&
+          number_of(received.phonemes.back().event.phoneme) == number_of(last.phoneme);
       bool enough_audio = false;
       if (!received.audio.empty()) {
         // The sender's audio starts at running time 0, so the audio received so far reaches

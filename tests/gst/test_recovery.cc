@@ -28,7 +28,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -54,21 +53,25 @@
 namespace {
 
 using pfap::testing::Event;
+using pfap::testing::lossless_states;
 using pfap::testing::number_of;
+using pfap::testing::Settled;
+using pfap::testing::settled_of;
+using pfap::testing::speech_session;
+using pfap::testing::SpeechPhoneme;
 using pfap::testing::stat;
 using pfap::testing::stats_text;
 using Clock = std::chrono::steady_clock;
-using Settled = std::array<int32_t, pfap::kFapCount>;
+
+constexpr const char* kElements[] = {"rtppfappay", "rtppfapdepay"};  // the plugin's, under test
 
 // ---------------------------------------------------------------------------------------------
 // Sessions and FAP states
 
-// The seeded speech session of speech_session.h as x-pfap phoneme events.
-std::vector<Event> speech_session(uint32_t seed, int n_phonemes, double fap_chance,
-                                  GstClockTime start = 0) {
+// A seeded speech session of speech_session.h as x-pfap phoneme events.
+std::vector<Event> events_of(const std::vector<SpeechPhoneme>& session) {
   std::vector<Event> events;
-  for (const pfap::testing::SpeechPhoneme& p :
-       pfap::testing::speech_session(seed, n_phonemes, fap_chance, start)) {
+  for (const SpeechPhoneme& p : session) {
     Event e;
     e.phoneme = p.phoneme;
     e.faps = p.faps;
@@ -78,24 +81,6 @@ std::vector<Event> speech_session(uint32_t seed, int n_phonemes, double fap_chan
     events.push_back(e);
   }
   return events;
-}
-
-Settled settled_of(const pfap::FapState& state) {
-  Settled s{};
-  for (int f = pfap::kMinFapIndex; f <= pfap::kMaxFapIndex; ++f) s[f] = state.settled(f);
-  return s;
-}
-
-// What every receiver that lost nothing holds after each phoneme: the sender's FAPs applied
-// in order.
-std::vector<Settled> sender_states(const std::vector<Event>& sent) {
-  pfap::FapState state;
-  std::vector<Settled> out;
-  for (const Event& e : sent) {
-    for (const pfap::Fap& f : e.faps) state.apply(f, static_cast<int64_t>(e.pts));
-    out.push_back(settled_of(state));
-  }
-  return out;
 }
 
 std::string differences(const Settled& got, const Settled& want) {
@@ -149,14 +134,12 @@ class ReceiverState {
 using pfap::testing::bound_port;
 using pfap::testing::fast_rtcp;
 using pfap::testing::Pipeline;
+using pfap::testing::plugin_available;
 
 GstFlowReturn push(GstElement* appsrc, const Event& e) {
-  GstBuffer* buffer = pfap::testing::phoneme_buffer(e.phoneme, e.faps, e.pts,
-                                                    (e.flags & PFAP_FLAG_SENTENCE_START) != 0);
-  GstFlowReturn ret = GST_FLOW_ERROR;
-  g_signal_emit_by_name(appsrc, "push-buffer", buffer, &ret);
-  gst_buffer_unref(buffer);
-  return ret;
+  return pfap::testing::push(
+      appsrc, pfap::testing::phoneme_buffer(e.phoneme, e.faps, e.pts,
+                                            (e.flags & PFAP_FLAG_SENTENCE_START) != 0));
 }
 
 GstFlowReturn push_harness(GstHarness* h, const Event& e) {
@@ -173,21 +156,6 @@ bool is_complete_recovery(GstBuffer* buffer) {
                         (static_cast<const uint8_t*>(gst_rtp_buffer_get_payload(&rtp))[0] & 0x80);
   gst_rtp_buffer_unmap(&rtp);
   return complete;
-}
-
-::testing::AssertionResult plugin_available() {
-  for (const char* name : {"rtppfappay", "rtppfapdepay"}) {
-    GstElementFactory* factory = gst_element_factory_find(name);
-    if (factory == nullptr) {
-      const char* path = g_getenv("GST_PLUGIN_PATH");
-      return ::testing::AssertionFailure()
-             << "no element " << name
-             << "; GST_PLUGIN_PATH=" << (path != nullptr ? path : "(unset)")
-             << " should be the build's gst/ directory";
-    }
-    gst_object_unref(factory);
-  }
-  return ::testing::AssertionSuccess();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -268,11 +236,12 @@ void push_live(GstElement* appsrc, GstClock* clock, GstClockTime base_time,
 }
 
 TEST(RecoveryLoop, PliBringsACompleteStateAfterALongBurst) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   // About 4 s of speech from 300 ms on; nearly every phoneme moves a FAP, so the burst surely
   // loses state.
-  const std::vector<Event> sent = speech_session(11, 44, 0.9, 300 * GST_MSECOND);
-  const std::vector<Settled> want = sender_states(sent);
+  const std::vector<SpeechPhoneme> session = speech_session(11, 44, 0.9, 300 * GST_MSECOND);
+  const std::vector<Event> sent = events_of(session);
+  const std::vector<Settled> want = lossless_states(session);
   LoopRecord record;
   // Packets 12..16 are lost: 5 in a row, more than the coverage of 1. Packet 0 is the
   // complete recovery every stream starts with.
@@ -534,17 +503,13 @@ SessionRun run_session(const std::vector<Event>& sent, const std::string& pay_pr
       return out;
     }
   }
-  GstFlowReturn ret = GST_FLOW_ERROR;
-  g_signal_emit_by_name(src, "end-of-stream", &ret);
+  pfap::testing::end_of_stream(src);
   const std::string eos = p.wait_eos(std::chrono::seconds(30));
   EXPECT_EQ(eos, "");
   if (!eos.empty()) return out;
 
   ReceiverState state;
-  for (;;) {
-    GstSample* sample = nullptr;
-    g_signal_emit_by_name(p.by_name("sink"), "try-pull-sample", GstClockTime{0}, &sample);
-    if (sample == nullptr) break;
+  for (GstSample* sample : pfap::testing::pull_all(p.by_name("sink"))) {
     const Received r = state.apply(pfap::testing::read_event(gst_sample_get_buffer(sample)));
     gst_sample_unref(sample);
     if (r.number >= 0) out.phonemes.push_back(r);
@@ -635,8 +600,9 @@ class RecoveryRandomLoss : public ::testing::Test {
   static constexpr int kPhonemes = 3000;
 
   static void SetUpTestSuite() {
-    session_ = new std::vector<Event>(speech_session(2024, kPhonemes, 0.45));
-    lossless_ = new std::vector<Settled>(sender_states(*session_));
+    const std::vector<SpeechPhoneme> session = speech_session(2024, kPhonemes, 0.45);
+    session_ = new std::vector<Event>(events_of(session));
+    lossless_ = new std::vector<Settled>(lossless_states(session));
   }
   static void TearDownTestSuite() {
     delete session_;
@@ -659,7 +625,7 @@ std::vector<Settled>* RecoveryRandomLoss::lossless_ = nullptr;
 // The lossless receiver: every phoneme, whole, with the sender's state. The other tests
 // compare with the sender's states, which this shows to be the lossless receiver's.
 TEST_F(RecoveryRandomLoss, LosslessReceiverHasTheSendersState) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   for (unsigned depth : {0u, 4u}) {
     SCOPED_TRACE("recovery-depth " + std::to_string(depth));
     const SessionRun run = run_session(*session_, pay(depth), true, {});
@@ -678,7 +644,7 @@ TEST_F(RecoveryRandomLoss, LosslessReceiverHasTheSendersState) {
 }
 
 TEST_F(RecoveryRandomLoss, BurstsWithinTheDepthLeaveTheStateExact) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   for (unsigned depth : {1u, 4u, 15u}) {
     for (double loss : {0.01, 0.05, 0.10, 0.20}) {
       const LossPattern pattern{LossPattern::Kind::kWithinDepth, loss, depth,
@@ -708,7 +674,7 @@ TEST_F(RecoveryRandomLoss, BurstsWithinTheDepthLeaveTheStateExact) {
 // request goes upstream to the payloader in the same pipeline); every phoneme not flagged
 // is exact.
 TEST_F(RecoveryRandomLoss, LongerBurstsAreExactWheneverNotUncertain) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   constexpr unsigned kDepth = 4;
   for (double loss : {0.01, 0.05, 0.10, 0.20}) {
     const LossPattern pattern{LossPattern::Kind::kBursts, loss, 12,
@@ -733,7 +699,7 @@ TEST_F(RecoveryRandomLoss, LongerBurstsAreExactWheneverNotUncertain) {
 // The comparison can see lost FAPs: without recovery, the same kind of loss leaves the
 // state wrong for a large share of the phonemes (over a third at 5 % loss, over half at 20 %).
 TEST_F(RecoveryRandomLoss, WithoutRecoveryTheStateDiffers) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   for (double loss : {0.05, 0.20}) {
     const LossPattern pattern{LossPattern::Kind::kWithinDepth, loss, 4,
                               400 + static_cast<uint32_t>(loss * 100)};
@@ -829,16 +795,19 @@ GstElement* harness_element(GstHarness* h, const char* name) {
   return e;
 }
 
-guint64 jitterbuffer_stat(GstHarness* h, const char* field) {
+// The packets rtpjitterbuffer has handled: pushed on, or dropped as late or duplicate.
+guint64 jitterbuffer_handled(GstElement* jb) {
   GstStructure* s = nullptr;
-  g_object_get(harness_element(h, "jb"), "stats", &s, nullptr);
-  guint64 value = 0;
-  gst_structure_get_uint64(s, field, &value);
+  g_object_get(jb, "stats", &s, nullptr);
+  guint64 handled = 0;
+  for (const char* field : {"num-pushed", "num-late", "num-duplicates"}) {
+    guint64 value = 0;
+    gst_structure_get_uint64(s, field, &value);
+    handled += value;
+  }
   gst_structure_free(s);
-  return value;
+  return handled;
 }
-
-guint64 jitterbuffer_pushed(GstHarness* h) { return jitterbuffer_stat(h, "num-pushed"); }
 
 // What the receiver made of the session, phoneme by phoneme, counted as it came: nothing
 // grows with the session's length, so that the heap measures the elements.
@@ -898,13 +867,12 @@ struct JitterbufferInput {
 // dropped a packet without counting it); takes the output as it comes. Without this the test
 // thread would run seconds of stream time ahead of the jitterbuffer's, and a complete state
 // asked for would queue behind all of it: a receiver does not lag its sender so in real time.
-void catch_up(GstHarness* h, GstTestClock* clock, JitterbufferInput& in, ReceiverState& state,
-              const std::vector<Settled>& lossless, SoakCount& c, bool& eos) {
+void catch_up(GstHarness* h, GstElement* jb, GstTestClock* clock, JitterbufferInput& in,
+              ReceiverState& state, const std::vector<Settled>& lossless, SoakCount& c, bool& eos) {
   guint64 last = G_MAXUINT64;
   for (int still = 0;; g_usleep(20)) {
     take_output(h, state, lossless, c, eos);
-    const guint64 handled = jitterbuffer_pushed(h) + jitterbuffer_stat(h, "num-late") +
-                            jitterbuffer_stat(h, "num-duplicates") + in.uncounted;
+    const guint64 handled = jitterbuffer_handled(jb) + in.uncounted;
     const guint64 arrived = in.arrived.load();
     if (handled >= arrived) return;
     still = handled == last ? still + 1 : 0;
@@ -919,7 +887,7 @@ void catch_up(GstHarness* h, GstTestClock* clock, JitterbufferInput& in, Receive
 
 // PFAP_SOAK_MINUTES sets the stream time (default 60).
 TEST(RecoverySoak, AnHourThroughNetsimAndRtpjitterbuffer) {
-  ASSERT_TRUE(plugin_available());
+  ASSERT_TRUE(plugin_available(kElements));
   const char* minutes_env = g_getenv("PFAP_SOAK_MINUTES");
   const int minutes = minutes_env != nullptr ? std::atoi(minutes_env) : 60;
   ASSERT_GT(minutes, 1);
@@ -927,9 +895,10 @@ TEST(RecoverySoak, AnHourThroughNetsimAndRtpjitterbuffer) {
   // About 11 phonemes per second of stream time; one phoneme in three moves FAPs.
   const int n = static_cast<int>(minutes * 60 * 12);
   ASSERT_LT(n, 65536) << "phoneme numbers are 16 bits";
-  const std::vector<Event> sent = speech_session(60, n, 0.35);
+  const std::vector<SpeechPhoneme> session = speech_session(60, n, 0.35);
+  const std::vector<Event> sent = events_of(session);
   ASSERT_GE(sent.back().pts, length);
-  const std::vector<Settled> lossless = sender_states(sent);
+  const std::vector<Settled> lossless = lossless_states(session);
 
   // Coverage 1: a single loss is repaired, two in a row are not (about one packet in a
   // hundred at 10 % loss): the test sees both.
@@ -943,7 +912,8 @@ TEST(RecoverySoak, AnHourThroughNetsimAndRtpjitterbuffer) {
   GstTestClock* clock = gst_harness_get_testclock(h);
   gst_harness_set_src_caps_str(h, "application/x-pfap");
   GstPad* net_src = gst_element_get_static_pad(harness_element(h, "net"), "src");
-  GstPad* jb_sink = gst_element_get_static_pad(harness_element(h, "jb"), "sink");
+  GstElement* jb = harness_element(h, "jb");
+  GstPad* jb_sink = gst_element_get_static_pad(jb, "sink");
   Reorderer reorderer(jb_sink);
   JitterbufferInput jb_input;
   gst_pad_add_probe(jb_sink, GST_PAD_PROBE_TYPE_BUFFER, count_buffer, &jb_input.arrived, nullptr);
@@ -973,7 +943,7 @@ TEST(RecoverySoak, AnHourThroughNetsimAndRtpjitterbuffer) {
       calm_set = true;
     }
     ASSERT_EQ(push_harness(h, e), GST_FLOW_OK);
-    catch_up(h, clock, jb_input, state, lossless, count, eos);
+    catch_up(h, jb, clock, jb_input, state, lossless, count, eos);
     if (e.pts >= next_sample) {
       const size_t heap = pfap::testing::heap_bytes();
       if (heap_warm == 0) heap_warm = heap;
@@ -1000,8 +970,8 @@ TEST(RecoverySoak, AnHourThroughNetsimAndRtpjitterbuffer) {
   SCOPED_TRACE("depayloader " + stats);
   const guint64 lost = stat(depay, "lost"), recovered = stat(depay, "recovered"),
                 requests = stat(depay, "requests");
-  const guint64 duplicates = jitterbuffer_stat(h, "num-duplicates");
-  const guint64 pushed = jitterbuffer_pushed(h);
+  const guint64 duplicates = stat(jb, "num-duplicates");
+  const guint64 pushed = stat(jb, "num-pushed");
 
   // Every phoneme not flagged uncertain has the sender's state, in order.
   EXPECT_EQ(count.differing, 0) << count.first_difference;

@@ -182,7 +182,7 @@ TEST(Speech, LongPhonemesAreSplit) {
   e.sentence_start = true;
   e.faps = {{69, 40, 500, Curve::kLinear}};
   std::vector<SpokenPhoneme> out;
-  add_phoneme(e, 22050, 11 * 22050, 22050, "m", out);
+  add_phoneme(e, 22050, 11 * 22050, 22050, out);
   ASSERT_EQ(out.size(), 3u);
   EXPECT_EQ(out[0].event.phoneme.duration_ms, 4095);
   EXPECT_EQ(out[1].event.phoneme.duration_ms, 4095);
@@ -206,7 +206,7 @@ TEST(Speech, LongPhonemesAreSplit) {
 TEST(Speech, DurationsOnTheUtterancesMsGrid) {
   MarkupEvent e;
   std::vector<SpokenPhoneme> out;
-  add_phoneme(e, 9, 1777, 22050, "a", out);
+  add_phoneme(e, 9, 1777, 22050, out);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].event.phoneme.duration_ms, 81);
   EXPECT_EQ(out[0].n_samples, 1768u);

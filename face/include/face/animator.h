@@ -55,6 +55,9 @@ class Animator {
   // whose bookmarked amplitude is not 0, as "index:amplitude".
   std::string describe(int64_t time_ns) const;
 
+  // The time of the last event applied, as apply() took it (0 before any).
+  int64_t last_ns() const { return last_ns_; }
+
   // When the last phoneme is over and the last transition has ended.
   int64_t end_ns() const { return end_ns_; }
 

@@ -31,7 +31,7 @@ enum class BookmarkStatus : uint8_t {
   kAmplitudeOutOfRange,   // |a| > 2529600
   kTransitionOutOfRange,  // T < 0 or T > 16383
   kCurveOutOfRange,       // C outside 1..3
-  kTooManyBookmarks,      // more than 40 consecutive bookmarks
+  kTooManyBookmarks,      // more consecutive bookmarks than allowed (40 by default)
   kUnexpectedText,        // something other than white space between bookmarks
 };
 
@@ -48,9 +48,10 @@ struct BookmarkResult {
 // or 2) to `out` and moves `pos` past the closing '>'; on error `out` and `pos` are unchanged.
 BookmarkResult parse_bookmark(std::string_view text, size_t& pos, std::vector<Fap>& out);
 
-// Parses a run of at most 40 bookmarks separated by optional white space, the whole of
-// `text`. On error `out` is unchanged.
-BookmarkResult parse_bookmarks(std::string_view text, std::vector<Fap>& out);
+// Parses a run of at most `max_bookmarks` bookmarks (MPEG-4 allows 40 before a phoneme)
+// separated by optional white space, the whole of `text`. On error `out` is unchanged.
+BookmarkResult parse_bookmarks(std::string_view text, std::vector<Fap>& out,
+                               size_t max_bookmarks = kMaxBookmarksPerPhoneme);
 
 // The transformed single-amplitude form "<FAP n a T C>", n in 3..74, one per FAP, no spaces
 // between bookmarks; appended to `out`.
