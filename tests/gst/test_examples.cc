@@ -889,6 +889,8 @@ TEST(Story, SpeaksSendsWithLossRendersAndMuxes) {
   const long long lost = number_after(r.out, "phonemes, ");  // packets found lost
   const long long frames = number_after(r.out, "story.webm: ");
   ASSERT_GT(sent, 5) << r.out;
+  ASSERT_GE(arrived, 0) << r.out;
+  ASSERT_GE(lost, 0) << r.out;
   // netsim drops (at 40 %, all of 15 packets pass once in 2000 runs), and rtpbin may keep
   // back more: a new source is on probation until two packets follow each other, and heavy
   // loss can keep it there. The depayloader counts by sequence number what did not reach it:

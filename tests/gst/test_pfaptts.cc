@@ -303,6 +303,7 @@ TEST(PfapTts, UtterancePtsGivesSilenceAndGap) {
   ASSERT_EQ(t.say("First.", 0), GST_FLOW_OK);
   const uint64_t first_end = total_samples(t.audio());
   const std::vector<Event> first = t.phonemes();
+  ASSERT_FALSE(first.empty());
   std::vector<GstEvent*> no_gaps = Tts::events(t.pfap_harness(), GST_EVENT_GAP);
   EXPECT_TRUE(no_gaps.empty());
   unref_all(no_gaps);

@@ -789,7 +789,9 @@ TEST(RtpPfapPay, DefaultRecoveryDepthCoversFourPackets) {
   Payloader pay;
   one_packet_per_phoneme(pay);
   pay.push(sentence(0, 3, 40, true));
-  for (const RtpPacket& p : pay.pull_data()) {
+  const std::vector<RtpPacket> data = pay.pull_data();
+  ASSERT_EQ(data.size(), 3u);
+  for (const RtpPacket& p : data) {
     EXPECT_EQ(p.packet.recovery_kind, pfap::RecoveryKind::kDynamic);
     EXPECT_EQ(p.packet.covered_packets, 4u);
   }

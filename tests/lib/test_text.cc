@@ -2,6 +2,7 @@
 
 #include <set>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -99,8 +100,7 @@ TEST(ReadLine, PhonemeFieldsGoToTheirPlaces) {
 
 TEST(ReadLine, EveryFieldTakesZeroAndItsMaximum) {
   EXPECT_EQ(read_one("0 0 0 0 -"), phoneme_event(0, 0, 0, 0));
-  EXPECT_EQ(read_one("9223372032759 255 4095 510 -"),
-            phoneme_event(9223372032759, 255, 4095, 510));
+  EXPECT_EQ(read_one("9223372032759 255 4095 510 -"), phoneme_event(9223372032759, 255, 4095, 510));
 }
 
 TEST(ReadLine, NumbersTakeASignAndLeadingZerosAsInBookmarks) {
@@ -562,8 +562,10 @@ TEST(RoundTrip, EveryPrefixOfALineIsReadWithinTheLine) {
                                "10 state complete <FAP 3 -2529600 0 3><FAP 4 1 2 1>\r"};
   for (const std::string& line : lines) {
     for (size_t size = 0; size <= line.size(); ++size) {
-      // A copy of exactly `size` bytes, so that reading past it is a heap overflow.
-      const std::string prefix = line.substr(0, size);
+      // A heap copy of exactly `size` bytes, so that reading past it is a heap overflow (a short
+      // std::string keeps its bytes inline, with a NUL after them).
+      const std::vector<char> bytes(line.begin(), line.begin() + static_cast<long>(size));
+      const std::string_view prefix(bytes.data(), bytes.size());
       TextReader reader;
       TextEvent out;
       bool has_event = false;

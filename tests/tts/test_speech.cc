@@ -116,9 +116,11 @@ TEST(Speech, BookmarksFollowTheMpegRule) {
   EXPECT_EQ(index_of_fap(3), hello) << "before the first word";
   EXPECT_EQ(index_of_fap(4), world) << "between words: the next word's first phoneme";
   EXPECT_EQ(index_of_fap(5), how - 3) << "before the full stop: world's last phoneme (D)";
+  ASSERT_GE(index_of_fap(5), 0);
   EXPECT_EQ(name(s.phonemes[index_of_fap(5)]), "D");
   EXPECT_EQ(index_of_fap(6), how) << "after the full stop: the next sentence's first word";
   EXPECT_EQ(index_of_fap(7), you + 1) << "before the question mark: you's last phoneme";
+  ASSERT_GE(index_of_fap(7), 0);
   EXPECT_EQ(name(s.phonemes[index_of_fap(7)]), "UW");
   EXPECT_EQ(index_of_fap(8), you + 1) << "at the end of the text: you's last phoneme";
 }
@@ -135,6 +137,7 @@ TEST(Speech, BookmarkAfterAFullStopBeforeMoreText) {
     }
   }
   EXPECT_EQ(with_fap, second_sentence) << describe(s);
+  ASSERT_GE(with_fap, 0) << describe(s);
   EXPECT_EQ(name(s.phonemes[with_fap]), "G");
 }
 
