@@ -286,8 +286,8 @@ int main(int argc, char** argv) {
     GstElementFactory* factory = gst_element_factory_find(name);
     if (factory == nullptr) {
       std::fprintf(stderr,
-                   "pfap-loopback: no element %s: set GST_PLUGIN_PATH to the directory of "
-                   "libgstpfap.so (for example build/gst)\n",
+                   "pfap-loopback: no element %s: set GST_PLUGIN_PATH to the directories of "
+                   "the pfap plugins (for example build/gst:build/ext)\n",
                    name);
       return 1;
     }

@@ -18,7 +18,7 @@
 // time. Printed: each run, then the medians, items/s and the ratio to rtpgst.
 //
 // Run: meson test -C build --benchmark --verbose elements
-//  or: GST_PLUGIN_PATH=build/gst build/tests/bench/bench_elements [N [repetitions]]
+//  or: GST_PLUGIN_PATH=build/gst:build/ext build/tests/bench/bench_elements [N [repetitions]]
 #include <gst/gst.h>
 
 #include <atomic>

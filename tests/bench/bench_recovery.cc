@@ -45,7 +45,7 @@
 // rtpulpfecdec finds in rtpstorage exactly what had arrived by then (FecReceiver).
 //
 // Run: meson test -C build --benchmark --suite gst --verbose recovery
-//  or: GST_PLUGIN_PATH=build/gst build/tests/bench/bench_recovery [phonemes [only]]
+//  or: GST_PLUGIN_PATH=build/gst:build/ext build/tests/bench/bench_recovery [phonemes [only]]
 // (`only`: run just the protections whose name contains it, beside "none").
 #include <gst/check/gstharness.h>
 #include <gst/check/gsttestclock.h>
