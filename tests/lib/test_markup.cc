@@ -174,5 +174,28 @@ TEST(MarkupEvent, InvalidEventsAndWrongSizesAreRefused) {
   EXPECT_FALSE(read_markup(Bytes{0x01, 0, 0, 0}, back));
 }
 
+TEST(MarkupEvent, ApplyStartsEachFapAndACompleteStateResetsTheRest) {
+  FapState state;
+  MarkupEvent phoneme;
+  phoneme.faps = {{3, 100, 10, Curve::kLinear}, {4, -50, 0, Curve::kLinear}};
+  apply_markup(phoneme, 1'000'000'000, state);
+  EXPECT_EQ(state.amplitude(3, 1'005'000'000), 50);
+  EXPECT_EQ(state.settled(4), -50);
+
+  MarkupEvent complete;
+  complete.kind = PFAP_EVENT_COMPLETE;
+  complete.faps = {{3, 7, 0, Curve::kLinear}};
+  apply_markup(complete, 2'000'000'000, state);
+  EXPECT_EQ(state.settled(3), 7);
+  EXPECT_EQ(state.settled(4), 0);
+
+  MarkupEvent recovered;
+  recovered.kind = PFAP_EVENT_RECOVERED;
+  recovered.faps = {{5, 9, 0, Curve::kLinear}};
+  apply_markup(recovered, 3'000'000'000, state);
+  EXPECT_EQ(state.settled(3), 7);
+  EXPECT_EQ(state.settled(5), 9);
+}
+
 }  // namespace
 }  // namespace pfap

@@ -6,6 +6,7 @@
 #include <span>
 #include <vector>
 
+#include "pfap/fap_state.h"
 #include "pfap/markup.h"
 #include "pfap/model.h"
 
@@ -30,5 +31,9 @@ bool write_markup(const MarkupEvent& event, std::span<uint8_t> out);
 
 // Reads a whole event; false when the bytes are not a valid event.
 bool read_markup(std::span<const uint8_t> bytes, MarkupEvent& out);
+
+// Applies `event` at `time_ns` (its buffer's time) to a receiver's `state`: a complete state
+// first returns every FAP to 0, then each of the event's FAPs starts at `time_ns`.
+void apply_markup(const MarkupEvent& event, int64_t time_ns, FapState& state);
 
 }  // namespace pfap
