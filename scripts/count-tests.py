@@ -1,6 +1,7 @@
 """Counts the test cases behind meson test logs: GoogleTest cases from each gtest program's
-result lines, one case for any other test. With one log, prints 'tests: N passed, M failed';
-with several (one per build), a line for each and then that line for them all."""
+result lines, pytest's from its summary line, one case for any other test. With one log,
+prints 'tests: N passed, M failed'; with several (one per build), a line for each and then
+that line for them all."""
 import json
 import re
 import sys
@@ -14,6 +15,13 @@ def count(path):
             out = test.get("stdout") or ""
             ok = len(re.findall(r"^\[       OK \]", out, re.M))
             bad = len(re.findall(r"^\[  FAILED  \] .*\(\d+ ms\)$", out, re.M))
+            # pytest (tests/python): its closing summary, "== 3 failed, 21 passed in 2.1s ==".
+            summary = re.findall(r"^=+ (.*\d+ (?:passed|failed|errors?).*) in [\d.]+s.* =+$",
+                                 out, re.M)
+            if summary and not (ok or bad):
+                words = dict((w, int(n)) for n, w in re.findall(r"(\d+) (\w+)", summary[-1]))
+                ok = words.get("passed", 0)
+                bad = words.get("failed", 0) + words.get("error", 0) + words.get("errors", 0)
             if ok or bad:
                 passed, failed = passed + ok, failed + bad
                 if test["result"] != "OK" and not bad:

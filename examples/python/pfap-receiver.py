@@ -1,0 +1,104 @@
+#!/usr/bin/python3
+"""Prints the phonemes and FAPs of a PFAP RTP stream received on UDP.
+
+    udpsrc ! rtpjitterbuffer ! rtppfapdepay ! appsink
+
+Each application/x-pfap buffer from appsink is read with GstPfap.Event (libgstpfap through
+GObject-Introspection), phoneme symbols named with the stream's alphabet. Send it something:
+
+    gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfapparse alphabet=x-pfap-arpabet ! \\
+        rtppfappay ! udpsink host=127.0.0.1 port=5004
+
+From a build tree, point GI_TYPELIB_PATH and LD_LIBRARY_PATH at build/gst-libs/gst/pfap (and
+build/lib) and GST_PLUGIN_PATH at build/gst (docs/apps.md).
+"""
+import argparse
+import sys
+
+import gi
+
+gi.require_version("Gst", "1.0")
+gi.require_version("GstApp", "1.0")
+gi.require_version("GstPfap", "1.0")
+from gi.repository import GLib, Gst, GstApp, GstPfap  # noqa: E402,F401
+
+FLAG_NAMES = [(GstPfap.EventFlags.STRESS, "stress"), (GstPfap.EventFlags.WORD_BEGIN, "word"),
+              (GstPfap.EventFlags.END_OF_TEXT, "end-of-text"),
+              (GstPfap.EventFlags.SENTENCE_START, "sentence"),
+              (GstPfap.EventFlags.UNCERTAIN, "uncertain")]
+
+
+def describe(event, pts, alphabet):
+    kind = event.get_kind()
+    time = "%.3f" % (pts / Gst.SECOND) if pts != Gst.CLOCK_TIME_NONE else "-"
+    flags = ",".join(name for flag, name in FLAG_NAMES if event.get_flags() & flag)
+    if kind == GstPfap.EventKind.PHONEME:
+        symbol = event.get_symbol()
+        name = alphabet.get_phoneme_name(symbol) if alphabet else None
+        line = "%s phoneme %s %d ms f0 %d Hz" % (time, name or "#%d" % symbol,
+                                                  event.get_duration_ms(), 2 * event.get_f0())
+    elif kind == GstPfap.EventKind.RECOVERED:
+        line = "%s recovered" % time
+    else:
+        line = "%s complete state" % time
+    if flags:
+        line += " [%s]" % flags
+    for fap in event.get_faps():
+        line += "\n    FAP %d -> %d over %d ms (%s)" % (
+            fap.index, fap.amplitude, fap.transition_ms, fap.curve.value_nick)
+    return line
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--port", type=int, default=5004, help="UDP port (default 5004)")
+    parser.add_argument("--address", default="127.0.0.1", help="address to listen on")
+    parser.add_argument("--clock-rate", type=int, default=44100,
+                        help="the stream's RTP clock rate (SDP a=rtpmap PFAP/<rate>)")
+    parser.add_argument("--alphabet", default=None,
+                        help="phoneme alphabet when the caps name none (default: the caps', "
+                             "else " + GstPfap.ALPHABET_ARPABET + ")")
+    parser.add_argument("--idle-exit", type=float, default=0,
+                        help="exit after this many seconds without an event (0: never)")
+    args = parser.parse_args()
+
+    Gst.init(None)
+    pipeline = Gst.parse_launch(
+        "udpsrc name=src ! rtpjitterbuffer ! rtppfapdepay ! "
+        "appsink name=sink caps=%s sync=false" % GstPfap.CAPS)
+    src = pipeline.get_by_name("src")
+    src.set_property("address", args.address)
+    src.set_property("port", args.port)
+    src.set_property("caps", Gst.Caps.from_string(
+        "application/x-rtp,media=application,encoding-name=PFAP,clock-rate=%d" % args.clock_rate))
+    sink = pipeline.get_by_name("sink")
+    pipeline.set_state(Gst.State.PLAYING)
+    print("listening on %s:%d" % (args.address, args.port), flush=True)
+
+    alphabet = None
+    idle_ns = int(args.idle_exit * Gst.SECOND) if args.idle_exit > 0 else Gst.CLOCK_TIME_NONE
+    try:
+        while True:
+            sample = sink.try_pull_sample(idle_ns)
+            if sample is None:
+                break
+            if alphabet is None:
+                caps = sample.get_caps().get_structure(0)
+                name = caps.get_string("alphabet") or args.alphabet or GstPfap.ALPHABET_ARPABET
+                alphabet = GstPfap.Alphabet.find(name)
+                if alphabet is None:
+                    print("unknown alphabet %s: symbols shown as numbers" % name, file=sys.stderr)
+            buffer = sample.get_buffer()
+            try:
+                event = GstPfap.Event.new_from_buffer(buffer)
+            except GLib.Error as e:
+                print("dropped: %s" % e.message, file=sys.stderr)
+                continue
+            print(describe(event, buffer.pts, alphabet), flush=True)
+    except KeyboardInterrupt:
+        pass
+    pipeline.set_state(Gst.State.NULL)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,107 @@
+"""The example programs in examples/python and examples/gjs, run as a user runs them, against
+the build tree (tests/python/meson.build sets the paths)."""
+import shutil
+import socket
+import subprocess
+from pathlib import Path
+
+import gi
+
+gi.require_version("Gst", "1.0")
+gi.require_version("GstPfap", "1.0")
+from gi.repository import Gst, GstPfap  # noqa: E402
+
+import pytest  # noqa: E402
+
+Gst.init(None)
+
+SOURCE = Path(__file__).resolve().parents[2]
+HELLO = SOURCE / "docs" / "examples" / "hello.pfap"
+PYTHON_RECEIVER = [str(SOURCE / "examples" / "python" / "pfap-receiver.py")]
+GJS_RECEIVER = ["gjs", str(SOURCE / "examples" / "gjs" / "pfap-receiver.js")]
+MOUTH = [str(SOURCE / "examples" / "python" / "pfap-mouth.py")]
+needs_gjs = pytest.mark.skipif(shutil.which("gjs") is None, reason="gjs is not installed")
+
+
+def phoneme_names(path):
+    """The phonemes of a .pfap file, read with pfapparse and named with GstPfap."""
+    pipeline = Gst.parse_launch("filesrc name=src ! pfapparse ! appsink name=sink sync=false")
+    pipeline.get_by_name("src").set_property("location", str(path))
+    sink = pipeline.get_by_name("sink")
+    pipeline.set_state(Gst.State.PLAYING)
+    arpabet = GstPfap.Alphabet.find(GstPfap.ALPHABET_ARPABET)
+    names = []
+    while (sample := sink.try_pull_sample(5 * Gst.SECOND)) is not None:
+        event = GstPfap.Event.new_from_buffer(sample.get_buffer())
+        if event.get_kind() == GstPfap.EventKind.PHONEME:
+            names.append(arpabet.get_phoneme_name(event.get_symbol()))
+    pipeline.set_state(Gst.State.NULL)
+    return names
+
+
+def free_udp_port():
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def receive(command):
+    """Runs a receiver example on a free port, sends hello.pfap to it, returns its output."""
+    port = free_udp_port()
+    receiver = subprocess.Popen(command + ["--port", str(port), "--idle-exit", "2"],
+                                stdout=subprocess.PIPE, text=True)
+    try:
+        assert receiver.stdout.readline().startswith("listening on 127.0.0.1:%d" % port)
+        sender = Gst.parse_launch(
+            "filesrc name=src ! pfapparse alphabet=" + GstPfap.ALPHABET_ARPABET +
+            " ! rtppfappay ! udpsink host=127.0.0.1 port=%d" % port)
+        sender.get_by_name("src").set_property("location", str(HELLO))
+        sender.set_state(Gst.State.PLAYING)
+        message = sender.get_bus().timed_pop_filtered(
+            20 * Gst.SECOND, Gst.MessageType.EOS | Gst.MessageType.ERROR)
+        sender.set_state(Gst.State.NULL)
+        assert message is not None and message.type == Gst.MessageType.EOS
+        out, _ = receiver.communicate(timeout=30)
+    finally:
+        receiver.kill()
+        receiver.wait()
+    assert receiver.returncode == 0
+    return out
+
+
+@pytest.mark.parametrize("command", [
+    PYTHON_RECEIVER, MOUTH, pytest.param(GJS_RECEIVER, marks=needs_gjs)],
+    ids=["python-receiver", "python-mouth", "gjs-receiver"])
+def test_examples_answer_help(command):
+    run = subprocess.run(command + ["--help"], capture_output=True, text=True, timeout=30)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.startswith("usage: ")
+
+
+@pytest.mark.parametrize("command", [PYTHON_RECEIVER, pytest.param(GJS_RECEIVER, marks=needs_gjs)],
+                         ids=["python", "gjs"])
+def test_receiver_prints_every_phoneme_by_name(command):
+    expected = phoneme_names(HELLO)
+    assert len(expected) > 5
+    out = receive(command)
+    got = [line.split()[2] for line in out.splitlines() if " phoneme " in line]
+    assert got == expected
+    assert "    FAP 69 -> 30 over 400 ms" in out  # hello.pfap's first bookmark
+
+
+def test_mouth_opens_and_closes_with_the_jaw():
+    run = subprocess.run(MOUTH + ["--plain", str(HELLO)], capture_output=True, text=True,
+                         timeout=60)
+    assert run.returncode == 0, run.stderr
+    # A frame is the top lip, one row per step of the opening, then the bottom lip.
+    frames, rows = [], 0
+    for line in run.stdout.splitlines():
+        if line.startswith(" _"):
+            rows = 0
+        elif line.startswith("|"):
+            rows += 1
+        else:
+            frames.append(rows)
+    assert len(frames) > 25, "fewer frames than a second at 25 per second"
+    assert max(frames) >= 2, "the mouth never opened"
+    assert frames[-1] == 0, "the mouth is still open after the last phoneme"
