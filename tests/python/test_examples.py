@@ -1,8 +1,11 @@
 """The example programs in examples/python and examples/gjs, run as a user runs them, against
 the build tree (tests/python/meson.build sets the paths)."""
+import os
+import re
 import shutil
 import socket
 import subprocess
+import sys
 from pathlib import Path
 
 import gi
@@ -105,3 +108,35 @@ def test_mouth_opens_and_closes_with_the_jaw():
     assert len(frames) > 25, "fewer frames than a second at 25 per second"
     assert max(frames) >= 2, "the mouth never opened"
     assert frames[-1] == 0, "the mouth is still open after the last phoneme"
+
+
+def apps_md_blocks(language):
+    text = (SOURCE / "docs" / "apps.md").read_text()
+    return re.findall(r"^```%s\n(.*?)^```$" % re.escape(language), text, re.M | re.S)
+
+
+def test_apps_md_python_runs():
+    (code,) = apps_md_blocks("python")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=30)
+    assert run.returncode == 0, run.stderr
+    lines = run.stdout.splitlines()
+    assert lines[0] == "AA <enum GST_PFAP_VISEME_A of type GstPfap.Viseme>"
+    assert lines[1] == "[(69, 40, 500)]"
+    assert lines[2].split() == ["20.0", "40"]  # halfway along the spline, then its target
+    assert lines[3] == "at byte 11: transition time out of range"
+
+
+@pytest.mark.parametrize("language, compiler", [("c", "cc"), ("cpp", "c++")])
+def test_apps_md_c_and_cpp_compile(language, compiler):
+    if shutil.which(compiler) is None or shutil.which("pkg-config") is None:
+        pytest.skip("no %s or pkg-config" % compiler)
+    (code,) = apps_md_blocks(language)
+    flags = subprocess.run(["pkg-config", "--cflags", "gstreamer-pfap-1.0", "gstreamer-app-1.0"],
+                           capture_output=True, text=True, check=True).stdout.split()
+    std = ["-std=c++20"] if language == "cpp" else []
+    run = subprocess.run([compiler, "-x", "c++" if language == "cpp" else "c", "-c", "-o",
+                          os.devnull, "-", "-Wall", "-Werror", "-Wno-unused-function",
+                          "-Wno-unused-variable"] + std + flags,
+                         input=code, capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
