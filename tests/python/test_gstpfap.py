@@ -39,17 +39,21 @@ def random_fap(rng):
 def random_session(seed, n_phonemes):
     """Seeded phonemes as a TTS engine gives them (tests/gst/test_pipeline.cc does the same in
     C++): contiguous, 0..5 FAPs each, sentences ended by end of text and begun with a sentence
-    start after a pause; returns (pts, event) pairs."""
+    start after a pause. Returns (pts, event, fields): fields are the values the event was
+    given, as event_fields() reads them back, so that a setter or getter that lost a value
+    cannot go unnoticed."""
     rng = random.Random(seed)
     t = Gst.SECOND + rng.randint(0, 999_999_999)
     sentence_start = True
     session = []
     for i in range(n_phonemes):
         event = GstPfap.Event.new(GstPfap.EventKind.PHONEME)
-        event.set_symbol(rng.randint(0, 255))
-        event.set_duration_ms(GstPfap.MAX_DURATION_MS if rng.random() < 0.05
-                              else rng.randint(0, 400))
-        event.set_f0(rng.randint(0, 255))
+        symbol = rng.randint(0, 255)
+        duration = GstPfap.MAX_DURATION_MS if rng.random() < 0.05 else rng.randint(0, 400)
+        f0 = rng.randint(0, 255)
+        event.set_symbol(symbol)
+        event.set_duration_ms(duration)
+        event.set_f0(f0)
         flags = GstPfap.EventFlags(0)
         if rng.random() < 0.3:
             flags |= GstPfap.EventFlags.STRESS
@@ -61,10 +65,13 @@ def random_session(seed, n_phonemes):
         if sentence_start:
             flags |= GstPfap.EventFlags.SENTENCE_START
         event.set_flags(flags)
-        for _ in range(rng.randint(0, 5)):
-            event.add_fap(random_fap(rng))
-        session.append((t, event))
-        t += event.get_duration_ms() * Gst.MSECOND
+        faps = [random_fap(rng) for _ in range(rng.randint(0, 5))]
+        for fap in faps:
+            event.add_fap(fap)
+        fields = (GstPfap.EventKind.PHONEME, symbol, duration, f0, int(flags),
+                  [fap_tuple(f) for f in faps])
+        session.append((t, event, fields))
+        t += duration * Gst.MSECOND
         sentence_start = end_of_text
         if end_of_text:
             t += rng.randint(1, 1500) * Gst.MSECOND + rng.randint(0, 999_999)
@@ -109,7 +116,7 @@ def run_pipeline(description, buffers, timeout_s=20):
 def test_every_field_round_trips_through_pay_and_depay(seed):
     session = random_session(seed, 200)
     buffers = []
-    for pts, event in session:
+    for pts, event, _ in session:
         buffer = event.to_buffer()
         buffer.pts = pts
         buffers.append(buffer)
@@ -117,11 +124,37 @@ def test_every_field_round_trips_through_pay_and_depay(seed):
         "appsrc name=src format=time caps=" + GstPfap.CAPS + " ! rtppfappay ! rtppfapdepay ! "
         "appsink name=sink sync=false emit-signals=false wait-on-eos=false", buffers)
     assert len(got) == len(session)
-    for i, ((pts, sent), buffer) in enumerate(zip(session, got)):
+    for i, ((pts, _, fields), buffer) in enumerate(zip(session, got)):
         back = GstPfap.Event.new_from_buffer(buffer)
-        assert event_fields(back) == event_fields(sent), "event %d (seed %d)" % (i, seed)
+        assert event_fields(back) == fields, "event %d (seed %d)" % (i, seed)
         assert buffer.pts == pts, "event %d (seed %d)" % (i, seed)
-        assert buffer.duration == sent.get_duration_ms() * Gst.MSECOND
+        assert buffer.duration == fields[2] * Gst.MSECOND
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_random_events_of_every_kind_round_trip_through_buffers(seed):
+    """What the payloader does not send (state events, the uncertain flag) round-trips
+    through buffers: a state event keeps its flags and FAPs, and carries no phoneme."""
+    rng = random.Random(seed)
+    for i in range(300):
+        kind = GstPfap.EventKind(rng.randint(1, 3))
+        symbol, duration, f0 = rng.randint(0, 255), rng.randint(0, 4095), rng.randint(0, 255)
+        flags = GstPfap.EventFlags(rng.randint(0, 31))
+        faps = [random_fap(rng) for _ in range(rng.randint(0, 8))]
+        event = GstPfap.Event.new(kind)
+        event.set_symbol(symbol)
+        event.set_duration_ms(duration)
+        event.set_f0(f0)
+        event.set_flags(flags)
+        for fap in faps:
+            event.add_fap(fap)
+        phoneme = kind == GstPfap.EventKind.PHONEME
+        expected = (kind, symbol if phoneme else 0, duration if phoneme else 0,
+                    f0 if phoneme else 0, int(flags), [fap_tuple(f) for f in faps])
+        buffer = event.to_buffer()
+        assert buffer.duration == (duration * Gst.MSECOND if phoneme else Gst.CLOCK_TIME_NONE)
+        assert event_fields(GstPfap.Event.new_from_buffer(buffer)) == expected, \
+            "event %d (seed %d)" % (i, seed)
 
 
 def test_fap_fields_and_state_events_round_trip_through_bytes():
