@@ -136,7 +136,7 @@ TEST(GstPfapEvent, OutOfRangeValuesAreNamedAndNothingIsWritten) {
   EXPECT_EQ(gst_pfap_event_to_buffer(event, &raw), nullptr);
   error.reset(raw);
   ASSERT_NE(error, nullptr);
-  EXPECT_NE(strstr(error->message, "FAP 1 (index 3, amplitude 2529601"), nullptr)
+  EXPECT_NE(strstr(error->message, "FAP 1: index 3, amplitude 2529601"), nullptr)
       << error->message;
 }
 

@@ -47,6 +47,15 @@ GstPfapFap *gst_pfap_fap_from_lib (const pfap::Fap& fap)
                            static_cast<GstPfapCurve> (fap.curve));
 }
 
+gchar *gst_pfap_fap_out_of_range (const pfap::Fap& fap)
+{
+  return g_strdup_printf ("index %u, amplitude %d, transition %u ms, curve %u is out of range "
+                          "(index %d..%d, |amplitude| <= %d, transition <= %u ms, curve 1..3)",
+                          fap.index, fap.amplitude, fap.transition_ms, unsigned (fap.curve),
+                          pfap::kMinFapIndex, pfap::kMaxFapIndex, pfap::kMaxAmplitude,
+                          unsigned{pfap::kMaxTransitionMs});
+}
+
 GstPfapFap *gst_pfap_fap_new (guint8 index, gint32 amplitude, guint16 transition_ms,
                               GstPfapCurve curve)
 {
@@ -116,13 +125,12 @@ static gchar *out_of_range (const pfap::MarkupEvent& event)
     return g_strdup_printf ("%zu FAPs are more than an event holds (%u)", event.faps.size (),
                             unsigned{G_MAXUINT16});
   for (size_t i = 0; i < event.faps.size (); ++i) {
-    const pfap::Fap& f = event.faps[i];
-    if (!pfap::is_valid (f))
-      return g_strdup_printf ("FAP %zu (index %u, amplitude %d, transition %u ms, curve %u) is "
-                              "out of range: index %d..%d, |amplitude| <= %d, transition <= %u "
-                              "ms, curve 1..3", i, f.index, f.amplitude, f.transition_ms,
-                              unsigned (f.curve), pfap::kMinFapIndex, pfap::kMaxFapIndex,
-                              pfap::kMaxAmplitude, unsigned{pfap::kMaxTransitionMs});
+    if (!pfap::is_valid (event.faps[i])) {
+      gchar *why = gst_pfap_fap_out_of_range (event.faps[i]);
+      gchar *message = g_strdup_printf ("FAP %zu: %s", i, why);
+      g_free (why);
+      return message;
+    }
   }
   return nullptr;
 }
@@ -130,6 +138,8 @@ static gchar *out_of_range (const pfap::MarkupEvent& event)
 GstBuffer *gst_pfap_event_to_buffer (const GstPfapEvent *event, GError **error)
 {
   g_return_val_if_fail (event != nullptr, nullptr);
+  // GStreamer's allocator exists only after gst_init(): say so rather than crash in it.
+  g_return_val_if_fail (gst_is_initialized (), nullptr);
   const pfap::MarkupEvent& e = event->event;
   GstBuffer *buffer = gst_buffer_new_allocate (nullptr, pfap::markup_size (e), nullptr);
   GstMapInfo map;

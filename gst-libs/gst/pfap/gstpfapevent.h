@@ -244,8 +244,8 @@ GstPfapEvent *gst_pfap_event_new_from_buffer (GstBuffer *buffer, GError **error)
  * @event: a #GstPfapEvent
  * @error: a #GError for a %GST_PFAP_EVENT_ERROR_OUT_OF_RANGE value
  *
- * Writes @event into a new buffer for appsrc. A phoneme's buffer has the phoneme's duration;
- * set its PTS to the phoneme's start. A state event's symbol, duration and f0 are written as 0.
+ * Writes @event into a new buffer for appsrc, after gst_init(). A phoneme's buffer has the
+ * phoneme's duration; set its PTS to the phoneme's start. A state event's symbol, duration and f0 are written as 0.
  *
  * Returns: (transfer full) (nullable): the buffer, or %NULL when a value is out of range
  * (the message says which).

@@ -48,11 +48,9 @@ GstPfapFapState *gst_pfap_fap_state_new (void)
 static gboolean check_fap (const pfap::Fap& fap, GError **error)
 {
   if (pfap::is_valid (fap)) return TRUE;
-  g_set_error (error, GST_PFAP_EVENT_ERROR, GST_PFAP_EVENT_ERROR_OUT_OF_RANGE,
-               "FAP index %u, amplitude %d, transition %u ms, curve %u is out of range: index "
-               "%d..%d, |amplitude| <= %d, transition <= %u ms, curve 1..3", fap.index,
-               fap.amplitude, fap.transition_ms, unsigned (fap.curve), pfap::kMinFapIndex,
-               pfap::kMaxFapIndex, pfap::kMaxAmplitude, unsigned{pfap::kMaxTransitionMs});
+  gchar *why = gst_pfap_fap_out_of_range (fap);
+  g_set_error (error, GST_PFAP_EVENT_ERROR, GST_PFAP_EVENT_ERROR_OUT_OF_RANGE, "FAP %s", why);
+  g_free (why);
   return FALSE;
 }
 
