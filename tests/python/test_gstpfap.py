@@ -180,7 +180,8 @@ def test_fap_fields_and_state_events_round_trip_through_bytes():
 
 
 @pytest.mark.parametrize("data", [b"", b"\x01\x00\x00", b"\x04" + bytes(7),
-                                  b"\x01\x00\x00\x00\x00\x00\x00\x01"])
+                                  b"\x01\x00\x00\x00\x00\x00\x00\x01"],
+                         ids=["empty", "short-header", "unknown-kind", "missing-fap"])
 def test_malformed_bytes_raise_a_malformed_gerror(data):
     with pytest.raises(GLib.Error) as raised:
         GstPfap.Event.new_from_buffer(Gst.Buffer.new_wrapped(data))
@@ -231,7 +232,7 @@ def test_bookmarks_parse_and_format():
     ("<FAP 48 1 0 4>", GstPfap.BookmarkError.CURVE_OUT_OF_RANGE, 12),
     ("  <FAP 48 1 0 1", GstPfap.BookmarkError.UNTERMINATED, 2),
     ("<FAP 48 x 0 1>", GstPfap.BookmarkError.BAD_NUMBER, 8),
-])
+], ids=["transition", "unknown-fap", "curve", "unterminated", "bad-number"])
 def test_bookmark_errors_are_gerrors_with_their_position(text, code, position):
     with pytest.raises(GLib.Error) as raised:
         GstPfap.bookmarks_parse(text, GstPfap.MAX_BOOKMARKS)
