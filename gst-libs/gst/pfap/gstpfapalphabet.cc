@@ -14,10 +14,8 @@ static_assert(std::string_view(GST_PFAP_ALPHABET_ARPABET) == pfap::kArpabetAlpha
 static_assert(int{GST_PFAP_VISEME_NONE} == int(pfap::Viseme::kNone));
 static_assert(int{GST_PFAP_VISEME_U} == int(pfap::Viseme::kU));
 
-struct _GstPfapAlphabet {
-  pfap::PhonemeAlphabet alphabet;
-};
-static_assert(sizeof (_GstPfapAlphabet) == sizeof (pfap::PhonemeAlphabet));
+// A GstPfapAlphabet pointer is a pfap::PhonemeAlphabet pointer under another name: the type
+// stays incomplete, and lib() turns the pointer back into what find_alphabet() gave.
 
 static GstPfapAlphabet *alphabet_copy (GstPfapAlphabet *alphabet)
 {
@@ -32,7 +30,7 @@ G_DEFINE_BOXED_TYPE (GstPfapAlphabet, gst_pfap_alphabet, alphabet_copy, alphabet
 
 static const pfap::PhonemeAlphabet& lib (const GstPfapAlphabet *alphabet)
 {
-  return alphabet->alphabet;
+  return *reinterpret_cast<const pfap::PhonemeAlphabet *> (alphabet);
 }
 
 // libpfap's names are std::string_views; interned once here, they are C strings that live
