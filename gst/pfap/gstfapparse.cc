@@ -66,8 +66,8 @@ struct Stream {
   pfap::FapFileReader reader;
   std::optional<pfap::FapFileMarkup> markup;  // once the header is read
   pfap::NotCarried reported;                  // what was already warned about
-  std::string tail;         // the start of a line whose end has not come yet
-  bool need_events = true;  // stream-start, caps or segment still to send
+  std::string tail;                           // the start of a line whose end has not come yet
+  bool need_events = true;                    // stream-start, caps or segment still to send
   bool discont = true;
   bool failed = false;  // an error was posted: the rest is dropped
   std::vector<pfap::TextEvent> events;
@@ -96,9 +96,7 @@ G_DEFINE_TYPE(GstFapParse, gst_fap_parse, GST_TYPE_ELEMENT)
 GST_ELEMENT_REGISTER_DEFINE(fapparse, "fapparse", GST_RANK_NONE, GST_TYPE_FAP_PARSE)
 
 // Back to the start of a file (READY to PAUSED, FLUSH_STOP).
-static void reset(GstFapParse* self) {
-  *self->stream = Stream{};
-}
+static void reset(GstFapParse* self) { *self->stream = Stream{}; }
 
 // The upstream file's name for messages, asked once: filesrc answers the URI query.
 static const std::string& file_name(GstFapParse* self) {
@@ -144,9 +142,10 @@ static void send_events(GstFapParse* self) {
 
 static GstFlowReturn bad_file(GstFapParse* self, const pfap::FapFileResult& result) {
   self->stream->failed = true;
-  GST_ELEMENT_ERROR(self, STREAM, DECODE,
-                    ("Bad FAP file %s, %s", file_name(self).c_str(), pfap::describe(result).c_str()),
-                    ("docs/fap-files.md describes what is read"));
+  GST_ELEMENT_ERROR(
+      self, STREAM, DECODE,
+      ("Bad FAP file %s, %s", file_name(self).c_str(), pfap::describe(result).c_str()),
+      ("docs/fap-files.md describes what is read"));
   return GST_FLOW_ERROR;
 }
 
@@ -155,12 +154,13 @@ static void report_not_carried(GstFapParse* self, const pfap::FapFrame& frame) {
   Stream& s = *self->stream;
   const pfap::NotCarried& now = s.markup->not_carried();
   if (now.visemes != s.reported.visemes && pfap_warn_at(now.visemes)) {
-    GST_ELEMENT_WARNING(self, STREAM, FORMAT,
-                        ("%s frame %u sets FAP 1 (viseme), which PFAP does not carry: visemes "
-                         "are phonemes here",
-                         file_name(self).c_str(), frame.number),
-                        ("%" G_GUINT64_FORMAT " such frames so far (warned at the 1st, 2nd, 4th, ...)",
-                         now.visemes));
+    GST_ELEMENT_WARNING(
+        self, STREAM, FORMAT,
+        ("%s frame %u sets FAP 1 (viseme), which PFAP does not carry: visemes "
+         "are phonemes here",
+         file_name(self).c_str(), frame.number),
+        ("%" G_GUINT64_FORMAT " such frames so far (warned at the 1st, 2nd, 4th, ...)",
+         now.visemes));
   }
   if (now.expression_flags != s.reported.expression_flags && pfap_warn_at(now.expression_flags)) {
     GST_ELEMENT_WARNING(self, STREAM, FORMAT,

@@ -112,22 +112,21 @@ static GstFlowReturn gst_pfap_fap_enc_chain(GstPad*, GstObject* parent, GstBuffe
   const GstClockTime running =
       gst_segment_to_running_time(&s.segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
   int64_t time_ns = GST_CLOCK_TIME_IS_VALID(running) ? static_cast<int64_t>(running)
-                                                      : (s.origin_ns ? *s.origin_ns + s.end_ns : 0);
+                                                     : (s.origin_ns ? *s.origin_ns + s.end_ns : 0);
   if (!s.origin_ns) s.origin_ns = time_ns;  // no segment came: the first event's time
   time_ns = std::max<int64_t>(time_ns - *s.origin_ns, 0);
   gst_buffer_unref(buffer);
 
   // The recorder adds the frames of transitions still running at the end.
   const int64_t end =
-      time_ns + (s.event.kind == PFAP_EVENT_PHONEME ? s.event.phoneme.duration_ms : 0) *
-                    pfap::kNsPerMs;
+      time_ns +
+      (s.event.kind == PFAP_EVENT_PHONEME ? s.event.phoneme.duration_ms : 0) * pfap::kNsPerMs;
   if (!s.recorder->apply(s.event, time_ns)) {
     if (pfap_warn_at(++s.over_limit)) {
-      GST_ELEMENT_WARNING(self, STREAM, ENCODE,
-                          ("The FAP file is full (%u frames); later events are not written.",
-                           s.recorder->frames()),
-                          ("%" G_GUINT64_FORMAT " events dropped so far; see max-frames",
-                           s.over_limit));
+      GST_ELEMENT_WARNING(
+          self, STREAM, ENCODE,
+          ("The FAP file is full (%u frames); later events are not written.", s.recorder->frames()),
+          ("%" G_GUINT64_FORMAT " events dropped so far; see max-frames", s.over_limit));
     }
     return GST_FLOW_OK;
   }
@@ -149,10 +148,10 @@ static GstFlowReturn write_file(GstPfapFapEnc* self) {
     return GST_FLOW_OK;
   }
   if (!s.recorder->finish(s.end_ns) && pfap_warn_at(++s.over_limit)) {
-    GST_ELEMENT_WARNING(self, STREAM, ENCODE,
-                        ("The FAP file is full (%u frames); its end is not written.",
-                         s.recorder->frames()),
-                        ("see max-frames"));
+    GST_ELEMENT_WARNING(
+        self, STREAM, ENCODE,
+        ("The FAP file is full (%u frames); its end is not written.", s.recorder->frames()),
+        ("see max-frames"));
   }
   GST_OBJECT_LOCK(self);
   const std::string name = self->name != nullptr ? self->name : kDefaultName;
@@ -291,8 +290,7 @@ static void gst_pfap_fap_enc_class_init(GstPfapFapEncClass* klass) {
   g_object_class_install_property(
       gobject_class, PROP_FRAME_RATE,
       g_param_spec_double("frame-rate", "Frame rate", "Frames a second of the FAP file",
-                          pfap::kMinFapFileFrameRate, pfap::kMaxFapFileFrameRate,
-                          kDefaultFrameRate,
+                          pfap::kMinFapFileFrameRate, pfap::kMaxFapFileFrameRate, kDefaultFrameRate,
                           static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
                                                    GST_PARAM_MUTABLE_READY)));
 

@@ -217,11 +217,14 @@ FapFileResult FapFileReader::read_mask(std::string_view line) {
   Fields fields(line);
   int fap = 0;
   for (std::string_view f = fields.next(); !f.empty(); f = fields.next()) {
-    if (++fap > kFapFileFaps) return error(FapFileStatus::kWrongMaskLength, number, fields.number());
-    if (f != "0" && f != "1") return error(FapFileStatus::kBadMaskFlag, number, fields.number(), fap);
+    if (++fap > kFapFileFaps)
+      return error(FapFileStatus::kWrongMaskLength, number, fields.number());
+    if (f != "0" && f != "1")
+      return error(FapFileStatus::kBadMaskFlag, number, fields.number(), fap);
     mask[fap] = f == "1";
   }
-  if (fap != kFapFileFaps) return error(FapFileStatus::kWrongMaskLength, number, fields.number() + 1);
+  if (fap != kFapFileFaps)
+    return error(FapFileStatus::kWrongMaskLength, number, fields.number() + 1);
   mask_ = mask;
   have_mask_ = true;
   return {};

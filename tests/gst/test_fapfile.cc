@@ -51,8 +51,8 @@ std::vector<fs::path> shared_files() {
   return files;
 }
 
-#define SKIP_WITHOUT_SHARED_FILES(files) \
-  if ((files).empty())                   \
+#define SKIP_WITHOUT_SHARED_FILES(files)              \
+  if ((files).empty())                                \
   GTEST_SKIP() << "no .fap files in " << shared_dir() \
                << ": the real MPEG-4 FAP files live beside the project in ../shared/fap"
 
@@ -68,7 +68,8 @@ std::string read_all(const fs::path& path) {
 std::vector<pfap::FapAmplitudes> amplitudes_of(const pfap::FapFile& file) {
   std::vector<pfap::FapAmplitudes> out;
   pfap::NotCarried ignored;
-  for (const pfap::FapFrame& frame : file.frames) out.push_back(pfap::amplitudes_of(frame, ignored));
+  for (const pfap::FapFrame& frame : file.frames)
+    out.push_back(pfap::amplitudes_of(frame, ignored));
   return out;
 }
 
@@ -131,8 +132,8 @@ TEST(FapParse, EachRealFileGivesBackEveryValueAtItsFrameTimes) {
 // Runs `text` through filesrc ! fapparse ! fakesink; returns the bus error.
 std::string error_of(const std::string& text, const TempDir& dir) {
   const std::string path = dir.file("bad.fap");
-  EXPECT_TRUE(g_file_set_contents(path.c_str(), text.data(), static_cast<gssize>(text.size()),
-                                  nullptr));
+  EXPECT_TRUE(
+      g_file_set_contents(path.c_str(), text.data(), static_cast<gssize>(text.size()), nullptr));
   Pipeline p("filesrc location=" + path + " ! fapparse ! fakesink");
   EXPECT_TRUE(p.ok()) << p.error();
   EXPECT_EQ(p.set_state(GST_STATE_PLAYING), "");
@@ -160,8 +161,7 @@ TEST(FapParse, BadFilesAreErrorsNamingFileLineAndField) {
   for (const Case& c : cases) {
     SCOPED_TRACE(c.said);
     const std::string error = error_of(c.text, dir);
-    EXPECT_NE(error.find("Bad FAP file " + dir.file("bad.fap") + ", " + c.said),
-              std::string::npos)
+    EXPECT_NE(error.find("Bad FAP file " + dir.file("bad.fap") + ", " + c.said), std::string::npos)
         << error;
   }
 }
@@ -310,7 +310,7 @@ TEST(FapRoundTrip, TenPercentLossRecoveredGivesEveryFrameTheReceiverHadWhole) {
   }
   std::cout << "[ fapfile  ] " << dropped << " of " << packets << " packets dropped; " << checked
             << " of " << frames << " frames received whole and compared\n";
-  EXPECT_GT(dropped, packets / 20);   // the loss happened
+  EXPECT_GT(dropped, packets / 20);     // the loss happened
   EXPECT_GT(checked, frames * 6 / 10);  // and recovery made most frames whole
 }
 

@@ -49,9 +49,9 @@ std::string read_all(const fs::path& path) {
   return s.str();
 }
 
-#define SKIP_WITHOUT_SHARED_FILES(files)                                                    \
-  if ((files).empty())                                                                    \
-  GTEST_SKIP() << "no .fap files in " << shared_dir()                                     \
+#define SKIP_WITHOUT_SHARED_FILES(files)              \
+  if ((files).empty())                                \
+  GTEST_SKIP() << "no .fap files in " << shared_dir() \
                << ": the real MPEG-4 FAP files live beside the project in ../shared/fap"
 
 // Each frame's amplitudes, as the mapping reads them.
@@ -175,8 +175,8 @@ std::string small_file(int frames, const std::string& header = "2.1 test 25") {
   for (int i = 5; i <= 68; ++i) mask += " 0";
   std::string text = header + " " + std::to_string(frames) + "\n";
   for (int k = 0; k < frames; ++k) {
-    text += mask + "\n" + std::to_string(k) + " " + std::to_string(k) + " " +
-            std::to_string(-k) + "\n";
+    text +=
+        mask + "\n" + std::to_string(k) + " " + std::to_string(k) + " " + std::to_string(-k) + "\n";
   }
   return text;
 }
@@ -211,9 +211,9 @@ TEST(FapFileRead, FractionsRoundToTheNearestHalvesAwayFromZero) {
     int32_t value;
     uint32_t rounded;
   };
-  const Case cases[] = {{"12", 12, 0},   {"12.0", 12, 0},  {"12.49", 12, 1}, {"12.5", 13, 1},
-                        {"-12.5", -13, 1}, {"-0.4", 0, 1}, {".5", 1, 1},     {"-.5", -1, 1},
-                        {"+3", 3, 0},    {"007", 7, 0}};
+  const Case cases[] = {{"12", 12, 0},     {"12.0", 12, 0}, {"12.49", 12, 1}, {"12.5", 13, 1},
+                        {"-12.5", -13, 1}, {"-0.4", 0, 1},  {".5", 1, 1},     {"-.5", -1, 1},
+                        {"+3", 3, 0},      {"007", 7, 0}};
   for (const Case& c : cases) {
     SCOPED_TRACE(c.text);
     FapFile file;
@@ -274,24 +274,24 @@ std::vector<BadFile> bad_files() {
       {"rate nan", "2.1 t nan 1\n", FapFileStatus::kBadFrameRate, 1, 3, 0},
       {"rate 1e3", "2.1 t 1e3 1\n", FapFileStatus::kBadFrameRate, 1, 3, 0},
       {"count 0", "2.1 t 25 0\n", FapFileStatus::kBadFrameCount, 1, 4, 0},
-      {"count absurd", "2.1 t 25 99999999999999999999999\n", FapFileStatus::kBadFrameCount, 1,
-       4, 0},
+      {"count absurd", "2.1 t 25 99999999999999999999999\n", FapFileStatus::kBadFrameCount, 1, 4,
+       0},
       {"count over the limit", "2.1 t 25 360001\n", FapFileStatus::kBadFrameCount, 1, 4, 0},
       {"count not a number", "2.1 t 25 1x\n", FapFileStatus::kBadFrameCount, 1, 4, 0},
-      {"name too long", "2.1 " + std::string(2000, 'n') + " 25 1\n", FapFileStatus::kBadName, 1,
-       2, 0},
+      {"name too long", "2.1 " + std::string(2000, 'n') + " 25 1\n", FapFileStatus::kBadName, 1, 2,
+       0},
       {"mask of 67", head + mask.substr(0, mask.size() - 2) + "\n", FapFileStatus::kWrongMaskLength,
        2, 68, 0},
       {"mask of 69", head + mask + " 0\n", FapFileStatus::kWrongMaskLength, 2, 69, 0},
       {"mask flag 2", head + "2" + mask.substr(1) + "\n", FapFileStatus::kBadMaskFlag, 2, 1, 1},
       {"frame number 1 first", head + mask + "\n1 1 2\n", FapFileStatus::kBadFrameNumber, 3, 1, 0},
-      {"frame number repeated", head + frame0 + mask + "\n0 1 2\n",
-       FapFileStatus::kBadFrameNumber, 5, 1, 0},
+      {"frame number repeated", head + frame0 + mask + "\n0 1 2\n", FapFileStatus::kBadFrameNumber,
+       5, 1, 0},
       {"value not a number", head + mask + "\n0 1 x\n", FapFileStatus::kBadValue, 3, 3, 4},
       {"value 5.", head + mask + "\n0 5. 1\n", FapFileStatus::kBadValue, 3, 2, 3},
       {"value -inf", head + mask + "\n0 -inf 1\n", FapFileStatus::kBadValue, 3, 2, 3},
-      {"value past the draft", head + mask + "\n0 1 2529601\n", FapFileStatus::kValueOutOfRange,
-       3, 3, 4},
+      {"value past the draft", head + mask + "\n0 1 2529601\n", FapFileStatus::kValueOutOfRange, 3,
+       3, 4},
       {"value far past", head + mask + "\n0 -99999999999999999999 1\n",
        FapFileStatus::kValueOutOfRange, 3, 2, 3},
       {"value rounds past", head + mask + "\n0 2529600.5 1\n", FapFileStatus::kValueOutOfRange, 3,
@@ -365,13 +365,12 @@ TEST(FapFileMarkup, ExpressionsBecomeFaps69To74AndVisemesAreCounted) {
   EXPECT_EQ(not_carried.visemes, 1u);
   EXPECT_EQ(not_carried.expression_flags, 1u);
   ASSERT_EQ(events.size(), 2u);
-  EXPECT_EQ(events[0].event.faps, (std::vector<Fap>{{69, 40, 0, Curve::kLinear},
-                                                    {71, 20, 0, Curve::kLinear}}));
+  EXPECT_EQ(events[0].event.faps,
+            (std::vector<Fap>{{69, 40, 0, Curve::kLinear}, {71, 20, 0, Curve::kLinear}}));
   // Joy and anger end; surprise starts.
-  EXPECT_EQ(events[1].event.faps,
-            (std::vector<Fap>{{69, 0, 0, Curve::kLinear},
-                              {71, 0, 0, Curve::kLinear},
-                              {74, 10, 0, Curve::kLinear}}));
+  EXPECT_EQ(events[1].event.faps, (std::vector<Fap>{{69, 0, 0, Curve::kLinear},
+                                                    {71, 0, 0, Curve::kLinear},
+                                                    {74, 10, 0, Curve::kLinear}}));
   EXPECT_EQ(events[1].time_ms, 40);
   EXPECT_TRUE(events[0].event.sentence_start);
   EXPECT_TRUE(events[1].event.phoneme.end_of_text);
@@ -411,8 +410,7 @@ TEST(FapRecorder, SetsEveryFapEverUsedInEveryFrameAndTheTwoStrongestExpressions)
   FapRecorder recorder(25.0);
   MarkupEvent e;
   e.kind = PFAP_EVENT_PHONEME;
-  e.faps = {{69, 40, 0, Curve::kLinear}, {72, 100, 0, Curve::kLinear},
-            {74, 5, 0, Curve::kLinear}};
+  e.faps = {{69, 40, 0, Curve::kLinear}, {72, 100, 0, Curve::kLinear}, {74, 5, 0, Curve::kLinear}};
   ASSERT_TRUE(recorder.apply(e, 40 * kNsPerMs));
   e.faps = {{10, -30, 80, Curve::kLinear}};
   ASSERT_TRUE(recorder.apply(e, 80 * kNsPerMs));
@@ -446,7 +444,7 @@ TEST(FapRecorder, EndsOnTheSettledStateAndHasAtLeastOneFrame) {
   e.faps = {{69, 40, 500, Curve::kLinear}};
   ASSERT_TRUE(running.apply(e, 400 * kNsPerMs));
   ASSERT_TRUE(running.finish(820 * kNsPerMs));  // frames 0..20; 20 (800 ms) at 32
-  ASSERT_EQ(running.frames(), 24u);  // then on while the transition runs (to 900 ms)
+  ASSERT_EQ(running.frames(), 24u);             // then on while the transition runs (to 900 ms)
   EXPECT_EQ(running.amplitudes()[20][69], 32);
   EXPECT_EQ(running.amplitudes()[22][69], 38);  // 880 ms
   EXPECT_EQ(running.amplitudes()[23][69], 40);  // 920 ms: settled

@@ -38,22 +38,22 @@ inline constexpr size_t kMaxFapFileNameBytes = 1024;
 
 enum class FapFileStatus : uint8_t {
   kOk = 0,
-  kBadVersion,             // not a version this reader accepts (2.0 or 2.1)
-  kMissingField,           // the header line ends before frame rate and frame count
-  kBadName,                // the name is longer than kMaxFapFileNameBytes
-  kBadFrameRate,           // not a number in kMinFapFileFrameRate..kMaxFapFileFrameRate
-  kBadFrameCount,          // not an integer in 1..kMaxFapFileFrames
-  kBadMaskFlag,            // a mask field that is not 0 or 1
-  kWrongMaskLength,        // a mask line without exactly 68 flags
-  kBadFrameNumber,         // not the number of this frame (consecutive from 0)
-  kBadValue,               // a value that is not a decimal number
-  kValueOutOfRange,        // |value| over the draft's 2529600, or a viseme or expression
-                           // field outside its MPEG-4 range
-  kMissingValues,          // fewer values than the mask sets
-  kExtraValues,            // more values than the mask sets
-  kTooManyFrames,          // a frame after the header's count
-  kTruncated,              // the file ends before the header's count of frames
-  kLineTooLong,            // a line over kMaxFapFileLineBytes
+  kBadVersion,       // not a version this reader accepts (2.0 or 2.1)
+  kMissingField,     // the header line ends before frame rate and frame count
+  kBadName,          // the name is longer than kMaxFapFileNameBytes
+  kBadFrameRate,     // not a number in kMinFapFileFrameRate..kMaxFapFileFrameRate
+  kBadFrameCount,    // not an integer in 1..kMaxFapFileFrames
+  kBadMaskFlag,      // a mask field that is not 0 or 1
+  kWrongMaskLength,  // a mask line without exactly 68 flags
+  kBadFrameNumber,   // not the number of this frame (consecutive from 0)
+  kBadValue,         // a value that is not a decimal number
+  kValueOutOfRange,  // |value| over the draft's 2529600, or a viseme or expression
+                     // field outside its MPEG-4 range
+  kMissingValues,    // fewer values than the mask sets
+  kExtraValues,      // more values than the mask sets
+  kTooManyFrames,    // a frame after the header's count
+  kTruncated,        // the file ends before the header's count of frames
+  kLineTooLong,      // a line over kMaxFapFileLineBytes
 };
 
 const char* to_string(FapFileStatus status);
@@ -81,8 +81,8 @@ struct FapFileHeader {
 
 struct FapFrame {
   uint32_t number = 0;
-  std::array<bool, kFapFileFaps + 1> set{};       // indexed by FAP 1..68; [0] unused
-  std::array<int32_t, kFapFileFaps + 1> value{};  // the value of each set FAP 3..68
+  std::array<bool, kFapFileFaps + 1> set{};             // indexed by FAP 1..68; [0] unused
+  std::array<int32_t, kFapFileFaps + 1> value{};        // the value of each set FAP 3..68
   std::array<int32_t, kVisemeFields> viseme{};          // when FAP 1 is set
   std::array<int32_t, kExpressionFields> expression{};  // when FAP 2 is set
   uint32_t rounded = 0;  // values written with a fraction, rounded to whole units
