@@ -39,6 +39,7 @@
 // clang-format on
 #include "gstfapparse.h"
 
+#include <bit>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -149,11 +150,17 @@ static GstFlowReturn bad_file(GstFapParse* self, const pfap::FapFileResult& resu
   return GST_FLOW_ERROR;
 }
 
-// Warns about what a frame holds that the draft cannot carry, at the 1st, 2nd, 4th, ... frame.
+// Whether a count that went from `before` to `now` passed the 1st, 2nd, 4th, 8th, ...
+// occurrence: pfap_warn_at for counts that may grow by more than one at a time.
+static bool passed_warning(uint64_t before, uint64_t now) {
+  return std::bit_width(before) < std::bit_width(now);
+}
+
+// Warns about what a frame holds that the draft cannot carry, at the 1st, 2nd, 4th, ... one.
 static void report_not_carried(GstFapParse* self, const pfap::FapFrame& frame) {
   Stream& s = *self->stream;
   const pfap::NotCarried& now = s.markup->not_carried();
-  if (now.visemes != s.reported.visemes && pfap_warn_at(now.visemes)) {
+  if (passed_warning(s.reported.visemes, now.visemes)) {
     GST_ELEMENT_WARNING(
         self, STREAM, FORMAT,
         ("%s frame %u sets FAP 1 (viseme), which PFAP does not carry: visemes "
@@ -162,14 +169,14 @@ static void report_not_carried(GstFapParse* self, const pfap::FapFrame& frame) {
         ("%" G_GUINT64_FORMAT " such frames so far (warned at the 1st, 2nd, 4th, ...)",
          now.visemes));
   }
-  if (now.expression_flags != s.reported.expression_flags && pfap_warn_at(now.expression_flags)) {
+  if (passed_warning(s.reported.expression_flags, now.expression_flags)) {
     GST_ELEMENT_WARNING(self, STREAM, FORMAT,
                         ("%s frame %u sets FAP 2's init_face or expression_def, which PFAP does "
                          "not carry; its expressions are carried",
                          file_name(self).c_str(), frame.number),
                         ("%" G_GUINT64_FORMAT " such frames so far", now.expression_flags));
   }
-  if (now.rounded_values != s.reported.rounded_values && pfap_warn_at(now.rounded_values)) {
+  if (passed_warning(s.reported.rounded_values, now.rounded_values)) {
     GST_ELEMENT_WARNING(self, STREAM, FORMAT,
                         ("%s frame %u has values with a fraction, rounded to whole FAP units",
                          file_name(self).c_str(), frame.number),
