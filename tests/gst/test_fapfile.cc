@@ -333,6 +333,96 @@ TEST(FapRoundTrip, TenPercentLossRecoveredGivesEveryFrameTheReceiverHadWhole) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// pfapfapenc on its own
+
+// Pushes events into pfapfapenc with the given properties; returns the file and the warnings.
+struct Encoded {
+  std::string text;
+  std::vector<std::string> warnings;
+};
+
+Encoded encode(const std::string& properties, const std::vector<GstBuffer*>& buffers) {
+  GstHarness* h = gst_harness_new_parse(("pfapfapenc " + properties).c_str());
+  GstBus* bus = gst_bus_new();
+  gst_element_set_bus(h->element, bus);
+  gst_harness_set_src_caps_str(h, "application/x-pfap");
+  for (GstBuffer* b : buffers) EXPECT_EQ(gst_harness_push(h, b), GST_FLOW_OK);
+  EXPECT_TRUE(gst_harness_push_event(h, gst_event_new_eos()));
+  Encoded out;
+  while (GstBuffer* b = gst_harness_try_pull(h)) {
+    GstMapInfo map;
+    gst_buffer_map(b, &map, GST_MAP_READ);
+    out.text.append(reinterpret_cast<const char*>(map.data), map.size);
+    gst_buffer_unmap(b, &map);
+    gst_buffer_unref(b);
+  }
+  while (GstMessage* m = gst_bus_pop_filtered(bus, GST_MESSAGE_WARNING)) {
+    GError* error = nullptr;
+    gst_message_parse_warning(m, &error, nullptr);
+    out.warnings.emplace_back(error->message);
+    g_error_free(error);
+    gst_message_unref(m);
+  }
+  gst_element_set_bus(h->element, nullptr);
+  gst_object_unref(bus);
+  gst_harness_teardown(h);
+  return out;
+}
+
+GstBuffer* phoneme_at(GstClockTime pts, uint16_t duration_ms, std::vector<pfap::Fap> faps) {
+  pfap::MarkupEvent e;
+  e.kind = PFAP_EVENT_PHONEME;
+  e.phoneme.duration_ms = duration_ms;
+  e.faps = std::move(faps);
+  return pfap::testing::markup_buffer(e, pts);
+}
+
+TEST(PfapFapEnc, MalformedEventsAreDroppedWithAWarningAndTheFileGoesOn) {
+  ASSERT_TRUE(plugin_available(kElements));
+  const char junk[] = "not an event";
+  const Encoded out =
+      encode("frame-rate=10 name-in-file=\"my face\"",
+             {phoneme_at(0, 100, {{3, 50, 0, pfap::Curve::kLinear}}),
+              gst_buffer_new_memdup(junk, sizeof junk),
+              phoneme_at(100 * GST_MSECOND, 100, {{3, -20, 0, pfap::Curve::kLinear}})});
+  ASSERT_EQ(out.warnings.size(), 1u);
+  EXPECT_NE(out.warnings[0].find("malformed"), std::string::npos) << out.warnings[0];
+  pfap::FapFile file;
+  const pfap::FapFileResult result = pfap::read_fap_file(out.text, file);
+  ASSERT_TRUE(result.ok()) << pfap::describe(result) << "\n" << out.text;
+  EXPECT_EQ(file.header.name, "my_face");
+  EXPECT_EQ(file.header.frame_rate, 10.0);
+  ASSERT_EQ(file.frames.size(), 2u);
+  EXPECT_EQ(file.frames[0].value[3], 50);
+  EXPECT_EQ(file.frames[1].value[3], -20);
+}
+
+TEST(PfapFapEnc, MaxFramesBoundsTheFileWithAWarning) {
+  ASSERT_TRUE(plugin_available(kElements));
+  std::vector<GstBuffer*> buffers;
+  for (int i = 0; i < 20; ++i) {
+    buffers.push_back(phoneme_at(i * 40 * GST_MSECOND, 40, {{5, i, 0, pfap::Curve::kLinear}}));
+  }
+  const Encoded out = encode("max-frames=8", buffers);
+  ASSERT_FALSE(out.warnings.empty());
+  EXPECT_NE(out.warnings[0].find("The FAP file is full (8 frames)"), std::string::npos)
+      << out.warnings[0];
+  EXPECT_LE(out.warnings.size(), 5u);  // rate-limited: the 1st, 2nd, 4th, 8th ... only
+  pfap::FapFile file;
+  ASSERT_TRUE(pfap::read_fap_file(out.text, file).ok());
+  ASSERT_EQ(file.frames.size(), 8u);
+  EXPECT_EQ(file.frames[7].value[5], 7);
+}
+
+TEST(PfapFapEnc, NoEventsNoFileAndAWarning) {
+  ASSERT_TRUE(plugin_available(kElements));
+  const Encoded out = encode("", {});
+  EXPECT_EQ(out.text, "");
+  ASSERT_EQ(out.warnings.size(), 1u);
+  EXPECT_NE(out.warnings[0].find("No PFAP events"), std::string::npos);
+}
+
+// ---------------------------------------------------------------------------------------------
 // docs/elements.md, "MPEG-4 FAP files"
 
 std::string source_path(const std::string& relative) {
