@@ -11,6 +11,40 @@ namespace {
 // MPEG-4's expression_intensity is 6 bits.
 constexpr int32_t kMaxExpressionIntensity = 63;
 
+// A frame of the file with changes: where a phoneme must start.
+struct Cut {
+  int64_t time_ms;
+  std::vector<Fap> faps;
+};
+
+TextEvent silence_phoneme(int64_t time_ms, int64_t duration_ms, uint8_t symbol) {
+  TextEvent e;
+  e.time_ms = time_ms;
+  e.event.kind = PFAP_EVENT_PHONEME;
+  e.event.phoneme.symbol = symbol;
+  e.event.phoneme.duration_ms =
+      static_cast<uint16_t>(std::min<int64_t>(duration_ms, kMaxPhonemeDurationMs));
+  return e;
+}
+
+// Appends a phoneme; FAPs past the 40 MPEG-4 allows go first on 0 ms silence phonemes, the
+// first of which takes the sentence start.
+void append_phoneme(TextEvent event, uint8_t silence, std::vector<TextEvent>& out) {
+  std::vector<Fap> faps = std::move(event.event.faps);
+  size_t taken = 0;
+  while (faps.size() - taken > size_t{kMaxBookmarksPerPhoneme}) {
+    TextEvent piece = silence_phoneme(event.time_ms, 0, silence);
+    piece.event.sentence_start = event.event.sentence_start;
+    event.event.sentence_start = false;
+    const auto from = faps.begin() + static_cast<std::ptrdiff_t>(taken);
+    piece.event.faps.assign(from, from + kMaxBookmarksPerPhoneme);
+    out.push_back(std::move(piece));
+    taken += kMaxBookmarksPerPhoneme;
+  }
+  event.event.faps.assign(faps.begin() + static_cast<std::ptrdiff_t>(taken), faps.end());
+  out.push_back(std::move(event));
+}
+
 }  // namespace
 
 int64_t frame_time_ms(uint64_t frame, double frame_rate) {
@@ -76,6 +110,77 @@ std::vector<TextEvent> markup_of(const FapFile& file, NotCarried* not_carried) {
   for (const FapFrame& frame : file.frames) markup.add(frame, events);
   if (not_carried != nullptr) *not_carried = markup.not_carried();
   return events;
+}
+
+std::vector<TextEvent> merge_with_speech(const std::vector<TextEvent>& speech,
+                                         const std::vector<TextEvent>& file_events,
+                                         uint8_t silence_symbol) {
+  std::vector<Cut> cuts;
+  int64_t file_end_ms = 0;
+  for (const TextEvent& e : file_events) {
+    if (e.event.kind != PFAP_EVENT_PHONEME) continue;
+    file_end_ms = std::max(file_end_ms, e.time_ms + e.event.phoneme.duration_ms);
+    if (e.event.faps.empty()) continue;
+    if (cuts.empty() || cuts.back().time_ms != e.time_ms) cuts.push_back({e.time_ms, {}});
+    cuts.back().faps.insert(cuts.back().faps.end(), e.event.faps.begin(), e.event.faps.end());
+  }
+
+  std::vector<TextEvent> out;
+  size_t next = 0;            // the first cut not placed yet
+  bool sentence_next = true;  // the next silence phoneme starts a sentence
+  // Silence phonemes for the cuts before `until_ms`, where no speech phoneme is.
+  auto fill_silence = [&](int64_t until_ms) {
+    for (; next < cuts.size() && cuts[next].time_ms < until_ms; ++next) {
+      const int64_t end_ms =
+          next + 1 < cuts.size() ? std::min(cuts[next + 1].time_ms, until_ms) : until_ms;
+      TextEvent e =
+          silence_phoneme(cuts[next].time_ms, end_ms - cuts[next].time_ms, silence_symbol);
+      e.event.sentence_start = sentence_next;
+      sentence_next = false;
+      e.event.faps = std::move(cuts[next].faps);
+      append_phoneme(std::move(e), silence_symbol, out);
+    }
+  };
+
+  for (const TextEvent& s : speech) {
+    fill_silence(s.time_ms);
+    if (s.event.kind != PFAP_EVENT_PHONEME) {
+      out.push_back(s);
+      continue;
+    }
+    const int64_t end_ms = s.time_ms + s.event.phoneme.duration_ms;
+    std::vector<Fap> faps = s.event.faps;
+    for (int64_t piece_ms = s.time_ms;;) {
+      if (next < cuts.size() && cuts[next].time_ms == piece_ms) {
+        faps.insert(faps.end(), cuts[next].faps.begin(), cuts[next].faps.end());
+        ++next;
+      }
+      const int64_t piece_end_ms =
+          next < cuts.size() && cuts[next].time_ms < end_ms ? cuts[next].time_ms : end_ms;
+      TextEvent piece = s;
+      piece.time_ms = piece_ms;
+      piece.event.phoneme.duration_ms = static_cast<uint16_t>(piece_end_ms - piece_ms);
+      piece.event.faps = std::move(faps);
+      faps.clear();
+      if (piece_ms != s.time_ms) {
+        piece.event.phoneme.stress = piece.event.phoneme.word_begin = false;
+        piece.event.sentence_start = false;
+      }
+      if (piece_end_ms != end_ms) piece.event.phoneme.end_of_text = false;
+      append_phoneme(std::move(piece), silence_symbol, out);
+      if (piece_end_ms == end_ms) break;
+      piece_ms = piece_end_ms;
+    }
+    sentence_next = s.event.phoneme.end_of_text;
+  }
+  fill_silence(std::max(file_end_ms, cuts.empty() ? 0 : cuts.back().time_ms + 1));
+  for (auto it = out.rbegin(); it != out.rend(); ++it) {
+    if (it->event.kind == PFAP_EVENT_PHONEME) {
+      it->event.phoneme.end_of_text = true;
+      break;
+    }
+  }
+  return out;
 }
 
 FapRecorder::FapRecorder(double frame_rate, uint32_t max_frames)

@@ -14,21 +14,10 @@
 
 namespace {
 
-void check_events(const pfap::FapFile& file) {
-  pfap::NotCarried not_carried;
-  const std::vector<pfap::TextEvent> events = pfap::markup_of(file, &not_carried);
-  FUZZ_CHECK(events.size() >= file.frames.size());
+// Applies `events` to a FapState and checks every frame's values at its time.
+void check_values(const pfap::FapFile& file, const std::vector<pfap::TextEvent>& events) {
   pfap::FapState state;
   size_t next = 0;
-  int64_t end_ms = 0;
-  for (const pfap::TextEvent& e : events) {
-    FUZZ_CHECK(e.time_ms == end_ms);  // phonemes tile the file's time
-    FUZZ_CHECK(pfap::is_valid(e.event.phoneme));
-    FUZZ_CHECK(e.event.faps.size() <= size_t{pfap::kMaxBookmarksPerPhoneme});
-    for (const pfap::Fap& f : e.event.faps) FUZZ_CHECK(pfap::is_valid(f));
-    end_ms += e.event.phoneme.duration_ms;
-  }
-  FUZZ_CHECK(events.back().event.phoneme.end_of_text);
   for (const pfap::FapFrame& frame : file.frames) {
     const int64_t at = pfap::frame_time_ms(frame.number, file.header.frame_rate) * pfap::kNsPerMs;
     for (; next < events.size() && events[next].time_ms * pfap::kNsPerMs <= at; ++next) {
@@ -42,6 +31,47 @@ void check_events(const pfap::FapFile& file) {
       FUZZ_CHECK(state.amplitude(i, at) == want[i]);
     }
   }
+}
+
+void check_valid(const std::vector<pfap::TextEvent>& events) {
+  if (events.empty()) return;  // a merge of no speech with a file that never changes
+  int64_t last_ms = 0;
+  for (const pfap::TextEvent& e : events) {
+    FUZZ_CHECK(e.time_ms >= last_ms);
+    last_ms = e.time_ms;
+    FUZZ_CHECK(pfap::is_valid(e.event.phoneme));
+    FUZZ_CHECK(e.event.faps.size() <= size_t{pfap::kMaxBookmarksPerPhoneme});
+    for (const pfap::Fap& f : e.event.faps) FUZZ_CHECK(pfap::is_valid(f));
+  }
+  FUZZ_CHECK(events.back().event.phoneme.end_of_text);
+}
+
+void check_events(const pfap::FapFile& file) {
+  const std::vector<pfap::TextEvent> events = pfap::markup_of(file);
+  FUZZ_CHECK(events.size() >= file.frames.size() && !events.empty());
+  int64_t end_ms = 0;
+  for (const pfap::TextEvent& e : events) {
+    FUZZ_CHECK(e.time_ms == end_ms);  // phonemes tile the file's time
+    end_ms += e.event.phoneme.duration_ms;
+  }
+  check_valid(events);
+  check_values(file, events);
+
+  // Merged with speech over the first half of the file, 70 ms phonemes with a gap after
+  // the third: the file's values stay.
+  std::vector<pfap::TextEvent> speech;
+  for (int64_t at = 0; at < end_ms / 2; at += 70) {
+    pfap::TextEvent s;
+    s.time_ms = speech.size() == 3 ? at + 30 : at;
+    s.event.kind = PFAP_EVENT_PHONEME;
+    s.event.phoneme.symbol = 7;
+    s.event.phoneme.duration_ms = 70;
+    speech.push_back(s);
+    if (speech.size() == 4) at += 30;
+  }
+  const std::vector<pfap::TextEvent> merged = pfap::merge_with_speech(speech, events);
+  check_valid(merged);
+  check_values(file, merged);
 }
 
 }  // namespace

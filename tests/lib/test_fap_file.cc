@@ -406,6 +406,82 @@ TEST(FapFileMarkup, FrameTimesAreRoundedToWholeMs) {
   EXPECT_EQ(first_difference(sampled(markup_of(file), file.header), amplitudes_of(file)), "");
 }
 
+TextEvent speech_phoneme(int64_t start_ms, uint16_t duration_ms, uint8_t symbol, bool end = false,
+                         std::vector<Fap> faps = {}) {
+  TextEvent e;
+  e.time_ms = start_ms;
+  e.event.kind = PFAP_EVENT_PHONEME;
+  e.event.phoneme = {.symbol = symbol,
+                     .duration_ms = duration_ms,
+                     .f0 = 60,
+                     .stress = true,
+                     .word_begin = true,
+                     .end_of_text = end};
+  e.event.sentence_start = start_ms == 0;
+  e.event.faps = std::move(faps);
+  return e;
+}
+
+TEST(FapFileMarkup, MergedWithSpeechTheFileKeepsItsValuesAndTheSpeechItsPhonemes) {
+  FapFile file;
+  ASSERT_TRUE(read_fap_file(small_file(20), file).ok());  // 0..800 ms, a change each frame
+  // Speech: 0..100 (split at 40 and 80), 100..250 (end of text; split at 120 ... 240), a gap
+  // with frames from 280, 400..500, then frames after the speech to 800.
+  const std::vector<TextEvent> speech = {speech_phoneme(0, 100, 7),
+                                         speech_phoneme(100, 150, 8, true),
+                                         speech_phoneme(400, 100, 9, true)};
+  const std::vector<TextEvent> merged = merge_with_speech(speech, markup_of(file), 0);
+  EXPECT_EQ(first_difference(sampled(merged, file.header), amplitudes_of(file)), "");
+
+  // Each speech phoneme is still there, in pieces that tile it; silence only where no speech.
+  for (const TextEvent& s : speech) {
+    int64_t covered = 0;
+    for (const TextEvent& m : merged) {
+      if (m.time_ms < s.time_ms || m.time_ms >= s.time_ms + s.event.phoneme.duration_ms) continue;
+      EXPECT_EQ(m.event.phoneme.symbol, s.event.phoneme.symbol) << m.time_ms;
+      EXPECT_EQ(m.event.phoneme.f0, 60);
+      EXPECT_EQ(m.event.phoneme.word_begin, m.time_ms == s.time_ms);
+      covered += m.event.phoneme.duration_ms;
+    }
+    EXPECT_EQ(covered, s.event.phoneme.duration_ms);
+  }
+  int64_t at = 0;
+  for (const TextEvent& m : merged) {
+    if (m.time_ms != at) {  // gaps: from each end of speech to the next frame
+      EXPECT_TRUE((at == 250 && m.time_ms == 280) || (at == 500 && m.time_ms == 520))
+          << at << " to " << m.time_ms;
+    }
+    at = m.time_ms + m.event.phoneme.duration_ms;
+    const bool in_speech = m.time_ms < 250 || (m.time_ms >= 400 && m.time_ms < 500);
+    EXPECT_EQ(m.event.phoneme.symbol == 0, !in_speech) << m.time_ms;
+    EXPECT_EQ(m.event.phoneme.end_of_text, m.time_ms == 240 || m.time_ms == 480 || m.time_ms == 760)
+        << m.time_ms;
+    EXPECT_EQ(m.event.sentence_start, m.time_ms == 0 || m.time_ms == 280 || m.time_ms == 520)
+        << m.time_ms;
+  }
+  EXPECT_EQ(at, 800);
+}
+
+TEST(FapFileMarkup, MergedTheFileWinsOverTheSpeechAtItsFrames) {
+  FapFile file;
+  ASSERT_TRUE(read_fap_file(small_file(3), file).ok());  // FAP 3: 0, 1, 2
+  const std::vector<TextEvent> speech = {
+      speech_phoneme(0, 50, 7, false, {{3, 99, 0, Curve::kLinear}}),
+      speech_phoneme(50, 70, 8, true, {{3, 77, 0, Curve::kLinear}})};
+  const std::vector<TextEvent> merged = merge_with_speech(speech, markup_of(file), 0);
+  // 99 at 0 is overridden by frame 0's 0... frame 0 has no change of FAP 3 (0 -> 0), so the
+  // speech's 99 holds at 0 ms; frames 1 and 2 (40, 80 ms) set 1 and 2 after the speech's.
+  const std::vector<FapAmplitudes> got = sampled(merged, file.header);
+  EXPECT_EQ(got[0][3], 99);
+  EXPECT_EQ(got[1][3], 1);
+  EXPECT_EQ(got[2][3], 2);
+  ASSERT_EQ(merged.size(), 4u);  // 0..40, 40..50, 50..80, 80..120
+  EXPECT_EQ(merged[1].time_ms, 40);
+  EXPECT_EQ(merged[1].event.phoneme.symbol, 7);
+  EXPECT_EQ(merged[3].event.phoneme.duration_ms, 40);
+  EXPECT_TRUE(merged[3].event.phoneme.end_of_text);
+}
+
 TEST(FapRecorder, SetsEveryFapEverUsedInEveryFrameAndTheTwoStrongestExpressions) {
   FapRecorder recorder(25.0);
   MarkupEvent e;

@@ -67,6 +67,20 @@ class FapFileMarkup {
 // The events of a whole file.
 std::vector<TextEvent> markup_of(const FapFile& file, NotCarried* not_carried = nullptr);
 
+// A file's events (markup_of) merged with a speech stream's events, both timed from 0 ms and
+// in time order, speech phonemes one after the other. Each frame's bookmarks go on the speech
+// phoneme that starts at the frame's time; a speech phoneme that spans a frame with changes is
+// split there into pieces of the same symbol and f0 (the first keeps stress, word begin,
+// sentence start and the speech's own FAPs, the last end of text). Where no speech phoneme
+// spans a frame with changes, a silence phoneme carries them, lasting until the next such
+// frame or speech phoneme. The file's bookmarks come after the speech's at the same time, so
+// the file's value wins there; a FAP the speech sets between frames holds until the file's
+// next change of it. More than kMaxBookmarksPerPhoneme FAPs on one phoneme go on 0 ms silence
+// phonemes before it. The last phoneme ends the text.
+std::vector<TextEvent> merge_with_speech(const std::vector<TextEvent>& speech,
+                                         const std::vector<TextEvent>& file_events,
+                                         uint8_t silence_symbol = kSilenceSymbol);
+
 // What a FAP file can hold of the amplitudes that it cannot write as they are.
 struct NotWritten {
   uint64_t expressions_dropped = 0;  // a third (or more) expression at once: FAP 2 has two
