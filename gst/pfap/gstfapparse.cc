@@ -21,6 +21,13 @@
  * The output is a TIME segment from 0 with the first frame at 0; a sink with sync=true plays
  * the animation in real time. The caps carry `alphabet` (#GstFapParse:alphabet).
  *
+ * With the request pad `speech` linked to a phoneme stream (pfaptts, pfapparse), the file's
+ * bookmarks go on the speech's phonemes instead (pfap::merge_with_speech): a phoneme that
+ * spans a frame with changes is split there into pieces of the same symbol, and silence
+ * phonemes carry only the frames where no one speaks. Both are timed from their segment's
+ * start. The two inputs are kept until both have ended (at most 100000 speech events), then
+ * the merged stream goes out; the caps take the speech's alphabet when it has one.
+ *
  * A bad file (an unsupported version, a mask without 68 flags, a value past the draft's
  * amplitude range, frame numbers out of order, an absurd frame count or rate, fewer frames
  * than the header says) is an error naming the file, its line, field and FAP: a FAP file's
@@ -35,10 +42,14 @@
  * |[
  * gst-launch-1.0 filesrc location=joy.fap ! fapparse ! rtppfappay ! udpsink host=127.0.0.1 port=5004
  * ]| Sends joy.fap as PFAP RTP packets to port 5004, in real time.
+ * |[
+ * gst-launch-1.0 pfaptts text="Hello world." name=t t.pfap ! p.speech filesrc location=joy.fap ! fapparse name=p ! pfapface ! videoconvert ! autovideosink
+ * ]| Smiles joy.fap's smile on the phonemes of a spoken sentence.
  */
 // clang-format on
 #include "gstfapparse.h"
 
+#include <algorithm>
 #include <bit>
 #include <cstdint>
 #include <optional>
@@ -75,20 +86,44 @@ struct Stream {
   std::string file;  // the upstream location, for messages; empty when unknown
 };
 
+// With a speech pad: both inputs kept until both have ended, then merged
+// (pfap::merge_with_speech). Under GstFapParse::merge_lock: the two pads stream in two threads.
+struct Merge {
+  Merge() { gst_segment_init(&speech_segment, GST_FORMAT_TIME); }
+
+  std::vector<pfap::TextEvent> file_events;
+  std::vector<pfap::TextEvent> speech;
+  GstSegment speech_segment;
+  int64_t speech_end_ms = 0;  // where the last speech phoneme ends
+  std::string alphabet;       // the speech caps' alphabet, if any
+  uint64_t dropped = 0;       // malformed or over-limit speech events
+  bool file_ended = false;
+  bool speech_ended = false;
+};
+
+// Far above an hour of speech (about 12 phonemes a second): bounds what the speech pad keeps.
+constexpr size_t kMaxSpeechEvents = 100'000;
+
 }  // namespace
 
 struct _GstFapParse {
   GstElement parent;
   GstPad* sinkpad;
   GstPad* srcpad;
+  GstPad* speechpad;     // the request pad, or NULL
   guint silence_symbol;  // under the object lock
   gchar* alphabet;       // under the object lock; NULL when unset
   Stream* stream;
+  GMutex merge_lock;
+  Merge* merge;
 };
 
 static GstStaticPadTemplate sink_template =
     GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS,
                             GST_STATIC_CAPS("text/x-raw, format = (string) utf8; text/plain"));
+
+static GstStaticPadTemplate speech_template = GST_STATIC_PAD_TEMPLATE(
+    "speech", GST_PAD_SINK, GST_PAD_REQUEST, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
 
 static GstStaticPadTemplate src_template =
     GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
@@ -97,7 +132,19 @@ G_DEFINE_TYPE(GstFapParse, gst_fap_parse, GST_TYPE_ELEMENT)
 GST_ELEMENT_REGISTER_DEFINE(fapparse, "fapparse", GST_RANK_NONE, GST_TYPE_FAP_PARSE)
 
 // Back to the start of a file (READY to PAUSED, FLUSH_STOP).
-static void reset(GstFapParse* self) { *self->stream = Stream{}; }
+static void reset(GstFapParse* self) {
+  *self->stream = Stream{};
+  g_mutex_lock(&self->merge_lock);
+  *self->merge = Merge{};
+  g_mutex_unlock(&self->merge_lock);
+}
+
+static bool merging(GstFapParse* self) {
+  GST_OBJECT_LOCK(self);
+  const bool speech = self->speechpad != nullptr;
+  GST_OBJECT_UNLOCK(self);
+  return speech;
+}
 
 // The upstream file's name for messages, asked once: filesrc answers the URI query.
 static const std::string& file_name(GstFapParse* self) {
@@ -127,12 +174,17 @@ static void send_events(GstFapParse* self) {
   }
   if (!gst_pad_has_current_caps(self->srcpad)) {
     GstCaps* caps = gst_static_pad_template_get_caps(&src_template);
+    // Merged, the phonemes are mostly the speech's: its alphabet, when it names one.
+    g_mutex_lock(&self->merge_lock);
+    std::string alphabet = self->merge->alphabet;
+    g_mutex_unlock(&self->merge_lock);
     GST_OBJECT_LOCK(self);
-    if (self->alphabet != nullptr && *self->alphabet != '\0') {
-      caps = gst_caps_make_writable(caps);
-      gst_caps_set_simple(caps, "alphabet", G_TYPE_STRING, self->alphabet, nullptr);
-    }
+    if (alphabet.empty() && self->alphabet != nullptr) alphabet = self->alphabet;
     GST_OBJECT_UNLOCK(self);
+    if (!alphabet.empty()) {
+      caps = gst_caps_make_writable(caps);
+      gst_caps_set_simple(caps, "alphabet", G_TYPE_STRING, alphabet.c_str(), nullptr);
+    }
     gst_pad_push_event(self->srcpad, gst_event_new_caps(caps));
     gst_caps_unref(caps);
   }
@@ -185,6 +237,31 @@ static void report_not_carried(GstFapParse* self, const pfap::FapFrame& frame) {
   s.reported = now;
 }
 
+// Pushes events, the silence symbol set on the phonemes the file made.
+static GstFlowReturn push_events(GstFapParse* self, const std::vector<pfap::TextEvent>& events) {
+  Stream& s = *self->stream;
+  send_events(self);
+  for (const pfap::TextEvent& event : events) {
+    GstBuffer* buffer = pfap_buffer_new(event.event);
+    if (buffer == nullptr) {
+      // The reader keeps values within range and the markup 40 FAPs per phoneme: a bug.
+      GST_ELEMENT_ERROR(
+          self, STREAM, FAILED, (nullptr),
+          ("the event at %" G_GINT64_FORMAT " ms is one x-pfap cannot hold", event.time_ms));
+      return GST_FLOW_ERROR;
+    }
+    GST_BUFFER_PTS(buffer) = event.time_ms * GST_MSECOND;
+    if (event.event.kind == PFAP_EVENT_PHONEME) {
+      GST_BUFFER_DURATION(buffer) = event.event.phoneme.duration_ms * GST_MSECOND;
+    }
+    if (s.discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
+    s.discont = false;
+    const GstFlowReturn ret = gst_pad_push(self->srcpad, buffer);
+    if (ret != GST_FLOW_OK) return ret;
+  }
+  return GST_FLOW_OK;
+}
+
 static GstFlowReturn push_frame(GstFapParse* self, const pfap::FapFrame& frame) {
   Stream& s = *self->stream;
   if (!s.markup) s.markup.emplace(s.reader.header());
@@ -194,24 +271,38 @@ static GstFlowReturn push_frame(GstFapParse* self, const pfap::FapFrame& frame) 
   GST_OBJECT_LOCK(self);
   const auto symbol = static_cast<uint8_t>(self->silence_symbol);
   GST_OBJECT_UNLOCK(self);
-  send_events(self);
-  for (pfap::TextEvent& event : s.events) {
-    event.event.phoneme.symbol = symbol;
-    GstBuffer* buffer = pfap_buffer_new(event.event);
-    if (buffer == nullptr) {
-      // The reader keeps values within range and the markup 40 FAPs per phoneme: a bug.
-      GST_ELEMENT_ERROR(self, STREAM, FAILED, (nullptr),
-                        ("frame %u gives an event x-pfap cannot hold", frame.number));
-      return GST_FLOW_ERROR;
-    }
-    GST_BUFFER_PTS(buffer) = event.time_ms * GST_MSECOND;
-    GST_BUFFER_DURATION(buffer) = event.event.phoneme.duration_ms * GST_MSECOND;
-    if (s.discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
-    s.discont = false;
-    const GstFlowReturn ret = gst_pad_push(self->srcpad, buffer);
-    if (ret != GST_FLOW_OK) return ret;
+  for (pfap::TextEvent& event : s.events) event.event.phoneme.symbol = symbol;
+  if (merging(self)) {
+    g_mutex_lock(&self->merge_lock);
+    self->merge->file_events.insert(self->merge->file_events.end(), s.events.begin(),
+                                    s.events.end());
+    g_mutex_unlock(&self->merge_lock);
+    return GST_FLOW_OK;
   }
-  return GST_FLOW_OK;
+  return push_events(self, s.events);
+}
+
+// At the end of the file or of the speech: once both have ended, the merged events and EOS
+// go downstream. Returns whether this call sent them (else the other input's end will).
+static bool end_of_input(GstFapParse* self, bool file) {
+  g_mutex_lock(&self->merge_lock);
+  Merge& m = *self->merge;
+  (file ? m.file_ended : m.speech_ended) = true;
+  if (!m.file_ended || !m.speech_ended) {
+    g_mutex_unlock(&self->merge_lock);
+    return false;
+  }
+  std::vector<pfap::TextEvent> file_events = std::move(m.file_events);
+  std::vector<pfap::TextEvent> speech = std::move(m.speech);
+  g_mutex_unlock(&self->merge_lock);
+  GST_OBJECT_LOCK(self);
+  const auto symbol = static_cast<uint8_t>(self->silence_symbol);
+  GST_OBJECT_UNLOCK(self);
+  GST_DEBUG_OBJECT(self, "merging %zu file events with %zu speech events", file_events.size(),
+                   speech.size());
+  push_events(self, pfap::merge_with_speech(speech, file_events, symbol));
+  gst_pad_push_event(self->srcpad, gst_event_new_eos());
+  return true;
 }
 
 static GstFlowReturn read_line(GstFapParse* self, std::string_view line) {
@@ -297,6 +388,11 @@ static gboolean gst_fap_parse_sink_event(GstPad* pad, GstObject* parent, GstEven
         gst_event_unref(event);
         return FALSE;
       }
+      if (merging(self)) {
+        gst_event_unref(event);
+        end_of_input(self, true);
+        return TRUE;
+      }
       send_events(self);
       break;
     }
@@ -327,6 +423,102 @@ static gboolean gst_fap_parse_src_query(GstPad* pad, GstObject* parent, GstQuery
     return TRUE;
   }
   return gst_pad_query_default(pad, parent, query);
+}
+
+// Speech events are kept, timed in ms from the speech segment's start, until both inputs end.
+static GstFlowReturn gst_fap_parse_speech_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
+  GstFapParse* self = GST_FAP_PARSE(parent);
+  pfap::TextEvent event;
+  const bool ok = pfap_buffer_read(buffer, event.event);
+  g_mutex_lock(&self->merge_lock);
+  Merge& m = *self->merge;
+  const GstClockTime running =
+      gst_segment_to_running_time(&m.speech_segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
+  // An event without a time starts where the speech before it ended.
+  event.time_ms = GST_CLOCK_TIME_IS_VALID(running)
+                      ? static_cast<int64_t>((running + GST_MSECOND / 2) / GST_MSECOND)
+                      : m.speech_end_ms;
+  if (!m.speech.empty()) event.time_ms = std::max(event.time_ms, m.speech.back().time_ms);
+  const bool kept = ok && m.speech.size() < kMaxSpeechEvents;
+  if (kept) {
+    if (event.event.kind == PFAP_EVENT_PHONEME) {
+      // Speech phonemes one after the other: an overlap is cut from the earlier one's end.
+      event.time_ms = std::max(event.time_ms, m.speech_end_ms);
+      m.speech_end_ms = event.time_ms + event.event.phoneme.duration_ms;
+    }
+    m.speech.push_back(std::move(event));
+  }
+  const uint64_t dropped = kept ? 0 : ++m.dropped;
+  g_mutex_unlock(&self->merge_lock);
+  if (!kept && pfap_warn_at(dropped)) {
+    GST_ELEMENT_WARNING(
+        self, STREAM, DECODE,
+        ("Dropped a speech event: %s.",
+         ok ? "too many speech events to merge" : "not a valid x-pfap event"),
+        ("%" G_GUINT64_FORMAT " dropped so far; at most %zu are kept", dropped, kMaxSpeechEvents));
+  }
+  gst_buffer_unref(buffer);
+  return GST_FLOW_OK;
+}
+
+static gboolean gst_fap_parse_speech_event(GstPad*, GstObject* parent, GstEvent* event) {
+  GstFapParse* self = GST_FAP_PARSE(parent);
+  switch (GST_EVENT_TYPE(event)) {
+    case GST_EVENT_CAPS: {
+      GstCaps* caps = nullptr;
+      gst_event_parse_caps(event, &caps);
+      const gchar* alphabet = gst_structure_get_string(gst_caps_get_structure(caps, 0), "alphabet");
+      g_mutex_lock(&self->merge_lock);
+      self->merge->alphabet = alphabet != nullptr ? alphabet : "";
+      g_mutex_unlock(&self->merge_lock);
+      break;
+    }
+    case GST_EVENT_SEGMENT: {
+      GstSegment segment;
+      gst_event_copy_segment(event, &segment);
+      if (segment.format == GST_FORMAT_TIME) {
+        g_mutex_lock(&self->merge_lock);
+        self->merge->speech_segment = segment;
+        g_mutex_unlock(&self->merge_lock);
+      }
+      break;
+    }
+    case GST_EVENT_EOS:
+      end_of_input(self, false);
+      break;
+    default:
+      break;  // the output's stream, caps, segment and flushes are the file's
+  }
+  gst_event_unref(event);
+  return TRUE;
+}
+
+static GstPad* gst_fap_parse_request_new_pad(GstElement* element, GstPadTemplate* templ,
+                                             const gchar*, const GstCaps*) {
+  GstFapParse* self = GST_FAP_PARSE(element);
+  GST_OBJECT_LOCK(self);
+  const bool taken = self->speechpad != nullptr;
+  GST_OBJECT_UNLOCK(self);
+  if (taken) {
+    GST_WARNING_OBJECT(self, "one speech pad only");
+    return nullptr;
+  }
+  GstPad* pad = gst_pad_new_from_template(templ, "speech");
+  gst_pad_set_chain_function(pad, gst_fap_parse_speech_chain);
+  gst_pad_set_event_function(pad, gst_fap_parse_speech_event);
+  GST_OBJECT_LOCK(self);
+  self->speechpad = pad;
+  GST_OBJECT_UNLOCK(self);
+  gst_element_add_pad(element, pad);
+  return pad;
+}
+
+static void gst_fap_parse_release_pad(GstElement* element, GstPad* pad) {
+  GstFapParse* self = GST_FAP_PARSE(element);
+  GST_OBJECT_LOCK(self);
+  if (self->speechpad == pad) self->speechpad = nullptr;
+  GST_OBJECT_UNLOCK(self);
+  gst_element_remove_pad(element, pad);
 }
 
 static GstStateChangeReturn gst_fap_parse_change_state(GstElement* element,
@@ -374,6 +566,8 @@ static void gst_fap_parse_get_property(GObject* object, guint prop_id, GValue* v
 
 static void gst_fap_parse_finalize(GObject* object) {
   delete GST_FAP_PARSE(object)->stream;
+  delete GST_FAP_PARSE(object)->merge;
+  g_mutex_clear(&GST_FAP_PARSE(object)->merge_lock);
   g_free(GST_FAP_PARSE(object)->alphabet);
   G_OBJECT_CLASS(gst_fap_parse_parent_class)->finalize(object);
 }
@@ -418,6 +612,7 @@ static void gst_fap_parse_class_init(GstFapParseClass* klass) {
                                                    GST_PARAM_MUTABLE_READY)));
 
   gst_element_class_add_static_pad_template(element_class, &sink_template);
+  gst_element_class_add_static_pad_template(element_class, &speech_template);
   gst_element_class_add_static_pad_template(element_class, &src_template);
   gst_element_class_set_static_metadata(
       element_class, "MPEG-4 FAP file parser", "Codec/Parser/Text",
@@ -425,6 +620,8 @@ static void gst_fap_parse_class_init(GstFapParseClass* klass) {
       "gst-pfap developers");
 
   element_class->change_state = gst_fap_parse_change_state;
+  element_class->request_new_pad = gst_fap_parse_request_new_pad;
+  element_class->release_pad = gst_fap_parse_release_pad;
 }
 
 static void gst_fap_parse_init(GstFapParse* self) {
@@ -442,4 +639,7 @@ static void gst_fap_parse_init(GstFapParse* self) {
   self->silence_symbol = kDefaultSilenceSymbol;
   self->alphabet = g_strdup(kDefaultAlphabet);
   self->stream = new Stream{};
+  self->speechpad = nullptr;
+  g_mutex_init(&self->merge_lock);
+  self->merge = new Merge{};
 }

@@ -206,6 +206,70 @@ TEST(FapParse, RoundedValuesAreWarnedAbout) {
   EXPECT_EQ(p.wait_eos(std::chrono::seconds(10), true), "");  // then EOS, no other warning
 }
 
+// With a speech pad, the file's FAPs go on the speech's phonemes, whichever input ends first.
+TEST(FapParse, MergedWithASpeechStreamKeepsTheFileValuesAndTheSpeechPhonemes) {
+  ASSERT_TRUE(plugin_available(kElements));
+  std::string mask = "0 0 1";
+  for (int i = 4; i <= 68; ++i) mask += " 0";
+  std::string text = "2.1 t 25 10\n";
+  for (int k = 0; k < 10; ++k)
+    text += mask + "\n" + std::to_string(k) + " " + std::to_string(k * 7) + "\n";
+  pfap::FapFile file;
+  ASSERT_TRUE(pfap::read_fap_file(text, file).ok());
+  for (const bool speech_ends_first : {true, false}) {
+    SCOPED_TRACE(speech_ends_first ? "speech ends first" : "file ends first");
+    GstHarness* h = gst_harness_new_with_padnames("fapparse", "sink", "src");
+    GstHarness* speech = gst_harness_new_with_element(h->element, "speech", nullptr);
+    ASSERT_NE(speech, nullptr);
+    gst_harness_set_src_caps_str(speech, "application/x-pfap,alphabet=x-sampa");
+    gst_harness_set_src_caps_str(h, "text/plain");
+    ASSERT_EQ(gst_harness_push(h, gst_buffer_new_memdup(text.data(), text.size())), GST_FLOW_OK);
+    for (const auto& [start, duration] : {std::pair{0, 100}, {100, 150}}) {
+      pfap::Phoneme p;
+      p.symbol = 9;
+      p.duration_ms = static_cast<uint16_t>(duration);
+      ASSERT_EQ(gst_harness_push(
+                    speech, pfap::testing::phoneme_buffer(p, {}, start * GST_MSECOND, start == 0)),
+                GST_FLOW_OK);
+    }
+    EXPECT_EQ(gst_harness_try_pull(h), nullptr);  // nothing before both inputs end
+    GstHarness* first = speech_ends_first ? speech : h;
+    GstHarness* second = speech_ends_first ? h : speech;
+    ASSERT_TRUE(gst_harness_push_event(first, gst_event_new_eos()));
+    EXPECT_EQ(gst_harness_try_pull(h), nullptr);
+    ASSERT_TRUE(gst_harness_push_event(second, gst_event_new_eos()));
+
+    GstCaps* caps = gst_pad_get_current_caps(h->sinkpad);
+    ASSERT_NE(caps, nullptr);
+    EXPECT_STREQ(gst_structure_get_string(gst_caps_get_structure(caps, 0), "alphabet"), "x-sampa");
+    gst_caps_unref(caps);
+    pfap::FapState state;
+    std::vector<pfap::testing::Event> events;
+    while (GstBuffer* b = gst_harness_try_pull(h)) {
+      events.push_back(pfap::testing::read_event(b));
+      events.back().pts = GST_BUFFER_PTS(b);
+      gst_buffer_unref(b);
+    }
+    size_t next = 0;
+    for (uint32_t k = 0; k < 10; ++k) {
+      const auto at = static_cast<GstClockTime>(pfap::frame_time_ms(k, 25.0)) * GST_MSECOND;
+      for (; next < events.size() && events[next].pts <= at; ++next) {
+        for (const pfap::Fap& f : events[next].faps) {
+          state.apply(f, static_cast<int64_t>(events[next].pts));
+        }
+      }
+      EXPECT_EQ(state.amplitude(3, static_cast<int64_t>(at)), k * 7.0) << "frame " << k;
+    }
+    // The speech's 250 ms are its symbol, cut at the frames; silence carries the rest.
+    for (const auto& e : events) {
+      EXPECT_EQ(e.phoneme.symbol, e.pts < 250 * GST_MSECOND ? 9 : 0) << e.pts;
+    }
+    EXPECT_TRUE(events.back().phoneme.end_of_text);
+    gst_harness_teardown(speech);
+    gst_harness_teardown(h);
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Over RTP with loss, back to a file
 
@@ -463,7 +527,7 @@ TEST(FapDocumented, EveryCommandRunsToEos) {
   const char* used[] = {"fapparse", "pfapfapenc", "pfaptts", "pfapface", "netsim"};
   ASSERT_TRUE(plugin_available(used));
   const std::vector<std::string> commands = documented_commands();
-  ASSERT_EQ(commands.size(), 3u);
+  ASSERT_EQ(commands.size(), 4u);
   TempDir dir;
   for (std::string command : commands) {
     SCOPED_TRACE(command);
