@@ -5,7 +5,6 @@
 #include "pfap/fap_file.h"
 
 #include <charconv>
-#include <cmath>
 #include <cstdio>
 
 #include "number.h"

@@ -9,13 +9,13 @@
 //    with the real files, temporary outputs and fakesink for the display.
 #include <gst/check/gstharness.h>
 #include <gst/gst.h>
-#include <gst/rtp/gstrtpbuffer.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <iostream>
 #include <random>
 #include <string>
 #include <vector>
