@@ -71,6 +71,38 @@ TEXT_LINES = [
 ]
 
 
+def fap_mask(faps):
+    return " ".join("1" if i in faps else "0" for i in range(1, 69))
+
+
+def fap_file(frames, faps, values, header="2.1 synthetic 25", end="\n"):
+    """A synthetic MPEG-4 FAP file (fuzz_fap_file's seeds; never the real shared ones)."""
+    lines = [f"{header} {frames}"]
+    for k in range(frames):
+        lines += [fap_mask(faps), f"{k} " + " ".join(values(k))]
+    return (end.join(lines) + end).encode()
+
+
+# Synthetic FAP files: plain, with comments and CRLF, fractions, visemes and expressions,
+# more than 40 FAPs at once, and bad ones (truncated, mask of 67, value out of range).
+FAP_FILES = {
+    "plain": fap_file(5, {3, 4, 48}, lambda k: [str(10 * k), str(-k), "0"]),
+    "crlf-comments": b"# a comment\r\n" + fap_file(2, {19, 20}, lambda k: ["1", "2"],
+                                                     header="2.0 C:\\faces\\a b 12.5",
+                                                     end="\r\n"),
+    "fractions": fap_file(3, {5}, lambda k: [f"{k}.5"]),
+    "viseme-expression": fap_file(3, {1, 2, 3}, lambda k: ["3", "4", "50", "1",
+                                                          "1", "40", "6", str(k), "0", "0",
+                                                          "-7"]),
+    "all-faps": fap_file(2, set(range(3, 69)), lambda k: [str(i * (k + 1)) for i in range(3, 69)],
+                         header="2.1 all 1000"),
+    "truncated": fap_file(3, {3}, lambda k: [str(k)])[:-3],
+    "mask-67": b"2.1 t 25 1\n" + fap_mask({3})[:-2].encode() + b"\n0 1\n",
+    "out-of-range": fap_file(1, {3}, lambda k: ["2529601"]),
+    "absurd-count": b"2.1 t 25 99999999999\n",
+}
+
+
 def write(harness, name, data):
     out = FUZZ / "corpus" / harness
     out.mkdir(parents=True, exist_ok=True)
@@ -97,7 +129,7 @@ def rtp_input(packets):
 
 
 def main():
-    for harness in ("fuzz_payload", "fuzz_bookmark", "fuzz_text", "fuzz_depay"):
+    for harness in ("fuzz_payload", "fuzz_bookmark", "fuzz_text", "fuzz_depay", "fuzz_fap_file"):
         shutil.rmtree(FUZZ / "corpus" / harness, ignore_errors=True)
 
     samples = sample_payloads()
@@ -140,6 +172,10 @@ def main():
                                          [(0x00, b"")]))
     write("fuzz_depay", "mixed", rtp_input([(0x01, samples[0]), (0x00, hex_bytes(BAD["curve_zero"])),
                                             (0x20, samples[1]), (0x00, samples[2])]))
+
+    for name, data in FAP_FILES.items():
+        write("fuzz_fap_file", name, data)
+
 
 if __name__ == "__main__":
     main()

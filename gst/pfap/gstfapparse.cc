@@ -1,0 +1,645 @@
+// The example pipelines stay on one line, to be copied.
+// clang-format off
+/**
+ * SECTION:element-fapparse
+ * @title: fapparse
+ * @see_also: pfapfapenc, pfapparse, rtppfappay, pfapface
+ *
+ * Reads an MPEG-4 FAP file (.fap, the FBA text format of Xface, Greta and other MPEG-4 face
+ * players; docs/fap-files.md) and outputs its animation as application/x-pfap events, which
+ * rtppfappay, pfapface and pfaptextenc take as they are. Frame k becomes a silence phoneme
+ * (#GstFapParse:silence-symbol) at k / frame rate seconds, rounded to the ms, lasting until
+ * the next frame, with a bookmark `<FAP n a 0 1>` (linear, T = 0) for each FAP whose value
+ * changed since the frame before: a receiver's FAP state holds each frame's values from its
+ * time to the next frame's, as MPEG-4 players show the file. More than 40 changes in a frame
+ * go on extra 0 ms silence phonemes at the same time (MPEG-4 allows 40 bookmarks before a
+ * phoneme). Expression FAP 2 becomes FAPs 69..74 as the bookmark rule `<FAP 2 e1 a1 e2 a2>`
+ * does. The draft has no place for FAP 1 (visemes are phonemes here), nor for FAP 2's
+ * init_face and expression_def: each frame that sets them is reported with a warning (at the
+ * 1st, 2nd, 4th, ... such frame), and the rest of the frame goes on.
+ *
+ * The output is a TIME segment from 0 with the first frame at 0; a sink with sync=true plays
+ * the animation in real time. The caps carry `alphabet` (#GstFapParse:alphabet).
+ *
+ * With the request pad `speech` linked to a phoneme stream (pfaptts, pfapparse), the file's
+ * bookmarks go on the speech's phonemes instead (pfap::merge_with_speech): a phoneme that
+ * spans a frame with changes is split there into pieces of the same symbol, and silence
+ * phonemes carry only the frames where no one speaks. Both are timed from their segment's
+ * start. The two inputs are kept until both have ended (at most 100000 speech events), then
+ * the merged stream goes out; the caps take the speech's alphabet when it has one.
+ *
+ * A bad file (an unsupported version, a mask without 68 flags, a value past the draft's
+ * amplitude range, frame numbers out of order, an absurd frame count or rate, fewer frames
+ * than the header says) is an error naming the file, its line, field and FAP: a FAP file's
+ * frames depend on the lines before, so there is nothing to skip to. The limits against
+ * hostile files are those of pfap/fap_file.h: lines of at most 64 KiB, 360000 frames, 1 to
+ * 1000 frames a second.
+ *
+ * ## Example pipelines
+ * |[
+ * gst-launch-1.0 filesrc location=joy.fap ! fapparse ! pfapface ! videoconvert ! autovideosink
+ * ]| Plays joy.fap on the pfapface face.
+ * |[
+ * gst-launch-1.0 filesrc location=joy.fap ! fapparse ! rtppfappay ! udpsink host=127.0.0.1 port=5004
+ * ]| Sends joy.fap as PFAP RTP packets to port 5004, in real time.
+ * |[
+ * gst-launch-1.0 pfaptts text="Hello world." name=t t.pfap ! p.speech filesrc location=joy.fap ! fapparse name=p ! pfapface ! videoconvert ! autovideosink
+ * ]| Smiles joy.fap's smile on the phonemes of a spoken sentence.
+ */
+// clang-format on
+#include "gstfapparse.h"
+
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "pfap/fap_animation.h"
+#include "pfap/fap_file.h"
+#include "pfap/phoneme_table.h"
+#include "pfapbuffer.h"
+
+GST_DEBUG_CATEGORY_STATIC(fapparse_debug);
+#define GST_CAT_DEFAULT fapparse_debug
+
+namespace {
+
+enum { PROP_0, PROP_SILENCE_SYMBOL, PROP_ALPHABET };
+
+constexpr guint kDefaultSilenceSymbol = pfap::kSilenceSymbol;
+constexpr const char* kDefaultAlphabet = pfap::kArpabetAlphabet.data();
+
+// What the streaming thread keeps between buffers. GObject runs no C++ constructors, so it
+// lives behind a pointer made in init and deleted in finalize.
+struct Stream {
+  pfap::FapFileReader reader;
+  std::optional<pfap::FapFileMarkup> markup;  // once the header is read
+  pfap::NotCarried reported;                  // what was already warned about
+  std::string tail;                           // the start of a line whose end has not come yet
+  bool need_events = true;                    // stream-start, caps or segment still to send
+  bool discont = true;
+  bool failed = false;  // an error was posted: the rest is dropped
+  std::vector<pfap::TextEvent> events;
+  std::string file;  // the upstream location, for messages; empty when unknown
+};
+
+// With a speech pad: both inputs kept until both have ended, then merged
+// (pfap::merge_with_speech). Under GstFapParse::merge_lock: the two pads stream in two threads.
+struct Merge {
+  Merge() { gst_segment_init(&speech_segment, GST_FORMAT_TIME); }
+
+  std::vector<pfap::TextEvent> file_events;
+  std::vector<pfap::TextEvent> speech;
+  GstSegment speech_segment;
+  int64_t speech_end_ms = 0;  // where the last speech phoneme ends
+  std::string alphabet;       // the speech caps' alphabet, if any
+  uint64_t dropped = 0;       // malformed or over-limit speech events
+  bool file_ended = false;
+  bool speech_ended = false;
+};
+
+// Far above an hour of speech (about 12 phonemes a second): bounds what the speech pad keeps.
+constexpr size_t kMaxSpeechEvents = 100'000;
+
+}  // namespace
+
+struct _GstFapParse {
+  GstElement parent;
+  GstPad* sinkpad;
+  GstPad* srcpad;
+  GstPad* speechpad;     // the request pad, or NULL
+  guint silence_symbol;  // under the object lock
+  gchar* alphabet;       // under the object lock; NULL when unset
+  Stream* stream;
+  GMutex merge_lock;
+  Merge* merge;
+};
+
+static GstStaticPadTemplate sink_template =
+    GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS,
+                            GST_STATIC_CAPS("text/x-raw, format = (string) utf8; text/plain"));
+
+static GstStaticPadTemplate speech_template = GST_STATIC_PAD_TEMPLATE(
+    "speech", GST_PAD_SINK, GST_PAD_REQUEST, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
+
+static GstStaticPadTemplate src_template =
+    GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
+
+G_DEFINE_TYPE(GstFapParse, gst_fap_parse, GST_TYPE_ELEMENT)
+GST_ELEMENT_REGISTER_DEFINE(fapparse, "fapparse", GST_RANK_NONE, GST_TYPE_FAP_PARSE)
+
+// Back to the start of a file (READY to PAUSED, FLUSH_STOP).
+static void reset(GstFapParse* self) {
+  *self->stream = Stream{};
+  g_mutex_lock(&self->merge_lock);
+  *self->merge = Merge{};
+  g_mutex_unlock(&self->merge_lock);
+}
+
+static bool merging(GstFapParse* self) {
+  GST_OBJECT_LOCK(self);
+  const bool speech = self->speechpad != nullptr;
+  GST_OBJECT_UNLOCK(self);
+  return speech;
+}
+
+// The upstream file's name for messages, asked once: filesrc answers the URI query.
+static const std::string& file_name(GstFapParse* self) {
+  Stream& s = *self->stream;
+  if (!s.file.empty()) return s.file;
+  GstQuery* query = gst_query_new_uri();
+  gchar* uri = nullptr;
+  if (gst_pad_peer_query(self->sinkpad, query)) gst_query_parse_uri(query, &uri);
+  gst_query_unref(query);
+  gchar* path = uri != nullptr ? g_filename_from_uri(uri, nullptr, nullptr) : nullptr;
+  s.file = path != nullptr ? path : uri != nullptr ? uri : "the FAP file";
+  g_free(path);
+  g_free(uri);
+  return s.file;
+}
+
+static void send_events(GstFapParse* self) {
+  Stream& s = *self->stream;
+  if (!s.need_events) return;
+  s.need_events = false;
+  if (GstEvent* start = gst_pad_get_sticky_event(self->srcpad, GST_EVENT_STREAM_START, 0)) {
+    gst_event_unref(start);
+  } else {
+    gchar* id = gst_pad_create_stream_id(self->srcpad, GST_ELEMENT(self), nullptr);
+    gst_pad_push_event(self->srcpad, pfap_make_sparse(gst_event_new_stream_start(id)));
+    g_free(id);
+  }
+  if (!gst_pad_has_current_caps(self->srcpad)) {
+    GstCaps* caps = gst_static_pad_template_get_caps(&src_template);
+    // Merged, the phonemes are mostly the speech's: its alphabet, when it names one.
+    g_mutex_lock(&self->merge_lock);
+    std::string alphabet = self->merge->alphabet;
+    g_mutex_unlock(&self->merge_lock);
+    GST_OBJECT_LOCK(self);
+    if (alphabet.empty() && self->alphabet != nullptr) alphabet = self->alphabet;
+    GST_OBJECT_UNLOCK(self);
+    if (!alphabet.empty()) {
+      caps = gst_caps_make_writable(caps);
+      gst_caps_set_simple(caps, "alphabet", G_TYPE_STRING, alphabet.c_str(), nullptr);
+    }
+    gst_pad_push_event(self->srcpad, gst_event_new_caps(caps));
+    gst_caps_unref(caps);
+  }
+  GstSegment segment;
+  gst_segment_init(&segment, GST_FORMAT_TIME);
+  gst_pad_push_event(self->srcpad, gst_event_new_segment(&segment));
+}
+
+static GstFlowReturn bad_file(GstFapParse* self, const pfap::FapFileResult& result) {
+  self->stream->failed = true;
+  GST_ELEMENT_ERROR(
+      self, STREAM, DECODE,
+      ("Bad FAP file %s, %s", file_name(self).c_str(), pfap::describe(result).c_str()),
+      ("docs/fap-files.md describes what is read"));
+  return GST_FLOW_ERROR;
+}
+
+// Whether a count that went from `before` to `now` passed the 1st, 2nd, 4th, 8th, ...
+// occurrence: pfap_warn_at for counts that may grow by more than one at a time.
+static bool passed_warning(uint64_t before, uint64_t now) {
+  return std::bit_width(before) < std::bit_width(now);
+}
+
+// Warns about what a frame holds that the draft cannot carry, at the 1st, 2nd, 4th, ... one.
+static void report_not_carried(GstFapParse* self, const pfap::FapFrame& frame) {
+  Stream& s = *self->stream;
+  const pfap::NotCarried& now = s.markup->not_carried();
+  if (passed_warning(s.reported.visemes, now.visemes)) {
+    GST_ELEMENT_WARNING(
+        self, STREAM, FORMAT,
+        ("%s frame %u sets FAP 1 (viseme), which PFAP does not carry: visemes "
+         "are phonemes here",
+         file_name(self).c_str(), frame.number),
+        ("%" G_GUINT64_FORMAT " such frames so far (warned at the 1st, 2nd, 4th, ...)",
+         now.visemes));
+  }
+  if (passed_warning(s.reported.expression_flags, now.expression_flags)) {
+    GST_ELEMENT_WARNING(self, STREAM, FORMAT,
+                        ("%s frame %u sets FAP 2's init_face or expression_def, which PFAP does "
+                         "not carry; its expressions are carried",
+                         file_name(self).c_str(), frame.number),
+                        ("%" G_GUINT64_FORMAT " such frames so far", now.expression_flags));
+  }
+  if (passed_warning(s.reported.rounded_values, now.rounded_values)) {
+    GST_ELEMENT_WARNING(self, STREAM, FORMAT,
+                        ("%s frame %u has values with a fraction, rounded to whole FAP units",
+                         file_name(self).c_str(), frame.number),
+                        ("%" G_GUINT64_FORMAT " such values so far", now.rounded_values));
+  }
+  s.reported = now;
+}
+
+// Pushes events, the silence symbol set on the phonemes the file made.
+static GstFlowReturn push_events(GstFapParse* self, const std::vector<pfap::TextEvent>& events) {
+  Stream& s = *self->stream;
+  send_events(self);
+  for (const pfap::TextEvent& event : events) {
+    GstBuffer* buffer = pfap_buffer_new(event.event);
+    if (buffer == nullptr) {
+      // The reader keeps values within range and the markup 40 FAPs per phoneme: a bug.
+      GST_ELEMENT_ERROR(
+          self, STREAM, FAILED, (nullptr),
+          ("the event at %" G_GINT64_FORMAT " ms is one x-pfap cannot hold", event.time_ms));
+      return GST_FLOW_ERROR;
+    }
+    GST_BUFFER_PTS(buffer) = event.time_ms * GST_MSECOND;
+    if (event.event.kind == PFAP_EVENT_PHONEME) {
+      GST_BUFFER_DURATION(buffer) = event.event.phoneme.duration_ms * GST_MSECOND;
+    }
+    if (s.discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
+    s.discont = false;
+    const GstFlowReturn ret = gst_pad_push(self->srcpad, buffer);
+    if (ret != GST_FLOW_OK) return ret;
+  }
+  return GST_FLOW_OK;
+}
+
+static GstFlowReturn push_frame(GstFapParse* self, const pfap::FapFrame& frame) {
+  Stream& s = *self->stream;
+  if (!s.markup) s.markup.emplace(s.reader.header());
+  s.events.clear();
+  s.markup->add(frame, s.events);
+  report_not_carried(self, frame);
+  GST_OBJECT_LOCK(self);
+  const auto symbol = static_cast<uint8_t>(self->silence_symbol);
+  GST_OBJECT_UNLOCK(self);
+  for (pfap::TextEvent& event : s.events) event.event.phoneme.symbol = symbol;
+  if (merging(self)) {
+    g_mutex_lock(&self->merge_lock);
+    self->merge->file_events.insert(self->merge->file_events.end(), s.events.begin(),
+                                    s.events.end());
+    g_mutex_unlock(&self->merge_lock);
+    return GST_FLOW_OK;
+  }
+  return push_events(self, s.events);
+}
+
+// At the end of the file or of the speech: once both have ended, the merged events and EOS
+// go downstream. Returns whether this call sent them (else the other input's end will).
+static bool end_of_input(GstFapParse* self, bool file) {
+  g_mutex_lock(&self->merge_lock);
+  Merge& m = *self->merge;
+  (file ? m.file_ended : m.speech_ended) = true;
+  if (!m.file_ended || !m.speech_ended) {
+    g_mutex_unlock(&self->merge_lock);
+    return false;
+  }
+  std::vector<pfap::TextEvent> file_events = std::move(m.file_events);
+  std::vector<pfap::TextEvent> speech = std::move(m.speech);
+  g_mutex_unlock(&self->merge_lock);
+  GST_OBJECT_LOCK(self);
+  const auto symbol = static_cast<uint8_t>(self->silence_symbol);
+  GST_OBJECT_UNLOCK(self);
+  GST_DEBUG_OBJECT(self, "merging %zu file events with %zu speech events", file_events.size(),
+                   speech.size());
+  push_events(self, pfap::merge_with_speech(speech, file_events, symbol));
+  gst_pad_push_event(self->srcpad, gst_event_new_eos());
+  return true;
+}
+
+static GstFlowReturn read_line(GstFapParse* self, std::string_view line) {
+  Stream& s = *self->stream;
+  pfap::FapFrame frame;
+  bool has_frame = false;
+  const pfap::FapFileResult result = s.reader.read_line(line, frame, has_frame);
+  if (!result.ok()) return bad_file(self, result);
+  return has_frame ? push_frame(self, frame) : GST_FLOW_OK;
+}
+
+// Splits `data` into lines, completing the tail kept from the chunks before.
+static GstFlowReturn read_chunk(GstFapParse* self, std::string_view data) {
+  Stream& s = *self->stream;
+  while (!data.empty()) {
+    const size_t end = data.find('\n');
+    const std::string_view piece = data.substr(0, end);
+    // + 1: a '\r' the reader drops. The reader refuses the line; no need to keep it whole.
+    if (s.tail.size() + piece.size() > pfap::kMaxFapFileLineBytes + 1) {
+      return bad_file(self, {pfap::FapFileStatus::kLineTooLong, s.reader.line() + 1, 0, 0});
+    }
+    if (end == std::string_view::npos) {
+      s.tail.append(piece);
+      return GST_FLOW_OK;
+    }
+    GstFlowReturn ret;
+    if (s.tail.empty()) {
+      ret = read_line(self, piece);
+    } else {
+      s.tail.append(piece);
+      ret = read_line(self, s.tail);
+      s.tail.clear();
+    }
+    if (ret != GST_FLOW_OK) return ret;
+    data.remove_prefix(end + 1);
+  }
+  return GST_FLOW_OK;
+}
+
+static GstFlowReturn gst_fap_parse_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
+  GstFapParse* self = GST_FAP_PARSE(parent);
+  if (self->stream->failed) {
+    gst_buffer_unref(buffer);
+    return GST_FLOW_ERROR;
+  }
+  GstMapInfo map;
+  if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) {
+    gst_buffer_unref(buffer);
+    GST_ELEMENT_ERROR(self, RESOURCE, READ, (nullptr), ("cannot map the input buffer"));
+    return GST_FLOW_ERROR;
+  }
+  const GstFlowReturn ret = read_chunk(self, {reinterpret_cast<const char*>(map.data), map.size});
+  gst_buffer_unmap(buffer, &map);
+  gst_buffer_unref(buffer);
+  return ret;
+}
+
+static gboolean gst_fap_parse_sink_event(GstPad* pad, GstObject* parent, GstEvent* event) {
+  GstFapParse* self = GST_FAP_PARSE(parent);
+  Stream& s = *self->stream;
+  switch (GST_EVENT_TYPE(event)) {
+    case GST_EVENT_STREAM_START:
+      return gst_pad_push_event(self->srcpad, pfap_make_sparse(event));
+    // The file's bytes say nothing about the output's caps and times.
+    case GST_EVENT_CAPS:
+    case GST_EVENT_SEGMENT:
+    case GST_EVENT_GAP:
+      gst_event_unref(event);
+      return TRUE;
+    case GST_EVENT_EOS: {
+      if (s.failed) break;
+      // The last line may have no line end; then the file must be whole.
+      GstFlowReturn ret = GST_FLOW_OK;
+      if (!s.tail.empty()) {
+        ret = read_line(self, s.tail);
+        s.tail.clear();
+      }
+      if (ret == GST_FLOW_OK) {
+        const pfap::FapFileResult result = s.reader.finish();
+        if (!result.ok()) ret = bad_file(self, result);
+      }
+      if (ret == GST_FLOW_ERROR) {
+        gst_event_unref(event);
+        return FALSE;
+      }
+      if (merging(self)) {
+        gst_event_unref(event);
+        end_of_input(self, true);
+        return TRUE;
+      }
+      send_events(self);
+      break;
+    }
+    case GST_EVENT_FLUSH_STOP:
+      reset(self);
+      break;
+    default:
+      break;
+  }
+  return gst_pad_event_default(pad, parent, event);
+}
+
+// Seeking would need the frames before the target (each frame's events are the changes
+// since the one before), so it is refused rather than passed upstream.
+static gboolean gst_fap_parse_src_event(GstPad* pad, GstObject* parent, GstEvent* event) {
+  if (GST_EVENT_TYPE(event) == GST_EVENT_SEEK) {
+    gst_event_unref(event);
+    return FALSE;
+  }
+  return gst_pad_event_default(pad, parent, event);
+}
+
+static gboolean gst_fap_parse_src_query(GstPad* pad, GstObject* parent, GstQuery* query) {
+  if (GST_QUERY_TYPE(query) == GST_QUERY_SEEKING) {
+    GstFormat format;
+    gst_query_parse_seeking(query, &format, nullptr, nullptr, nullptr);
+    gst_query_set_seeking(query, format, FALSE, -1, -1);
+    return TRUE;
+  }
+  return gst_pad_query_default(pad, parent, query);
+}
+
+// Speech events are kept, timed in ms from the speech segment's start, until both inputs end.
+static GstFlowReturn gst_fap_parse_speech_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
+  GstFapParse* self = GST_FAP_PARSE(parent);
+  pfap::TextEvent event;
+  const bool ok = pfap_buffer_read(buffer, event.event);
+  g_mutex_lock(&self->merge_lock);
+  Merge& m = *self->merge;
+  const GstClockTime running =
+      gst_segment_to_running_time(&m.speech_segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
+  // An event without a time starts where the speech before it ended.
+  event.time_ms = GST_CLOCK_TIME_IS_VALID(running)
+                      ? static_cast<int64_t>((running + GST_MSECOND / 2) / GST_MSECOND)
+                      : m.speech_end_ms;
+  if (!m.speech.empty()) event.time_ms = std::max(event.time_ms, m.speech.back().time_ms);
+  const bool kept = ok && m.speech.size() < kMaxSpeechEvents;
+  if (kept) {
+    if (event.event.kind == PFAP_EVENT_PHONEME) {
+      // Speech phonemes one after the other: an overlap is cut from the earlier one's end.
+      event.time_ms = std::max(event.time_ms, m.speech_end_ms);
+      m.speech_end_ms = event.time_ms + event.event.phoneme.duration_ms;
+    }
+    m.speech.push_back(std::move(event));
+  }
+  const uint64_t dropped = kept ? 0 : ++m.dropped;
+  g_mutex_unlock(&self->merge_lock);
+  if (!kept && pfap_warn_at(dropped)) {
+    GST_ELEMENT_WARNING(
+        self, STREAM, DECODE,
+        ("Dropped a speech event: %s.",
+         ok ? "too many speech events to merge" : "not a valid x-pfap event"),
+        ("%" G_GUINT64_FORMAT " dropped so far; at most %zu are kept", dropped, kMaxSpeechEvents));
+  }
+  gst_buffer_unref(buffer);
+  return GST_FLOW_OK;
+}
+
+static gboolean gst_fap_parse_speech_event(GstPad*, GstObject* parent, GstEvent* event) {
+  GstFapParse* self = GST_FAP_PARSE(parent);
+  switch (GST_EVENT_TYPE(event)) {
+    case GST_EVENT_CAPS: {
+      GstCaps* caps = nullptr;
+      gst_event_parse_caps(event, &caps);
+      const gchar* alphabet = gst_structure_get_string(gst_caps_get_structure(caps, 0), "alphabet");
+      g_mutex_lock(&self->merge_lock);
+      self->merge->alphabet = alphabet != nullptr ? alphabet : "";
+      g_mutex_unlock(&self->merge_lock);
+      break;
+    }
+    case GST_EVENT_SEGMENT: {
+      GstSegment segment;
+      gst_event_copy_segment(event, &segment);
+      if (segment.format == GST_FORMAT_TIME) {
+        g_mutex_lock(&self->merge_lock);
+        self->merge->speech_segment = segment;
+        g_mutex_unlock(&self->merge_lock);
+      }
+      break;
+    }
+    case GST_EVENT_EOS:
+      end_of_input(self, false);
+      break;
+    default:
+      break;  // the output's stream, caps, segment and flushes are the file's
+  }
+  gst_event_unref(event);
+  return TRUE;
+}
+
+static GstPad* gst_fap_parse_request_new_pad(GstElement* element, GstPadTemplate* templ,
+                                             const gchar*, const GstCaps*) {
+  GstFapParse* self = GST_FAP_PARSE(element);
+  GST_OBJECT_LOCK(self);
+  const bool taken = self->speechpad != nullptr;
+  GST_OBJECT_UNLOCK(self);
+  if (taken) {
+    GST_WARNING_OBJECT(self, "one speech pad only");
+    return nullptr;
+  }
+  GstPad* pad = gst_pad_new_from_template(templ, "speech");
+  gst_pad_set_chain_function(pad, gst_fap_parse_speech_chain);
+  gst_pad_set_event_function(pad, gst_fap_parse_speech_event);
+  GST_OBJECT_LOCK(self);
+  self->speechpad = pad;
+  GST_OBJECT_UNLOCK(self);
+  gst_element_add_pad(element, pad);
+  return pad;
+}
+
+static void gst_fap_parse_release_pad(GstElement* element, GstPad* pad) {
+  GstFapParse* self = GST_FAP_PARSE(element);
+  GST_OBJECT_LOCK(self);
+  if (self->speechpad == pad) self->speechpad = nullptr;
+  GST_OBJECT_UNLOCK(self);
+  gst_element_remove_pad(element, pad);
+}
+
+static GstStateChangeReturn gst_fap_parse_change_state(GstElement* element,
+                                                       GstStateChange transition) {
+  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) reset(GST_FAP_PARSE(element));
+  return GST_ELEMENT_CLASS(gst_fap_parse_parent_class)->change_state(element, transition);
+}
+
+static void gst_fap_parse_set_property(GObject* object, guint prop_id, const GValue* value,
+                                       GParamSpec* pspec) {
+  GstFapParse* self = GST_FAP_PARSE(object);
+  GST_OBJECT_LOCK(self);
+  switch (prop_id) {
+    case PROP_SILENCE_SYMBOL:
+      self->silence_symbol = g_value_get_uint(value);
+      break;
+    case PROP_ALPHABET:
+      g_free(self->alphabet);
+      self->alphabet = g_value_dup_string(value);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
+  GST_OBJECT_UNLOCK(self);
+}
+
+static void gst_fap_parse_get_property(GObject* object, guint prop_id, GValue* value,
+                                       GParamSpec* pspec) {
+  GstFapParse* self = GST_FAP_PARSE(object);
+  GST_OBJECT_LOCK(self);
+  switch (prop_id) {
+    case PROP_SILENCE_SYMBOL:
+      g_value_set_uint(value, self->silence_symbol);
+      break;
+    case PROP_ALPHABET:
+      g_value_set_string(value, self->alphabet);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
+  GST_OBJECT_UNLOCK(self);
+}
+
+static void gst_fap_parse_finalize(GObject* object) {
+  delete GST_FAP_PARSE(object)->stream;
+  delete GST_FAP_PARSE(object)->merge;
+  g_mutex_clear(&GST_FAP_PARSE(object)->merge_lock);
+  g_free(GST_FAP_PARSE(object)->alphabet);
+  G_OBJECT_CLASS(gst_fap_parse_parent_class)->finalize(object);
+}
+
+static void gst_fap_parse_class_init(GstFapParseClass* klass) {
+  GObjectClass* gobject_class = G_OBJECT_CLASS(klass);
+  GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
+
+  GST_DEBUG_CATEGORY_INIT(fapparse_debug, "fapparse", 0, "MPEG-4 FAP file parser");
+
+  gobject_class->set_property = gst_fap_parse_set_property;
+  gobject_class->get_property = gst_fap_parse_get_property;
+  gobject_class->finalize = gst_fap_parse_finalize;
+
+  /**
+   * GstFapParse:silence-symbol:
+   *
+   * The phoneme symbol of the silence phonemes that carry the frames: 0, the pause of
+   * x-pfap-arpabet, by default. Set it with #GstFapParse:alphabet for another alphabet.
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_SILENCE_SYMBOL,
+      g_param_spec_uint("silence-symbol", "Silence symbol",
+                        "Phoneme symbol of the silence phonemes that carry the frames", 0, 255,
+                        kDefaultSilenceSymbol,
+                        static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                 GST_PARAM_MUTABLE_READY)));
+
+  /**
+   * GstFapParse:alphabet:
+   *
+   * The phoneme alphabet of #GstFapParse:silence-symbol, for the `alphabet` field of the
+   * output caps (rtppfappay carries it to the SDP). Empty: no alphabet field.
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_ALPHABET,
+      g_param_spec_string("alphabet", "Phoneme alphabet",
+                          "Name of the phoneme alphabet of the silence symbol, for the caps "
+                          "and SDP (empty: none)",
+                          kDefaultAlphabet,
+                          static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                   GST_PARAM_MUTABLE_READY)));
+
+  gst_element_class_add_static_pad_template(element_class, &sink_template);
+  gst_element_class_add_static_pad_template(element_class, &speech_template);
+  gst_element_class_add_static_pad_template(element_class, &src_template);
+  gst_element_class_set_static_metadata(
+      element_class, "MPEG-4 FAP file parser", "Codec/Parser/Text",
+      "Reads MPEG-4 facial animation parameter (.fap) files as application/x-pfap events",
+      "gst-pfap developers");
+
+  element_class->change_state = gst_fap_parse_change_state;
+  element_class->request_new_pad = gst_fap_parse_request_new_pad;
+  element_class->release_pad = gst_fap_parse_release_pad;
+}
+
+static void gst_fap_parse_init(GstFapParse* self) {
+  self->sinkpad = gst_pad_new_from_static_template(&sink_template, "sink");
+  gst_pad_set_chain_function(self->sinkpad, gst_fap_parse_chain);
+  gst_pad_set_event_function(self->sinkpad, gst_fap_parse_sink_event);
+  gst_element_add_pad(GST_ELEMENT(self), self->sinkpad);
+
+  self->srcpad = gst_pad_new_from_static_template(&src_template, "src");
+  gst_pad_use_fixed_caps(self->srcpad);
+  gst_pad_set_event_function(self->srcpad, gst_fap_parse_src_event);
+  gst_pad_set_query_function(self->srcpad, gst_fap_parse_src_query);
+  gst_element_add_pad(GST_ELEMENT(self), self->srcpad);
+
+  self->silence_symbol = kDefaultSilenceSymbol;
+  self->alphabet = g_strdup(kDefaultAlphabet);
+  self->stream = new Stream{};
+  self->speechpad = nullptr;
+  g_mutex_init(&self->merge_lock);
+  self->merge = new Merge{};
+}

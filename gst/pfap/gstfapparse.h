@@ -1,0 +1,12 @@
+#pragma once
+
+#include <gst/gst.h>
+
+G_BEGIN_DECLS
+
+#define GST_TYPE_FAP_PARSE (gst_fap_parse_get_type())
+G_DECLARE_FINAL_TYPE(GstFapParse, gst_fap_parse, GST, FAP_PARSE, GstElement)
+
+GST_ELEMENT_REGISTER_DECLARE(fapparse);
+
+G_END_DECLS

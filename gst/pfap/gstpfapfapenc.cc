@@ -1,0 +1,345 @@
+// The example pipelines stay on one line, to be copied.
+// clang-format off
+/**
+ * SECTION:element-pfapfapenc
+ * @title: pfapfapenc
+ * @see_also: fapparse, pfaptextenc, rtppfapdepay
+ *
+ * Writes a phoneme / facial animation parameter (PFAP) stream as an MPEG-4 FAP file (.fap,
+ * version 2.1, the format Xface, Greta and other MPEG-4 face players read;
+ * docs/fap-files.md): the receiver's FAP state, built from the application/x-pfap events as
+ * pfapface builds it (phoneme FAPs at their start, recovered entries at their time, a
+ * complete state replacing everything), sampled at #GstPfapFapEnc:frame-rate. Frame 0 is the
+ * start of the first segment (running time), so that fapparse's frames come back as the same
+ * frames even when the first events are lost; a stream whose first event comes later starts
+ * with neutral frames, the receiver's state until then. Frame k is k / frame rate seconds
+ * after frame 0, rounded to the ms; the file ends with the last frame before the end of the
+ * last phoneme received, or later, once the last transition is over. Each amplitude is rounded
+ * to the nearest whole unit.
+ *
+ * FAPs 3..68 are written as they are; FAPs 69..74 (expressions) as FAP 2 with the two
+ * strongest in each frame, intensities clamped to MPEG-4's 0..63 (a warning says how many
+ * were dropped or clamped). Every FAP that is ever non-zero is set in every frame's mask, so
+ * that readers that hold a FAP the mask leaves out and readers that take it for 0 agree.
+ *
+ * The header line holds the number of frames, so the file is written in one buffer at EOS;
+ * up to #GstPfapFapEnc:max-frames frames are kept (a warning says when later events are not
+ * written). A malformed buffer is dropped with a warning and the stream goes on. A flush, or
+ * going from READY to PAUSED, starts a new file.
+ *
+ * ## Example pipelines
+ * |[
+ * gst-launch-1.0 pfaptts text="Hello <FAP 2 1 40 0 0 500 1> world." name=t t.pfap ! pfapfapenc ! filesink location=hello.fap
+ * ]| Writes the animation of a spoken sentence as hello.fap, 25 frames a second.
+ * |[
+ * gst-launch-1.0 -e udpsrc port=5004 caps="application/x-rtp,media=application,clock-rate=44100,encoding-name=PFAP" ! rtpjitterbuffer ! rtppfapdepay ! pfapfapenc frame-rate=30 ! filesink location=received.fap
+ * ]| Records a received PFAP stream as a 30 frames/s FAP file.
+ */
+// clang-format on
+#include "gstpfapfapenc.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "pfap/fap_animation.h"
+#include "pfap/fap_file.h"
+#include "pfapbuffer.h"
+
+GST_DEBUG_CATEGORY_STATIC(pfapfapenc_debug);
+#define GST_CAT_DEFAULT pfapfapenc_debug
+
+namespace {
+
+enum { PROP_0, PROP_FRAME_RATE, PROP_NAME, PROP_MAX_FRAMES };
+
+constexpr double kDefaultFrameRate = 25.0;
+constexpr const char* kDefaultName = "gst-pfap";
+
+// What the streaming thread keeps between buffers. GObject runs no C++ constructors, so it
+// lives behind a pointer made in init and deleted in finalize.
+struct Stream {
+  Stream() { gst_segment_init(&segment, GST_FORMAT_TIME); }
+
+  GstSegment segment;
+  std::optional<pfap::FapRecorder> recorder;  // made at the first event, with the properties
+  std::optional<int64_t> origin_ns;           // the first segment's start: frame 0
+  int64_t end_ns = 0;                         // where the last phoneme ends
+  uint64_t malformed = 0;
+  uint64_t over_limit = 0;  // events after max-frames
+  pfap::MarkupEvent event;  // reused for every buffer
+};
+
+}  // namespace
+
+struct _GstPfapFapEnc {
+  GstElement parent;
+  GstPad* sinkpad;
+  GstPad* srcpad;
+  gdouble frame_rate;  // under the object lock
+  gchar* name;         // under the object lock
+  guint max_frames;    // under the object lock
+  Stream* stream;
+};
+
+static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
+    "sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
+
+static GstStaticPadTemplate src_template =
+    GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS("text/plain"));
+
+G_DEFINE_TYPE(GstPfapFapEnc, gst_pfap_fap_enc, GST_TYPE_ELEMENT)
+GST_ELEMENT_REGISTER_DEFINE(pfapfapenc, "pfapfapenc", GST_RANK_NONE, GST_TYPE_PFAP_FAP_ENC)
+
+// A new file (FLUSH_STOP, READY to PAUSED).
+static void reset(GstPfapFapEnc* self) { *self->stream = Stream{}; }
+
+static GstFlowReturn gst_pfap_fap_enc_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
+  GstPfapFapEnc* self = GST_PFAP_FAP_ENC(parent);
+  Stream& s = *self->stream;
+  if (!pfap_buffer_read(buffer, s.event)) {
+    if (pfap_warn_at(++s.malformed)) PFAP_WARN_MALFORMED_EVENT(self, buffer);
+    gst_buffer_unref(buffer);
+    return GST_FLOW_OK;
+  }
+  if (!s.recorder) {
+    GST_OBJECT_LOCK(self);
+    s.recorder.emplace(self->frame_rate, self->max_frames);
+    GST_OBJECT_UNLOCK(self);
+  }
+  // Phonemes follow one another: an event without a time is where the one before ended.
+  const GstClockTime running =
+      gst_segment_to_running_time(&s.segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
+  int64_t time_ns = GST_CLOCK_TIME_IS_VALID(running) ? static_cast<int64_t>(running)
+                                                     : (s.origin_ns ? *s.origin_ns + s.end_ns : 0);
+  if (!s.origin_ns) s.origin_ns = time_ns;  // no segment came: the first event's time
+  time_ns = std::max<int64_t>(time_ns - *s.origin_ns, 0);
+  gst_buffer_unref(buffer);
+
+  // The recorder adds the frames of transitions still running at the end.
+  const int64_t end =
+      time_ns +
+      (s.event.kind == PFAP_EVENT_PHONEME ? s.event.phoneme.duration_ms : 0) * pfap::kNsPerMs;
+  if (!s.recorder->apply(s.event, time_ns)) {
+    if (pfap_warn_at(++s.over_limit)) {
+      GST_ELEMENT_WARNING(
+          self, STREAM, ENCODE,
+          ("The FAP file is full (%u frames); later events are not written.", s.recorder->frames()),
+          ("%" G_GUINT64_FORMAT " events dropped so far; see max-frames", s.over_limit));
+    }
+    return GST_FLOW_OK;
+  }
+  s.end_ns = std::max(s.end_ns, end);
+  return GST_FLOW_OK;
+}
+
+// Writes the file at EOS: its header needs the number of frames.
+static GstFlowReturn write_file(GstPfapFapEnc* self) {
+  Stream& s = *self->stream;
+  if (!gst_pad_has_current_caps(self->srcpad)) {
+    GstCaps* caps = gst_static_pad_template_get_caps(&src_template);
+    gst_pad_set_caps(self->srcpad, caps);
+    gst_caps_unref(caps);
+  }
+  if (!s.recorder) {
+    GST_ELEMENT_WARNING(self, STREAM, ENCODE, ("No PFAP events: no FAP file written."),
+                        ("a FAP file has at least one frame"));
+    return GST_FLOW_OK;
+  }
+  if (!s.recorder->finish(s.end_ns) && pfap_warn_at(++s.over_limit)) {
+    GST_ELEMENT_WARNING(
+        self, STREAM, ENCODE,
+        ("The FAP file is full (%u frames); its end is not written.", s.recorder->frames()),
+        ("see max-frames"));
+  }
+  GST_OBJECT_LOCK(self);
+  const std::string name = self->name != nullptr ? self->name : kDefaultName;
+  GST_OBJECT_UNLOCK(self);
+  pfap::NotWritten not_written;
+  const std::string text = pfap::write_fap_file(s.recorder->file(name, &not_written));
+  if (not_written.expressions_dropped != 0 || not_written.intensities_clamped != 0) {
+    GST_ELEMENT_WARNING(
+        self, STREAM, ENCODE,
+        ("The FAP file holds two expressions a frame with intensities 0..63: %" G_GUINT64_FORMAT
+         " expression values dropped, %" G_GUINT64_FORMAT " clamped.",
+         not_written.expressions_dropped, not_written.intensities_clamped),
+        (nullptr));
+  }
+  GST_DEBUG_OBJECT(self, "%u frames, %zu bytes", s.recorder->frames(), text.size());
+  return gst_pad_push(self->srcpad, gst_buffer_new_memdup(text.data(), text.size()));
+}
+
+static gboolean gst_pfap_fap_enc_sink_event(GstPad* pad, GstObject* parent, GstEvent* event) {
+  GstPfapFapEnc* self = GST_PFAP_FAP_ENC(parent);
+  switch (GST_EVENT_TYPE(event)) {
+    case GST_EVENT_CAPS: {
+      gst_event_unref(event);
+      GstCaps* caps = gst_static_pad_template_get_caps(&src_template);
+      const gboolean ok = gst_pad_set_caps(self->srcpad, caps);
+      gst_caps_unref(caps);
+      return ok;
+    }
+    case GST_EVENT_SEGMENT: {
+      GstSegment segment;
+      gst_event_copy_segment(event, &segment);
+      gst_event_unref(event);
+      if (segment.format != GST_FORMAT_TIME) {
+        GST_ELEMENT_ERROR(
+            self, STREAM, FORMAT, (nullptr),
+            ("%s segment: x-pfap streams have TIME segments", gst_format_get_name(segment.format)));
+        return FALSE;
+      }
+      self->stream->segment = segment;
+      if (!self->stream->origin_ns) {
+        self->stream->origin_ns = static_cast<int64_t>(
+            gst_segment_to_running_time(&segment, GST_FORMAT_TIME, segment.start));
+      }
+      // The file is bytes from its start.
+      GstSegment bytes;
+      gst_segment_init(&bytes, GST_FORMAT_BYTES);
+      return gst_pad_push_event(self->srcpad, gst_event_new_segment(&bytes));
+    }
+    case GST_EVENT_GAP:
+      gst_event_unref(event);
+      return TRUE;
+    case GST_EVENT_EOS:
+      // An error is posted by the push; EOS goes on for the sink to finish what it has.
+      write_file(self);
+      break;
+    case GST_EVENT_FLUSH_STOP:
+      reset(self);
+      break;
+    default:
+      break;
+  }
+  return gst_pad_event_default(pad, parent, event);
+}
+
+static GstStateChangeReturn gst_pfap_fap_enc_change_state(GstElement* element,
+                                                          GstStateChange transition) {
+  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) reset(GST_PFAP_FAP_ENC(element));
+  return GST_ELEMENT_CLASS(gst_pfap_fap_enc_parent_class)->change_state(element, transition);
+}
+
+static void gst_pfap_fap_enc_set_property(GObject* object, guint prop_id, const GValue* value,
+                                          GParamSpec* pspec) {
+  GstPfapFapEnc* self = GST_PFAP_FAP_ENC(object);
+  GST_OBJECT_LOCK(self);
+  switch (prop_id) {
+    case PROP_FRAME_RATE:
+      self->frame_rate = g_value_get_double(value);
+      break;
+    case PROP_NAME:
+      g_free(self->name);
+      self->name = g_value_dup_string(value);
+      break;
+    case PROP_MAX_FRAMES:
+      self->max_frames = g_value_get_uint(value);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
+  GST_OBJECT_UNLOCK(self);
+}
+
+static void gst_pfap_fap_enc_get_property(GObject* object, guint prop_id, GValue* value,
+                                          GParamSpec* pspec) {
+  GstPfapFapEnc* self = GST_PFAP_FAP_ENC(object);
+  GST_OBJECT_LOCK(self);
+  switch (prop_id) {
+    case PROP_FRAME_RATE:
+      g_value_set_double(value, self->frame_rate);
+      break;
+    case PROP_NAME:
+      g_value_set_string(value, self->name);
+      break;
+    case PROP_MAX_FRAMES:
+      g_value_set_uint(value, self->max_frames);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
+  GST_OBJECT_UNLOCK(self);
+}
+
+static void gst_pfap_fap_enc_finalize(GObject* object) {
+  delete GST_PFAP_FAP_ENC(object)->stream;
+  g_free(GST_PFAP_FAP_ENC(object)->name);
+  G_OBJECT_CLASS(gst_pfap_fap_enc_parent_class)->finalize(object);
+}
+
+static void gst_pfap_fap_enc_class_init(GstPfapFapEncClass* klass) {
+  GObjectClass* gobject_class = G_OBJECT_CLASS(klass);
+  GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
+
+  GST_DEBUG_CATEGORY_INIT(pfapfapenc_debug, "pfapfapenc", 0, "MPEG-4 FAP file writer");
+
+  gobject_class->set_property = gst_pfap_fap_enc_set_property;
+  gobject_class->get_property = gst_pfap_fap_enc_get_property;
+  gobject_class->finalize = gst_pfap_fap_enc_finalize;
+
+  /**
+   * GstPfapFapEnc:frame-rate:
+   *
+   * Frames a second of the file: the FAP state is sampled at this rate. From 1 to 1000 (the
+   * draft's times are whole ms).
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_FRAME_RATE,
+      g_param_spec_double("frame-rate", "Frame rate", "Frames a second of the FAP file",
+                          pfap::kMinFapFileFrameRate, pfap::kMaxFapFileFrameRate, kDefaultFrameRate,
+                          static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                   GST_PARAM_MUTABLE_READY)));
+
+  /**
+   * GstPfapFapEnc:name-in-file:
+   *
+   * The name in the file's header line (white space is written as '_': readers take the
+   * name as one word).
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_NAME,
+      g_param_spec_string("name-in-file", "Name in file", "The name in the FAP file's header",
+                          kDefaultName,
+                          static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                   GST_PARAM_MUTABLE_READY)));
+
+  /**
+   * GstPfapFapEnc:max-frames:
+   *
+   * The most frames kept for the file (it is written at EOS): at most fapparse's limit,
+   * 360000 (4 hours at 25 frames a second).
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_MAX_FRAMES,
+      g_param_spec_uint("max-frames", "Maximum frames", "The most frames the file holds", 1,
+                        pfap::kMaxFapFileFrames, pfap::kMaxFapFileFrames,
+                        static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                 GST_PARAM_MUTABLE_READY)));
+
+  gst_element_class_add_static_pad_template(element_class, &sink_template);
+  gst_element_class_add_static_pad_template(element_class, &src_template);
+  gst_element_class_set_static_metadata(
+      element_class, "MPEG-4 FAP file encoder", "Codec/Encoder/Text",
+      "Writes the facial animation of a PFAP stream as an MPEG-4 FAP (.fap) file",
+      "gst-pfap developers");
+
+  element_class->change_state = gst_pfap_fap_enc_change_state;
+}
+
+static void gst_pfap_fap_enc_init(GstPfapFapEnc* self) {
+  self->stream = new Stream{};
+  self->frame_rate = kDefaultFrameRate;
+  self->name = g_strdup(kDefaultName);
+  self->max_frames = pfap::kMaxFapFileFrames;
+  self->sinkpad = gst_pad_new_from_static_template(&sink_template, "sink");
+  gst_pad_set_chain_function(self->sinkpad, gst_pfap_fap_enc_chain);
+  gst_pad_set_event_function(self->sinkpad, gst_pfap_fap_enc_sink_event);
+  gst_element_add_pad(GST_ELEMENT(self), self->sinkpad);
+  self->srcpad = gst_pad_new_from_static_template(&src_template, "src");
+  gst_pad_use_fixed_caps(self->srcpad);
+  gst_element_add_pad(GST_ELEMENT(self), self->srcpad);
+}

@@ -1,0 +1,12 @@
+#pragma once
+
+#include <gst/gst.h>
+
+G_BEGIN_DECLS
+
+#define GST_TYPE_PFAP_FAP_ENC (gst_pfap_fap_enc_get_type())
+G_DECLARE_FINAL_TYPE(GstPfapFapEnc, gst_pfap_fap_enc, GST, PFAP_FAP_ENC, GstElement)
+
+GST_ELEMENT_REGISTER_DECLARE(pfapfapenc);
+
+G_END_DECLS

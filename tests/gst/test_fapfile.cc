@@ -1,0 +1,553 @@
+// fapparse and pfapfapenc (docs/fap-files.md, docs/elements.md "MPEG-4 FAP files"):
+//  - FapParse.*: each real file in ../shared/fap (or $PFAP_FAP_DIR) through fapparse, fed in
+//    odd-sized chunks: the events applied to a FapState and sampled at the frame times give
+//    back every value of the file; bad files are errors naming the file and line.
+//  - FapRoundTrip.*: fapparse ! rtppfappay ! (seeded 10 % loss) ! rtppfapdepay ! pfapfapenc:
+//    the written file has every frame of the original whose phoneme the receiver got whole
+//    (not flagged uncertain), and, without loss, every frame.
+//  - FapDocumented.*: the commands of docs/elements.md, "MPEG-4 FAP files", run as written
+//    with the real files, temporary outputs and fakesink for the display.
+#include <gst/check/gstharness.h>
+#include <gst/gst.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "pfap/fap_animation.h"
+#include "pfap/fap_file.h"
+#include "pfap/fap_state.h"
+#include "pfap_buffers.h"
+#include "pipeline.h"
+#include "temp_dir.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using pfap::testing::Pipeline;
+using pfap::testing::plugin_available;
+using pfap::testing::TempDir;
+
+constexpr const char* kElements[] = {"fapparse", "pfapfapenc", "rtppfappay", "rtppfapdepay"};
+
+fs::path shared_dir() {
+  const char* env = std::getenv("PFAP_FAP_DIR");
+  return env != nullptr && *env != '\0' ? fs::path(env) : fs::path(PFAP_SHARED_FAP_DIR);
+}
+
+std::vector<fs::path> shared_files() {
+  std::vector<fs::path> files;
+  if (!fs::is_directory(shared_dir())) return files;
+  for (const auto& entry : fs::directory_iterator(shared_dir())) {
+    if (entry.path().extension() == ".fap") files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+#define SKIP_WITHOUT_SHARED_FILES(files)              \
+  if ((files).empty())                                \
+  GTEST_SKIP() << "no .fap files in " << shared_dir() \
+               << ": the real MPEG-4 FAP files live beside the project in ../shared/fap"
+
+std::string read_all(const fs::path& path) {
+  gchar* contents = nullptr;
+  gsize length = 0;
+  if (!g_file_get_contents(path.c_str(), &contents, &length, nullptr)) return "";
+  std::string text(contents, length);
+  g_free(contents);
+  return text;
+}
+
+std::vector<pfap::FapAmplitudes> amplitudes_of(const pfap::FapFile& file) {
+  std::vector<pfap::FapAmplitudes> out;
+  pfap::NotCarried ignored;
+  for (const pfap::FapFrame& frame : file.frames)
+    out.push_back(pfap::amplitudes_of(frame, ignored));
+  return out;
+}
+
+// Pushes `bytes` into the harness in chunks of 1000 bytes (lines split across buffers), then
+// EOS.
+void push_file(GstHarness* h, const std::string& bytes) {
+  gst_harness_set_src_caps_str(h, "text/plain");
+  for (size_t at = 0; at < bytes.size(); at += 1000) {
+    const std::string chunk = bytes.substr(at, 1000);
+    ASSERT_EQ(gst_harness_push(h, gst_buffer_new_memdup(chunk.data(), chunk.size())), GST_FLOW_OK);
+  }
+  ASSERT_TRUE(gst_harness_push_event(h, gst_event_new_eos()));
+}
+
+TEST(FapParse, EachRealFileGivesBackEveryValueAtItsFrameTimes) {
+  ASSERT_TRUE(plugin_available(kElements));
+  const auto files = shared_files();
+  SKIP_WITHOUT_SHARED_FILES(files);
+  for (const fs::path& path : files) {
+    SCOPED_TRACE(path.filename().string());
+    const std::string bytes = read_all(path);
+    pfap::FapFile file;
+    ASSERT_TRUE(pfap::read_fap_file(bytes, file).ok());
+
+    GstHarness* h = gst_harness_new("fapparse");
+    push_file(h, bytes);
+    GstCaps* caps = gst_pad_get_current_caps(h->sinkpad);
+    ASSERT_NE(caps, nullptr);
+    EXPECT_STREQ(gst_structure_get_string(gst_caps_get_structure(caps, 0), "alphabet"),
+                 "x-pfap-arpabet");
+    gst_caps_unref(caps);
+
+    pfap::FapState state;
+    std::vector<std::pair<GstClockTime, std::vector<pfap::Fap>>> events;
+    while (GstBuffer* b = gst_harness_try_pull(h)) {
+      const pfap::testing::Event e = pfap::testing::read_event(b);
+      events.emplace_back(GST_BUFFER_PTS(b), e.faps);
+      gst_buffer_unref(b);
+    }
+    gst_harness_teardown(h);
+    ASSERT_FALSE(events.empty());
+
+    const auto want = amplitudes_of(file);
+    size_t next = 0;
+    for (uint32_t k = 0; k < file.header.frame_count; ++k) {
+      const auto at = static_cast<GstClockTime>(pfap::frame_time_ms(k, 25.0)) * GST_MSECOND;
+      for (; next < events.size() && events[next].first <= at; ++next) {
+        for (const pfap::Fap& f : events[next].second) {
+          state.apply(f, static_cast<int64_t>(events[next].first));
+        }
+      }
+      for (int i = pfap::kMinFapIndex; i <= pfap::kMaxFapIndex; ++i) {
+        ASSERT_EQ(state.amplitude(i, static_cast<int64_t>(at)), want[k][i])
+            << "frame " << k << " FAP " << i;
+      }
+    }
+  }
+}
+
+// Runs `text` through filesrc ! fapparse ! fakesink; returns the bus error.
+std::string error_of(const std::string& text, const TempDir& dir) {
+  const std::string path = dir.file("bad.fap");
+  EXPECT_TRUE(
+      g_file_set_contents(path.c_str(), text.data(), static_cast<gssize>(text.size()), nullptr));
+  Pipeline p("filesrc location=" + path + " ! fapparse ! fakesink");
+  EXPECT_TRUE(p.ok()) << p.error();
+  EXPECT_EQ(p.set_state(GST_STATE_PLAYING), "");
+  return p.wait_eos(std::chrono::seconds(10));
+}
+
+TEST(FapParse, BadFilesAreErrorsNamingFileLineAndField) {
+  ASSERT_TRUE(plugin_available(kElements));
+  TempDir dir;
+  std::string mask = "0 0 1";
+  for (int i = 4; i <= 68; ++i) mask += " 0";
+  struct Case {
+    std::string text;
+    std::string said;
+  };
+  const Case cases[] = {
+      {"2.1 t 25 2\n" + mask + "\n0 5\n", "line 4: the file ends before the header's count"},
+      {"2.1 t 25 1\n" + mask + " 0\n0 5\n", "line 2, field 69: mask without 68 flags"},
+      {"2.1 t 25 1\n" + mask + "\n0 3000000\n", "line 3, field 2 (FAP 3): value out of range"},
+      {"2.1 t 25 4000000\n", "line 1, field 4: frame count not an integer"},
+      {"2.1 t 100000 1\n", "line 1, field 3: frame rate not a number"},
+      {"2.1 t 25 1\n" + std::string(100000, '0') + "\n", "line 2: line longer than"},
+      {"\x01\x02garbage", "line 1, field 1: unsupported version"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.said);
+    const std::string error = error_of(c.text, dir);
+    EXPECT_NE(error.find("Bad FAP file " + dir.file("bad.fap") + ", " + c.said), std::string::npos)
+        << error;
+  }
+}
+
+TEST(FapParse, VisemesAreReportedNotSilentlyLost) {
+  ASSERT_TRUE(plugin_available(kElements));
+  TempDir dir;
+  std::string mask = "1 0 1";
+  for (int i = 4; i <= 68; ++i) mask += " 0";
+  std::string text = "2.1 t 25 3\n";
+  for (int k = 0; k < 3; ++k) text += mask + "\n" + std::to_string(k) + " 1 0 0 0 5\n";
+  const std::string path = dir.file("visemes.fap");
+  ASSERT_TRUE(g_file_set_contents(path.c_str(), text.data(), -1, nullptr));
+  Pipeline p("filesrc location=" + path + " ! fapparse ! fakesink");
+  ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+  // Warned at the 1st and 2nd frame that sets FAP 1, not at the 3rd; then EOS.
+  int warnings = 0;
+  for (std::string message = p.wait_eos(std::chrono::seconds(10), true); !message.empty();
+       message = p.wait_eos(std::chrono::seconds(10), true)) {
+    ASSERT_NE(message.find("sets FAP 1 (viseme), which PFAP does not carry"), std::string::npos)
+        << message;
+    ASSERT_LT(++warnings, 10);
+  }
+  EXPECT_EQ(warnings, 2);
+}
+
+// Three values rounded in one frame pass the 1st and 2nd rounded value at once: one warning.
+TEST(FapParse, RoundedValuesAreWarnedAbout) {
+  ASSERT_TRUE(plugin_available(kElements));
+  TempDir dir;
+  std::string mask = "0 0 1 1 1";
+  for (int i = 6; i <= 68; ++i) mask += " 0";
+  const std::string text = "2.1 t 25 1\n" + mask + "\n0 1.5 2.25 -3.5\n";
+  const std::string path = dir.file("fractions.fap");
+  ASSERT_TRUE(g_file_set_contents(path.c_str(), text.data(), -1, nullptr));
+  Pipeline p("filesrc location=" + path + " ! fapparse ! fakesink");
+  ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+  const std::string message = p.wait_eos(std::chrono::seconds(10), true);
+  EXPECT_NE(message.find("frame 0 has values with a fraction, rounded to whole FAP units"),
+            std::string::npos)
+      << message;
+  EXPECT_EQ(p.wait_eos(std::chrono::seconds(10), true), "");  // then EOS, no other warning
+}
+
+// With a speech pad, the file's FAPs go on the speech's phonemes, whichever input ends first.
+TEST(FapParse, MergedWithASpeechStreamKeepsTheFileValuesAndTheSpeechPhonemes) {
+  ASSERT_TRUE(plugin_available(kElements));
+  std::string mask = "0 0 1";
+  for (int i = 4; i <= 68; ++i) mask += " 0";
+  std::string text = "2.1 t 25 10\n";
+  for (int k = 0; k < 10; ++k)
+    text += mask + "\n" + std::to_string(k) + " " + std::to_string(k * 7) + "\n";
+  pfap::FapFile file;
+  ASSERT_TRUE(pfap::read_fap_file(text, file).ok());
+  for (const bool speech_ends_first : {true, false}) {
+    SCOPED_TRACE(speech_ends_first ? "speech ends first" : "file ends first");
+    GstHarness* h = gst_harness_new_with_padnames("fapparse", "sink", "src");
+    GstHarness* speech = gst_harness_new_with_element(h->element, "speech", nullptr);
+    ASSERT_NE(speech, nullptr);
+    gst_harness_set_src_caps_str(speech, "application/x-pfap,alphabet=x-sampa");
+    gst_harness_set_src_caps_str(h, "text/plain");
+    ASSERT_EQ(gst_harness_push(h, gst_buffer_new_memdup(text.data(), text.size())), GST_FLOW_OK);
+    for (const auto& [start, duration] : {std::pair{0, 100}, {100, 150}}) {
+      pfap::Phoneme p;
+      p.symbol = 9;
+      p.duration_ms = static_cast<uint16_t>(duration);
+      ASSERT_EQ(gst_harness_push(
+                    speech, pfap::testing::phoneme_buffer(p, {}, start * GST_MSECOND, start == 0)),
+                GST_FLOW_OK);
+    }
+    EXPECT_EQ(gst_harness_try_pull(h), nullptr);  // nothing before both inputs end
+    GstHarness* first = speech_ends_first ? speech : h;
+    GstHarness* second = speech_ends_first ? h : speech;
+    ASSERT_TRUE(gst_harness_push_event(first, gst_event_new_eos()));
+    EXPECT_EQ(gst_harness_try_pull(h), nullptr);
+    ASSERT_TRUE(gst_harness_push_event(second, gst_event_new_eos()));
+
+    GstCaps* caps = gst_pad_get_current_caps(h->sinkpad);
+    ASSERT_NE(caps, nullptr);
+    EXPECT_STREQ(gst_structure_get_string(gst_caps_get_structure(caps, 0), "alphabet"), "x-sampa");
+    gst_caps_unref(caps);
+    pfap::FapState state;
+    std::vector<pfap::testing::Event> events;
+    while (GstBuffer* b = gst_harness_try_pull(h)) {
+      events.push_back(pfap::testing::read_event(b));
+      events.back().pts = GST_BUFFER_PTS(b);
+      gst_buffer_unref(b);
+    }
+    size_t next = 0;
+    for (uint32_t k = 0; k < 10; ++k) {
+      const auto at = static_cast<GstClockTime>(pfap::frame_time_ms(k, 25.0)) * GST_MSECOND;
+      for (; next < events.size() && events[next].pts <= at; ++next) {
+        for (const pfap::Fap& f : events[next].faps) {
+          state.apply(f, static_cast<int64_t>(events[next].pts));
+        }
+      }
+      EXPECT_EQ(state.amplitude(3, static_cast<int64_t>(at)), k * 7.0) << "frame " << k;
+    }
+    // The speech's 250 ms are its symbol, cut at the frames; silence carries the rest.
+    for (const auto& e : events) {
+      EXPECT_EQ(e.phoneme.symbol, e.pts < 250 * GST_MSECOND ? 9 : 0) << e.pts;
+    }
+    EXPECT_TRUE(events.back().phoneme.end_of_text);
+    gst_harness_teardown(speech);
+    gst_harness_teardown(h);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Over RTP with loss, back to a file
+
+struct RoundTrip {
+  pfap::FapFile written;
+  std::vector<pfap::testing::Event> received;  // what pfapfapenc took
+  unsigned packets = 0;
+  unsigned dropped = 0;
+};
+
+struct DropState {
+  std::mt19937 random;
+  double loss;
+  unsigned packets = 0;
+  unsigned dropped = 0;
+};
+
+GstPadProbeReturn drop_some(GstPad*, GstPadProbeInfo*, gpointer data) {
+  auto* s = static_cast<DropState*>(data);
+  // The first packet, the payloader's complete state, always arrives: the receiver starts
+  // whole (else it waits for a complete state, draft 6.4). Data packets are lost from the 1st.
+  const bool drop = s->packets++ > 0 && std::uniform_real_distribution<>(0, 1)(s->random) < s->loss;
+  if (!drop) return GST_PAD_PROBE_OK;
+  ++s->dropped;
+  return GST_PAD_PROBE_DROP;
+}
+
+GstPadProbeReturn keep_event(GstPad*, GstPadProbeInfo* info, gpointer data) {
+  auto* received = static_cast<std::vector<pfap::testing::Event>*>(data);
+  received->push_back(pfap::testing::read_event(GST_PAD_PROBE_INFO_BUFFER(info)));
+  received->back().pts = GST_BUFFER_PTS(GST_PAD_PROBE_INFO_BUFFER(info));
+  return GST_PAD_PROBE_OK;
+}
+
+RoundTrip round_trip(const std::string& bytes, double loss, uint32_t seed) {
+  RoundTrip out;
+  GstHarness* h = gst_harness_new_parse(
+      "fapparse ! rtppfappay name=pay recovery-depth=4 ! rtppfapdepay name=depay ! "
+      "pfapfapenc name=enc");
+  DropState drops{std::mt19937(seed), loss};
+  GstElement* depay = gst_bin_get_by_name(GST_BIN(h->element), "depay");
+  GstElement* enc = gst_bin_get_by_name(GST_BIN(h->element), "enc");
+  GstPad* depay_sink = gst_element_get_static_pad(depay, "sink");
+  GstPad* enc_sink = gst_element_get_static_pad(enc, "sink");
+  gst_pad_add_probe(depay_sink, GST_PAD_PROBE_TYPE_BUFFER, drop_some, &drops, nullptr);
+  gst_pad_add_probe(enc_sink, GST_PAD_PROBE_TYPE_BUFFER, keep_event, &out.received, nullptr);
+  push_file(h, bytes);
+  std::string text;
+  while (GstBuffer* b = gst_harness_try_pull(h)) {
+    GstMapInfo map;
+    gst_buffer_map(b, &map, GST_MAP_READ);
+    text.append(reinterpret_cast<const char*>(map.data), map.size);
+    gst_buffer_unmap(b, &map);
+    gst_buffer_unref(b);
+  }
+  gst_object_unref(depay_sink);
+  gst_object_unref(enc_sink);
+  gst_object_unref(depay);
+  gst_object_unref(enc);
+  gst_harness_teardown(h);
+  const pfap::FapFileResult result = pfap::read_fap_file(text, out.written);
+  EXPECT_TRUE(result.ok()) << pfap::describe(result) << "\n" << text.substr(0, 400);
+  out.packets = drops.packets;
+  out.dropped = drops.dropped;
+  return out;
+}
+
+// Whether frame time `at` lies in a received phoneme the depayloader did not flag uncertain.
+bool whole_at(const std::vector<pfap::testing::Event>& received, GstClockTime at) {
+  for (const auto& e : received) {
+    if (e.kind != PFAP_EVENT_PHONEME || e.phoneme.duration_ms == 0) continue;
+    if (e.pts <= at && at < e.pts + e.phoneme.duration_ms * GST_MSECOND) {
+      return (e.flags & PFAP_FLAG_UNCERTAIN) == 0;
+    }
+  }
+  return false;
+}
+
+TEST(FapRoundTrip, WithoutLossEveryFrameComesBack) {
+  ASSERT_TRUE(plugin_available(kElements));
+  const auto files = shared_files();
+  SKIP_WITHOUT_SHARED_FILES(files);
+  for (const fs::path& path : files) {
+    SCOPED_TRACE(path.filename().string());
+    const std::string bytes = read_all(path);
+    pfap::FapFile file;
+    ASSERT_TRUE(pfap::read_fap_file(bytes, file).ok());
+    const RoundTrip r = round_trip(bytes, 0.0, 1);
+    EXPECT_EQ(r.dropped, 0u);
+    ASSERT_EQ(r.written.frames.size(), file.frames.size());
+    EXPECT_EQ(amplitudes_of(r.written), amplitudes_of(file));
+  }
+}
+
+TEST(FapRoundTrip, TenPercentLossRecoveredGivesEveryFrameTheReceiverHadWhole) {
+  ASSERT_TRUE(plugin_available(kElements));
+  const auto files = shared_files();
+  SKIP_WITHOUT_SHARED_FILES(files);
+  unsigned frames = 0, checked = 0, packets = 0, dropped = 0;
+  for (const fs::path& path : files) {
+    SCOPED_TRACE(path.filename().string());
+    const std::string bytes = read_all(path);
+    pfap::FapFile file;
+    ASSERT_TRUE(pfap::read_fap_file(bytes, file).ok());
+    const RoundTrip r = round_trip(bytes, 0.10, 2000 + static_cast<uint32_t>(frames));
+    // The file ends with the last phoneme received: the last packets may be lost.
+    ASSERT_LE(r.written.frames.size(), file.frames.size());
+    const auto got = amplitudes_of(r.written);
+    const auto want = amplitudes_of(file);
+    for (size_t k = 0; k < want.size(); ++k) {
+      const auto at = static_cast<GstClockTime>(pfap::frame_time_ms(k, 25.0)) * GST_MSECOND;
+      ++frames;
+      if (!whole_at(r.received, at)) continue;
+      ++checked;
+      ASSERT_LT(k, got.size());
+      EXPECT_EQ(got[k], want[k]) << "frame " << k;
+    }
+    packets += r.packets;
+    dropped += r.dropped;
+  }
+  std::cout << "[ fapfile  ] " << dropped << " of " << packets << " packets dropped; " << checked
+            << " of " << frames << " frames received whole and compared\n";
+  EXPECT_GT(dropped, packets / 20);     // the loss happened
+  EXPECT_GT(checked, frames * 6 / 10);  // and recovery made most frames whole
+}
+
+// ---------------------------------------------------------------------------------------------
+// pfapfapenc on its own
+
+// Pushes events into pfapfapenc with the given properties; returns the file and the warnings.
+struct Encoded {
+  std::string text;
+  std::vector<std::string> warnings;
+};
+
+Encoded encode(const std::string& properties, const std::vector<GstBuffer*>& buffers) {
+  GstHarness* h = gst_harness_new_parse(("pfapfapenc " + properties).c_str());
+  GstBus* bus = gst_bus_new();
+  gst_element_set_bus(h->element, bus);
+  gst_harness_set_src_caps_str(h, "application/x-pfap");
+  for (GstBuffer* b : buffers) EXPECT_EQ(gst_harness_push(h, b), GST_FLOW_OK);
+  EXPECT_TRUE(gst_harness_push_event(h, gst_event_new_eos()));
+  Encoded out;
+  while (GstBuffer* b = gst_harness_try_pull(h)) {
+    GstMapInfo map;
+    gst_buffer_map(b, &map, GST_MAP_READ);
+    out.text.append(reinterpret_cast<const char*>(map.data), map.size);
+    gst_buffer_unmap(b, &map);
+    gst_buffer_unref(b);
+  }
+  while (GstMessage* m = gst_bus_pop_filtered(bus, GST_MESSAGE_WARNING)) {
+    GError* error = nullptr;
+    gst_message_parse_warning(m, &error, nullptr);
+    out.warnings.emplace_back(error->message);
+    g_error_free(error);
+    gst_message_unref(m);
+  }
+  gst_element_set_bus(h->element, nullptr);
+  gst_object_unref(bus);
+  gst_harness_teardown(h);
+  return out;
+}
+
+GstBuffer* phoneme_at(GstClockTime pts, uint16_t duration_ms, std::vector<pfap::Fap> faps) {
+  pfap::MarkupEvent e;
+  e.kind = PFAP_EVENT_PHONEME;
+  e.phoneme.duration_ms = duration_ms;
+  e.faps = std::move(faps);
+  return pfap::testing::markup_buffer(e, pts);
+}
+
+TEST(PfapFapEnc, MalformedEventsAreDroppedWithAWarningAndTheFileGoesOn) {
+  ASSERT_TRUE(plugin_available(kElements));
+  const char junk[] = "not an event";
+  const Encoded out =
+      encode("frame-rate=10 name-in-file=\"my face\"",
+             {phoneme_at(0, 100, {{3, 50, 0, pfap::Curve::kLinear}}),
+              gst_buffer_new_memdup(junk, sizeof junk),
+              phoneme_at(100 * GST_MSECOND, 100, {{3, -20, 0, pfap::Curve::kLinear}})});
+  ASSERT_EQ(out.warnings.size(), 1u);
+  EXPECT_NE(out.warnings[0].find("malformed"), std::string::npos) << out.warnings[0];
+  pfap::FapFile file;
+  const pfap::FapFileResult result = pfap::read_fap_file(out.text, file);
+  ASSERT_TRUE(result.ok()) << pfap::describe(result) << "\n" << out.text;
+  EXPECT_EQ(file.header.name, "my_face");
+  EXPECT_EQ(file.header.frame_rate, 10.0);
+  ASSERT_EQ(file.frames.size(), 2u);
+  EXPECT_EQ(file.frames[0].value[3], 50);
+  EXPECT_EQ(file.frames[1].value[3], -20);
+}
+
+TEST(PfapFapEnc, MaxFramesBoundsTheFileWithAWarning) {
+  ASSERT_TRUE(plugin_available(kElements));
+  std::vector<GstBuffer*> buffers;
+  for (int i = 0; i < 20; ++i) {
+    buffers.push_back(phoneme_at(i * 40 * GST_MSECOND, 40, {{5, i, 0, pfap::Curve::kLinear}}));
+  }
+  const Encoded out = encode("max-frames=8", buffers);
+  ASSERT_FALSE(out.warnings.empty());
+  EXPECT_NE(out.warnings[0].find("The FAP file is full (8 frames)"), std::string::npos)
+      << out.warnings[0];
+  EXPECT_LE(out.warnings.size(), 5u);  // rate-limited: the 1st, 2nd, 4th, 8th ... only
+  pfap::FapFile file;
+  ASSERT_TRUE(pfap::read_fap_file(out.text, file).ok());
+  ASSERT_EQ(file.frames.size(), 8u);
+  EXPECT_EQ(file.frames[7].value[5], 7);
+}
+
+TEST(PfapFapEnc, NoEventsNoFileAndAWarning) {
+  ASSERT_TRUE(plugin_available(kElements));
+  const Encoded out = encode("", {});
+  EXPECT_EQ(out.text, "");
+  ASSERT_EQ(out.warnings.size(), 1u);
+  EXPECT_NE(out.warnings[0].find("No PFAP events"), std::string::npos);
+}
+
+// ---------------------------------------------------------------------------------------------
+// docs/elements.md, "MPEG-4 FAP files"
+
+std::string source_path(const std::string& relative) {
+  return std::string(PFAP_SOURCE_DIR) + "/" + relative;
+}
+
+std::vector<std::string> documented_commands() {
+  const std::string doc = read_all(source_path("docs/elements.md"));
+  const size_t start = doc.find("\n## MPEG-4 FAP files\n");
+  EXPECT_NE(start, std::string::npos);
+  const size_t end = doc.find("\n## ", start + 1);
+  std::vector<std::string> commands;
+  bool in_block = false;
+  size_t at = start + 1;
+  while (at < end) {
+    size_t eol = doc.find('\n', at);
+    if (eol == std::string::npos) eol = doc.size();
+    std::string line = doc.substr(at, eol - at);
+    at = eol + 1;
+    if (line.rfind("```", 0) == 0) in_block = !in_block;
+    if (!in_block || line.rfind("gst-launch-1.0 ", 0) != 0) continue;
+    line = line.substr(std::string("gst-launch-1.0 ").size());
+    if (line.rfind("-e ", 0) == 0) line = line.substr(3);
+    commands.push_back(line);
+  }
+  return commands;
+}
+
+void replace_all(std::string& s, const std::string& from, const std::string& to) {
+  for (size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size())) {
+    s.replace(at, from.size(), to);
+  }
+}
+
+TEST(FapDocumented, EveryCommandRunsToEos) {
+  const auto files = shared_files();
+  SKIP_WITHOUT_SHARED_FILES(files);
+  const char* used[] = {"fapparse", "pfapfapenc", "pfaptts", "pfapface", "netsim"};
+  ASSERT_TRUE(plugin_available(used));
+  const std::vector<std::string> commands = documented_commands();
+  ASSERT_EQ(commands.size(), 4u);
+  TempDir dir;
+  for (std::string command : commands) {
+    SCOPED_TRACE(command);
+    replace_all(command, "../shared/fap/", shared_dir().string() + "/");
+    replace_all(command, "location=hello.fap", "location=" + dir.file("hello.fap"));
+    replace_all(command, "location=joy-again.fap", "location=" + dir.file("joy-again.fap"));
+    replace_all(command, "autovideosink", "fakesink sync=false");
+    Pipeline p(command);
+    ASSERT_TRUE(p.ok()) << p.error();
+    ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+    EXPECT_EQ(p.wait_eos(std::chrono::seconds(60)), "");
+  }
+  // The files the commands wrote read back.
+  for (const char* name : {"hello.fap", "joy-again.fap"}) {
+    SCOPED_TRACE(name);
+    pfap::FapFile file;
+    const pfap::FapFileResult result = pfap::read_fap_file(read_all(dir.file(name)), file);
+    EXPECT_TRUE(result.ok()) << pfap::describe(result);
+    EXPECT_GT(file.frames.size(), 10u);
+  }
+}
+
+}  // namespace
