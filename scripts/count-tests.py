@@ -1,5 +1,6 @@
 """Counts the test cases behind meson test logs: GoogleTest cases from each gtest program's
-result lines, one case for any other test. With one log, prints 'tests: N passed, M failed';
+result lines, node's test runner's from its closing '# pass N' and '# fail N' (web/), one case
+for any other test. With one log, prints 'tests: N passed, M failed';
 with several (one per build), a line for each and then that line for them all."""
 import json
 import re
@@ -14,6 +15,10 @@ def count(path):
             out = test.get("stdout") or ""
             ok = len(re.findall(r"^\[       OK \]", out, re.M))
             bad = len(re.findall(r"^\[  FAILED  \] .*\(\d+ ms\)$", out, re.M))
+            node_pass = re.search(r"^# pass (\d+)$", out, re.M)
+            node_fail = re.search(r"^# fail (\d+)$", out, re.M)
+            if node_pass and node_fail:
+                ok, bad = ok + int(node_pass.group(1)), bad + int(node_fail.group(1))
             if ok or bad:
                 passed, failed = passed + ok, failed + bad
                 if test["result"] != "OK" and not bad:
