@@ -556,7 +556,7 @@ int export_render(const char* dir) {
     std::cout << "]}}";
     for (const auto& [style, style_name] :
          {std::pair{face::Style::kCartoon, "cartoon"}, std::pair{face::Style::kLine, "line"}}) {
-      constexpr int kWidth = 160, kHeight = 120;
+      constexpr int kWidth = 320, kHeight = 240;
       std::vector<uint8_t> pixels(4 * kWidth * kHeight);
       face::render(pose, style, "", {pixels.data(), kWidth, kHeight, 4 * kWidth, false});
       std::ofstream out(std::filesystem::path(dir) / (states[i].first + "-" + style_name + ".bgrx"),
