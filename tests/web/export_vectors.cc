@@ -441,6 +441,20 @@ int export_recovery() {
       if (lost) return;
       const bool unknown = !first_packet && unknown_loss(rng);
       if (unknown) receiver.lost_unknown();
+      // The settled state after each phoneme: the packet cut after it, received by a copy.
+      std::vector<std::string> phoneme_states;
+      for (size_t i = 0; i < packet.phonemes.size(); ++i) {
+        pfap::RecoveryReceiver copy = receiver;
+        Packet cut = packet;
+        cut.phonemes.resize(i + 1);
+        cut.faps.resize(cut.phonemes.back().fap_end);
+        copy.receive(cut, seq, time_ns);
+        std::string settled = "[";
+        for (int f = pfap::kMinFapIndex; f <= pfap::kMaxFapIndex; ++f) {
+          settled += (f > pfap::kMinFapIndex ? "," : "") + std::to_string(copy.state().settled(f));
+        }
+        phoneme_states.push_back(settled + "]");
+      }
       const pfap::ReceiveResult r = receiver.receive(packet, seq, time_ns);
       const Bytes bytes = encode(packet);
       const char* recovery = r.recovery == pfap::ReceiveResult::Recovery::kNone        ? "none"
@@ -458,6 +472,9 @@ int export_recovery() {
         std::cout << (f > pfap::kMinFapIndex ? "," : "") << receiver.state().settled(f);
       }
       // Amplitudes at each phoneme's start and halfway through it, on the FAPs the sessions use.
+      std::cout << "],\"phonemeSettled\":[";
+      for (size_t i = 0; i < phoneme_states.size(); ++i)
+        std::cout << (i ? "," : "") << phoneme_states[i];
       std::cout << "],\"amplitudes\":[";
       int64_t start = time_ns;
       bool first_sample = true;

@@ -64,7 +64,8 @@ export class PfapReceiver {
   }
 
   /**
-   * Takes one RTP packet; returns the events it gives, in order (also passed to onEvent).
+   * Takes one RTP packet; returns the events it gives, in order (also passed to onEvent, each
+   * once the face state holds it).
    * A malformed packet gives none and is counted (stats) and warned about (onWarning, at the
    * 1st, 2nd, 4th... of a kind); the stream goes on.
    * @param {Uint8Array} bytes
@@ -117,9 +118,11 @@ export class PfapReceiver {
     const r = this.recovery.receive(packet, rtp.sequenceNumber, timeNs);
     const uncertain = !r.stateWhole;
     const events = [];
+    // onEvent sees each event as soon as the face state holds it.
     const emit = (event) => {
       this.animator.apply(event, event.timeNs);
       events.push(event);
+      if (this.onEvent) this.onEvent(event);
     };
     // An unchanged complete state changes nothing: a lossless stream comes out as it was sent.
     if (r.recovery === 'recovered' || (r.recovery === 'complete' && r.changed)) {
@@ -149,7 +152,6 @@ export class PfapReceiver {
     s.gaps += r.lost > 0 ? 1 : 0;
     s.recovered += r.recovery === 'recovered' ? 1 : 0;
     s.completeStates += r.recovery === 'complete' ? 1 : 0;
-    if (this.onEvent) for (const e of events) this.onEvent(e);
     if (r.requestComplete) {
       ++s.requests;
       if (this.onRequestComplete) this.onRequestComplete({ sequenceNumber: rtp.sequenceNumber, ssrc: rtp.ssrc });

@@ -18,14 +18,24 @@ function ticks(timeNs) {
 }
 
 test('received sessions give every phoneme at its time and libpfap\'s FAP state', () => {
+  let phonemesCompared = 0;
   for (const setup of setups) {
     const requests = [];
-    const receiver = new PfapReceiver({ payloadType: 96, onRequestComplete: (r) => requests.push(r) });
+    // The settled state at each phoneme event, as the face holds it when onEvent sees it.
+    const phonemeSettled = [];
+    const onEvent = (e) => {
+      if (e.kind !== 'phoneme') return;
+      const settled = [];
+      for (let f = 3; f <= 74; ++f) settled.push(receiver.animator.state.settled(f));
+      phonemeSettled.push(settled);
+    };
+    const receiver = new PfapReceiver({ payloadType: 96, onEvent, onRequestComplete: (r) => requests.push(r) });
     const base = 0xffff0000; // the timestamp wraps within the first seconds
     let lastEnd = -Infinity;
     for (const p of setup.packets) {
       const payload = fromHex(p.payload);
       if (p.lostUnknownBefore) receiver.lostUnknown();
+      phonemeSettled.length = 0;
       const events = receiver.receive(makeRtp({ payloadType: 96, sequenceNumber: p.sequenceNumber, timestamp: (base + ticks(p.timeNs)) >>> 0, ssrc: 1234, payload }));
       const phonemes = events.filter((e) => e.kind === 'phoneme');
       const first = setup.packets[0];
@@ -41,12 +51,16 @@ test('received sessions give every phoneme at its time and libpfap\'s FAP state'
       const settled = [];
       for (let f = 3; f <= 74; ++f) settled.push(receiver.recovery.state.settled(f));
       assert.deepStrictEqual(settled, p.settled);
+      // libpfap's settled state after each of the packet's phonemes.
+      assert.deepStrictEqual(phonemeSettled, p.phonemeSettled, `packet ${p.sequenceNumber}`);
+      phonemesCompared += phonemeSettled.length;
     }
     const lost = setup.packets.reduce((n, p) => n + p.result.lost, 0);
     assert.equal(receiver.stats.lost, lost);
     assert.equal(receiver.stats.packets, setup.packets.length);
     assert.equal(requests.length, receiver.stats.requests);
   }
+  assert.ok(phonemesCompared > 3000, `${phonemesCompared} phonemes`);
 });
 
 function phonemePacket(symbol, faps = []) {
