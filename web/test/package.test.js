@@ -1,10 +1,11 @@
 // The package as a page and a TypeScript user get it: every module imports only relative
 // paths with their extensions (a browser loads them from a served directory, no bundler) and
 // uses no Node-only API; index.d.ts declares every export; `npm pack` ships src/ and
-// package.json, and nothing of the tests.
+// package.json, and nothing of the tests; the tarball installs, and `import 'pfap'` works.
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { readFileSync, readdirSync } from 'node:fs';
+import { mkdtempSync, readFileSync, readdirSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { test } from 'node:test';
 import { fileURLToPath } from 'node:url';
@@ -35,4 +36,22 @@ test('npm pack ships the modules and their types', () => {
   const [pack] = JSON.parse(execFileSync('npm', ['pack', '--dry-run', '--json'], { cwd: root, encoding: 'utf8', stdio: ['ignore', 'pipe', 'ignore'] }));
   const files = pack.files.map((f) => f.path).sort();
   assert.deepEqual(files, ['package.json', 'src/index.d.ts', ...sources.map((f) => `src/${f}`)].sort());
+});
+
+test('the tarball installs into a project, and import \'pfap\' gives the package', () => {
+  const dir = mkdtempSync(path.join(tmpdir(), 'pfap-pack-'));
+  try {
+    const quiet = { cwd: dir, encoding: 'utf8', stdio: ['ignore', 'pipe', 'ignore'] };
+    const [pack] = JSON.parse(execFileSync('npm', ['pack', root, '--json'], quiet));
+    writeFileSync(path.join(dir, 'package.json'), '{"name": "user", "version": "1.0.0", "type": "module"}');
+    // No dependencies to fetch: the install needs no network.
+    execFileSync('npm', ['install', '--offline', '--no-audit', '--no-fund', `./${pack.filename}`], quiet);
+    writeFileSync(path.join(dir, 'use.js'), "import { decodePayload } from 'pfap';\n" +
+      'console.log(JSON.stringify(decodePayload(new Uint8Array([0x00, 7, 5, 0, 6]))));\n');
+    const out = JSON.parse(execFileSync(process.execPath, ['use.js'], quiet));
+    assert.deepStrictEqual(out, { ok: true, packet: { complete: false, coverage: 0, recovery: [], phonemes: [
+      { symbol: 7, duration: 80, f0: 0, stress: false, wordBegin: true, endOfText: false, faps: [] }] } });
+  } finally {
+    rmSync(dir, { recursive: true, force: true });
+  }
 });
