@@ -32,6 +32,16 @@ test('index.d.ts declares every export of index.js', () => {
   }
 });
 
+test('index.d.ts type-checks, and a page written against it too (tsc --strict)', () => {
+  const tsc = path.join(root, 'node_modules', 'typescript', 'bin', 'tsc');
+  const args = ['--noEmit', '--strict', '--target', 'es2020', '--module', 'es2020', '--moduleResolution', 'node', '--lib', 'es2020,dom'];
+  try {
+    execFileSync(process.execPath, [tsc, ...args, path.join(root, 'test', 'types.ts')], { encoding: 'utf8' });
+  } catch (e) {
+    assert.fail(`tsc: ${e.stdout}${e.message}`);
+  }
+});
+
 test('npm pack ships the modules and their types', () => {
   const [pack] = JSON.parse(execFileSync('npm', ['pack', '--dry-run', '--json'], { cwd: root, encoding: 'utf8', stdio: ['ignore', 'pipe', 'ignore'] }));
   const files = pack.files.map((f) => f.path).sort();
