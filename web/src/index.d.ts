@@ -224,3 +224,4 @@ export declare const MAX_PHONEME_DURATION_MS: 4095;
 export declare const MAX_F0_HZ: 510;
 export declare function f0Code(hz: number): number;
 export declare function isValidFap(fap: Fap): boolean;
+export declare function isValidPhoneme(phoneme: Phoneme): boolean;

@@ -12,4 +12,5 @@ export { DEFAULT_CLOCK_RATE, PfapReceiver } from './receiver.js';
 export {
   COVERAGE_STEPS, Curve, FAP_COUNT, FIRST_EXPRESSION_INDEX, MAX_AMPLITUDE, MAX_F0_HZ, MAX_FAP_INDEX,
   MAX_PHONEME_DURATION_MS, MAX_TRANSITION_MS, MIN_FAP_INDEX, NS_PER_MS, f0Code, isValidFap,
+  isValidPhoneme,
 } from './model.js';

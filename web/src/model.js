@@ -38,6 +38,22 @@ export function isValidFap(fap) {
 }
 
 /**
+ * Whether `phoneme` holds values the wire can carry (f0 in Hz, any whole number: the encoder
+ * rounds it with f0Code) and a list of FAPs.
+ * @param {import('./index.js').Phoneme} phoneme
+ */
+export function isValidPhoneme(phoneme) {
+  return (
+    phoneme !== null &&
+    typeof phoneme === 'object' &&
+    isInt(phoneme.symbol, 0, 255) &&
+    isInt(phoneme.duration, 0, MAX_PHONEME_DURATION_MS) &&
+    isInt(phoneme.f0, 0, Number.MAX_SAFE_INTEGER) &&
+    Array.isArray(phoneme.faps)
+  );
+}
+
+/**
  * The f0 code for a frequency in Hz: nearest 2 Hz step, halves rounded up, saturating at
  * 510 Hz (code 255), as pfap::f0_code.
  * @param {number} hz a whole number of Hz, 0 or more

@@ -3,7 +3,9 @@
 // in the same order, so the same status and byte offset for every bad payload. docs/format.md
 // has the bit layout and the table of statuses.
 
-import { COVERAGE_STEPS, MAX_AMPLITUDE, MAX_FAP_INDEX, MIN_FAP_INDEX, f0Code, isValidFap } from './model.js';
+import {
+  COVERAGE_STEPS, MAX_AMPLITUDE, MAX_FAP_INDEX, MIN_FAP_INDEX, f0Code, isValidFap, isValidPhoneme,
+} from './model.js';
 
 const PACKET_DESCRIPTOR_BYTES = 1;
 const PHONEME_DESCRIPTOR_BYTES = 4;
@@ -150,21 +152,6 @@ export class EncodeError extends Error {
   }
 }
 
-function isInt(v, lo, hi) {
-  return Number.isInteger(v) && v >= lo && v <= hi;
-}
-
-function validPhoneme(p) {
-  return (
-    p !== null &&
-    typeof p === 'object' &&
-    isInt(p.symbol, 0, 255) &&
-    isInt(p.duration, 0, 4095) &&
-    isInt(p.f0, 0, Number.MAX_SAFE_INTEGER) &&
-    Array.isArray(p.faps)
-  );
-}
-
 // The checks of pfap::encode_payload, in its order.
 function check(packet) {
   const recovery = packet.recovery ?? [];
@@ -186,7 +173,7 @@ function check(packet) {
     if (phonemes.length === 0) throw new EncodeError('kEmptyPacket', 'empty packet');
   }
   phonemes.forEach((p, i) => {
-    if (!validPhoneme(p)) throw new EncodeError('kInvalidPhoneme', `phoneme ${i} has a field out of range`);
+    if (!isValidPhoneme(p)) throw new EncodeError('kInvalidPhoneme', `phoneme ${i} has a field out of range`);
     if (p.endOfText && i + 1 !== phonemes.length) {
       throw new EncodeError('kEndOfTextNotLast', `end of text on phoneme ${i}, not the last`);
     }
