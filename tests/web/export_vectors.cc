@@ -10,6 +10,7 @@
 //   export_vectors curves               pfap::FapState amplitudes, settled values and
 //                                       recovery entries after seeded bookmarks
 //   export_vectors animator             face::Animator's FAP values after seeded events
+//   export_vectors alphabet             x-pfap-arpabet: each symbol 0..255's name and viseme
 //   export_vectors recovery             the seeded speech sessions sent with recovery, lost
 //                                       at seeded places, and what RecoveryReceiver holds
 //   export_vectors render DIR           face states, their poses, and their frames drawn by
@@ -398,6 +399,23 @@ int export_animator() {
   return 0;
 }
 
+int export_alphabet() {
+  const pfap::PhonemeAlphabet* alphabet = pfap::find_alphabet(pfap::kArpabetAlphabet);
+  std::cout << "[";
+  for (int symbol = 0; symbol < 256; ++symbol) {
+    const pfap::PhonemeInfo* info = pfap::find_phoneme(*alphabet, static_cast<uint8_t>(symbol));
+    std::cout << (symbol ? "," : "");
+    if (info == nullptr) {
+      std::cout << "null";
+    } else {
+      std::cout << "{\"name\":\"" << info->name
+                << "\",\"viseme\":" << static_cast<int>(info->viseme) << "}";
+    }
+  }
+  std::cout << "]\n";
+  return 0;
+}
+
 // The seeded speech sessions of speech_session.h, packetized and sent with dynamic recovery
 // (and complete states in some), lost at seeded places, received by RecoveryReceiver.
 int export_recovery() {
@@ -595,10 +613,12 @@ int main(int argc, char** argv) {
   if (mode == "rtp" && argc == 2) return export_rtp();
   if (mode == "curves" && argc == 2) return export_curves();
   if (mode == "animator" && argc == 2) return export_animator();
+  if (mode == "alphabet" && argc == 2) return export_alphabet();
   if (mode == "recovery" && argc == 2) return export_recovery();
   if (mode == "render" && argc == 3) return export_render(argv[2]);
-  std::fprintf(stderr,
-               "usage: export_vectors payloads CORPUS_DIR | decode | rtp | curves | animator | "
-               "recovery | render DIR\n");
+  std::fprintf(
+      stderr,
+      "usage: export_vectors payloads CORPUS_DIR | decode | rtp | curves | animator | alphabet | "
+      "recovery | render DIR\n");
   return 2;
 }

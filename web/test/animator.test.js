@@ -1,10 +1,11 @@
 // Animator and face model against pfapface's (face::Animator, face::pose_from_faps): seeded
 // phonemes (x-pfap-arpabet, unknown symbols, no alphabet), FAPs, recovered and complete states
-// give the same FAP values and overlay text (poses: renderer.test.js).
+// give the same FAP values and overlay text (poses: renderer.test.js); the phoneme table is
+// libpfap's.
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 
-import { Animator, findAlphabet } from '../src/index.js';
+import { Animator, findAlphabet, findPhoneme, findSymbol } from '../src/index.js';
 import { exportVectors } from './libpfap.js';
 
 // Math.sin and friends may differ from glibc's in the last bit; everything else is exact.
@@ -33,4 +34,16 @@ test('FAP values over time equal face::Animator\'s', () => {
     }
   }
   assert.ok(unknown > 0, 'no phoneme without a viseme');
+});
+
+test('x-pfap-arpabet names and visemes equal libpfap\'s, symbol by symbol', () => {
+  const table = exportVectors(['alphabet']);
+  const alphabet = findAlphabet('x-pfap-arpabet');
+  assert.equal(table.length, 256);
+  table.forEach((expected, symbol) => {
+    assert.deepStrictEqual(findPhoneme(alphabet, symbol), expected, `symbol ${symbol}`);
+    if (expected !== null) assert.equal(findSymbol(alphabet, expected.name), symbol);
+  });
+  assert.equal(table.filter((p) => p !== null).length, 40);
+  assert.equal(findAlphabet('x-unknown'), null);
 });
