@@ -201,10 +201,13 @@ export declare class PfapReceiver {
   constructor(options?: PfapReceiverOptions);
   readonly stats: ReceiverStats;
   readonly stateWhole: boolean;
+  /** events received that the face has not reached yet */
+  readonly pendingEvents: number;
   readonly recovery: RecoveryReceiver;
   readonly animator: Animator;
   receive(bytes: Uint8Array): ReceiverEvent[];
   lostUnknown(): void;
+  advance(timeNs: number): void;
   faps(timeNs: number): Float64Array;
   pose(timeNs: number): FacePose;
   draw(ctx: CanvasRenderingContext2D, timeNs: number, options?: { style?: 'cartoon' | 'line'; overlay?: boolean }): void;

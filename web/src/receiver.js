@@ -14,6 +14,10 @@ import { RtpError, parseRtp } from './rtp.js';
 /** The draft's default RTP clock (section 7). */
 export const DEFAULT_CLOCK_RATE = 44100;
 
+// Events not yet drawn are kept for the face until a draw reaches their time; a program that
+// never draws applies the oldest beyond this many, so that memory stays bounded.
+const MAX_PENDING_EVENTS = 4096;
+
 // 1st, 2nd, 4th, 8th... occurrence: per-item warnings rate-limited as rtppfapdepay's.
 function warnAt(count) {
   return count > 0 && (count & (count - 1)) === 0;
@@ -41,6 +45,7 @@ export class PfapReceiver {
     this.onWarning = options.onWarning ?? null;
     this.recovery = new RecoveryReceiver({ retryNs: options.retryNs });
     this.animator = new Animator(this.alphabet);
+    this._pending = []; // events received whose time the face has not reached, oldest first
     /** Counters, as rtppfapdepay's stats property. */
     this.stats = {
       packets: 0, malformedRtp: 0, malformedPayload: 0, otherPayloadType: 0, late: 0, phonemes: 0,
@@ -58,14 +63,19 @@ export class PfapReceiver {
     return this.recovery.stateWhole;
   }
 
+  /** How many events received the face has not reached yet (advance() takes them). */
+  get pendingEvents() {
+    return this._pending.length;
+  }
+
   _warn(kind, message) {
     const count = ++this.stats[kind];
     if (this.onWarning && warnAt(count)) this.onWarning(`${message} (${count} so far)`);
   }
 
   /**
-   * Takes one RTP packet; returns the events it gives, in order (also passed to onEvent, each
-   * once the face state holds it).
+   * Takes one RTP packet; returns the events it gives, in order (also passed to onEvent). The
+   * face takes them when advance(), faps(), pose() or draw() reach their times.
    * A malformed packet gives none and is counted (stats) and warned about (onWarning, at the
    * 1st, 2nd, 4th... of a kind); the stream goes on.
    * @param {Uint8Array} bytes
@@ -100,6 +110,7 @@ export class PfapReceiver {
       this._ssrc = rtp.ssrc;
       this.recovery.reset(true);
       this.animator.reset();
+      this._pending.length = 0;
       this._lastSequenceNumber = null;
       this._baseTimestamp = rtp.timestamp;
       this._lastTimestamp = rtp.timestamp;
@@ -118,9 +129,11 @@ export class PfapReceiver {
     const r = this.recovery.receive(packet, rtp.sequenceNumber, timeNs);
     const uncertain = !r.stateWhole;
     const events = [];
-    // onEvent sees each event as soon as the face state holds it.
+    // Packets come ahead of their time (the sender's packetizing delay, the page's buffering):
+    // the face takes each event when a draw reaches its time, as pfapface takes each buffer
+    // when its frame's time comes.
     const emit = (event) => {
-      this.animator.apply(event, event.timeNs);
+      this._pending.push(event);
       events.push(event);
       if (this.onEvent) this.onEvent(event);
     };
@@ -152,6 +165,10 @@ export class PfapReceiver {
     s.gaps += r.lost > 0 ? 1 : 0;
     s.recovered += r.recovery === 'recovered' ? 1 : 0;
     s.completeStates += r.recovery === 'complete' ? 1 : 0;
+    const excess = this._pending.length - MAX_PENDING_EVENTS;
+    if (excess > 0) {
+      for (const e of this._pending.splice(0, excess)) this.animator.apply(e, e.timeNs);
+    }
     if (r.requestComplete) {
       ++s.requests;
       if (this.onRequestComplete) this.onRequestComplete({ sequenceNumber: rtp.sequenceNumber, ssrc: rtp.ssrc });
@@ -165,10 +182,25 @@ export class PfapReceiver {
   }
 
   /**
+   * Brings the face to `timeNs` (stream time): applies, in order, every event received whose
+   * time has come. faps(), pose() and draw() do it first.
+   * @param {number} timeNs
+   */
+  advance(timeNs) {
+    let n = 0;
+    while (n < this._pending.length && this._pending[n].timeNs <= timeNs) {
+      this.animator.apply(this._pending[n], this._pending[n].timeNs);
+      ++n;
+    }
+    if (n > 0) this._pending.splice(0, n);
+  }
+
+  /**
    * Every FAP's amplitude at `timeNs` (stream time), mouth and expressions included.
    * @param {number} timeNs
    */
   faps(timeNs) {
+    this.advance(timeNs);
     return this.animator.faps(timeNs);
   }
 
@@ -177,26 +209,27 @@ export class PfapReceiver {
    * @param {number} timeNs
    */
   pose(timeNs) {
+    this.advance(timeNs);
     return this.animator.pose(timeNs);
   }
 
   /**
-   * Draws the face at `timeNs` on a canvas 2D context (see renderFace for the options).
+   * Draws the face at `timeNs` on a canvas 2D context, in `style` ('cartoon' or 'line'), with
+   * pfapface's debug overlay (the phoneme sounding and the FAPs not at 0) when `overlay`.
    * @param {CanvasRenderingContext2D} ctx
    * @param {number} timeNs
    * @param {{style?: 'cartoon'|'line', overlay?: boolean}} [options]
    */
   draw(ctx, timeNs, options = {}) {
-    renderFace(ctx, this.pose(timeNs), {
-      style: options.style,
-      overlay: options.overlay ? this.animator.describe(timeNs) : '',
-    });
+    const pose = this.pose(timeNs);
+    renderFace(ctx, pose, { style: options.style, overlay: options.overlay ? this.animator.describe(timeNs) : '' });
   }
 
   /** Back to no packet seen. */
   reset() {
     this.recovery.reset(true);
     this.animator.reset();
+    this._pending.length = 0;
     this._ssrc = null;
     this._lastSequenceNumber = null;
   }

@@ -21,21 +21,12 @@ test('received sessions give every phoneme at its time and libpfap\'s FAP state'
   let phonemesCompared = 0;
   for (const setup of setups) {
     const requests = [];
-    // The settled state at each phoneme event, as the face holds it when onEvent sees it.
-    const phonemeSettled = [];
-    const onEvent = (e) => {
-      if (e.kind !== 'phoneme') return;
-      const settled = [];
-      for (let f = 3; f <= 74; ++f) settled.push(receiver.animator.state.settled(f));
-      phonemeSettled.push(settled);
-    };
-    const receiver = new PfapReceiver({ payloadType: 96, onEvent, onRequestComplete: (r) => requests.push(r) });
+    const receiver = new PfapReceiver({ payloadType: 96, onRequestComplete: (r) => requests.push(r) });
     const base = 0xffff0000; // the timestamp wraps within the first seconds
     let lastEnd = -Infinity;
     for (const p of setup.packets) {
       const payload = fromHex(p.payload);
       if (p.lostUnknownBefore) receiver.lostUnknown();
-      phonemeSettled.length = 0;
       const events = receiver.receive(makeRtp({ payloadType: 96, sequenceNumber: p.sequenceNumber, timestamp: (base + ticks(p.timeNs)) >>> 0, ssrc: 1234, payload }));
       const phonemes = events.filter((e) => e.kind === 'phoneme');
       const first = setup.packets[0];
@@ -51,7 +42,14 @@ test('received sessions give every phoneme at its time and libpfap\'s FAP state'
       const settled = [];
       for (let f = 3; f <= 74; ++f) settled.push(receiver.recovery.state.settled(f));
       assert.deepStrictEqual(settled, p.settled);
-      // libpfap's settled state after each of the packet's phonemes.
+      // The face brought to each phoneme's time holds libpfap's settled state after it (the
+      // sessions' phonemes last 40 ms or more, so no later one shares its time).
+      const phonemeSettled = phonemes.map((e) => {
+        receiver.advance(e.timeNs);
+        const s = [];
+        for (let f = 3; f <= 74; ++f) s.push(receiver.animator.state.settled(f));
+        return s;
+      });
       assert.deepStrictEqual(phonemeSettled, p.phonemeSettled, `packet ${p.sequenceNumber}`);
       phonemesCompared += phonemeSettled.length;
     }
@@ -112,4 +110,27 @@ test('a new SSRC is a new stream: uncertain, asking for a complete state, until 
   assert.equal(events[0].uncertain, true, 'another sender');
   assert.equal(events[0].timeNs, 0, 'its own stream time');
   assert.equal(requests.length, 2);
+});
+
+test('the face takes each event when its time comes, not when its packet does', () => {
+  const receiver = new PfapReceiver();
+  const rtp = (seq, timestamp, payload) => makeRtp({ payloadType: 96, sequenceNumber: seq, timestamp, ssrc: 5, payload });
+  receiver.receive(rtp(1, 0, encodePayload({ complete: true, coverage: 0, recovery: [], phonemes: [] })));
+  // Both packets come at once, ahead of their time, as a sender with a delay sends them.
+  receiver.receive(rtp(2, 0, phonemePacket(1)));  // AA from 0 to 100 ms
+  receiver.receive(rtp(3, 4410, phonemePacket(22, [{ index: 12, amplitude: 300, transition: 0, curve: 1 }])));  // M from 100 ms
+  assert.equal(receiver.faps(50_000_000)[12], 0, 'the smile is not there before its phoneme');
+  assert.equal(receiver.animator.describe(50_000_000), 'AA');
+  assert.equal(receiver.faps(150_000_000)[12], 300);
+  assert.match(receiver.animator.describe(150_000_000), /^M 12:300/);
+});
+
+test('a receiver nobody draws keeps at most 4096 events for the face', () => {
+  const receiver = new PfapReceiver();
+  for (let seq = 0; seq < 5000; ++seq) {
+    receiver.receive(makeRtp({ payloadType: 96, sequenceNumber: seq, timestamp: seq * 4410, ssrc: 5, payload: phonemePacket(1, [{ index: 3, amplitude: seq, transition: 0, curve: 1 }]) }));
+  }
+  assert.equal(receiver.pendingEvents, 4096);
+  // The oldest went to the face in order: FAP 3 holds the last of them.
+  assert.equal(receiver.animator.state.settled(3), 5000 - 4096 - 1);
 });
