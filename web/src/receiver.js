@@ -53,8 +53,7 @@ export class PfapReceiver {
     };
     this._ssrc = null;
     this._lastSequenceNumber = null;
-    this._baseTimestamp = 0; // the stream's first RTP timestamp: time 0
-    this._extTimestamp = 0; // the last timestamp, unwrapped, relative to the base
+    this._extTimestamp = 0; // the last timestamp, unwrapped, in ticks since the SSRC's first
     this._lastTimestamp = 0;
   }
 
@@ -112,7 +111,6 @@ export class PfapReceiver {
       this.animator.reset();
       this._pending.length = 0;
       this._lastSequenceNumber = null;
-      this._baseTimestamp = rtp.timestamp;
       this._lastTimestamp = rtp.timestamp;
       this._extTimestamp = 0;
     } else if (((rtp.sequenceNumber - this._lastSequenceNumber) & 0xffff) >= 0x8000 || rtp.sequenceNumber === this._lastSequenceNumber) {
