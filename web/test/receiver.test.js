@@ -6,8 +6,12 @@
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 
-import { PfapReceiver, encodePayload, makeRtp } from '../src/index.js';
-import { exportVectors, fromHex } from './libpfap.js';
+import path from 'node:path';
+
+import { createCanvas } from '@napi-rs/canvas';
+
+import { PfapReceiver, decodePayload, encodePayload, makeRtp } from '../src/index.js';
+import { exportVectors, fromHex, sourceRoot } from './libpfap.js';
 
 const RATE = 44100;
 const TICK_NS = 1e9 / RATE;
@@ -133,4 +137,29 @@ test('a receiver nobody draws keeps at most 4096 events for the face', () => {
   assert.equal(receiver.pendingEvents, 4096);
   // The oldest went to the face in order: FAP 3 holds the last of them.
   assert.equal(receiver.animator.state.settled(3), 5000 - 4096 - 1);
+});
+
+test('hostile packets never throw, and every one is counted', () => {
+  const payloads = exportVectors(['payloads', path.join(sourceRoot, 'tests/fuzz/corpus/fuzz_payload')]);
+  const rtps = exportVectors(['rtp']);
+  const receiver = new PfapReceiver();
+  let sequenceNumber = 0;
+  let events = 0;
+  // Arbitrary RTP packets, then the mutated payloads in well-formed RTP (a new SSRC now and
+  // then, sequence numbers jumping).
+  for (const { bytes } of rtps) events += receiver.receive(fromHex(bytes)).length;
+  const refusedRtp = rtps.filter((r) => r.rtp === null).length;
+  for (const [i, record] of [...payloads.mutated, ...payloads.arbitrary].entries()) {
+    sequenceNumber += i % 17 === 0 ? 1000 : 1;
+    const bytes = makeRtp({ payloadType: 96, sequenceNumber, timestamp: sequenceNumber * 441, ssrc: 1 + Math.floor(i / 3000), payload: fromHex(record.bytes) });
+    events += receiver.receive(bytes).length;
+  }
+  const s = receiver.stats;
+  assert.equal(s.malformedRtp, refusedRtp);
+  assert.equal(s.packets, rtps.length - refusedRtp + payloads.mutated.length + payloads.arbitrary.length);
+  const malformed = [...rtps.filter((r) => r.rtp !== null).map((r) => r.rtp.payload), ...[...payloads.mutated, ...payloads.arbitrary].map((r) => r.bytes)]
+    .filter((hex) => !decodePayload(fromHex(hex)).ok).length;
+  assert.equal(s.malformedPayload, malformed);
+  assert.ok(events > 5000, `${events} events`);
+  receiver.draw(createCanvas(64, 48).getContext('2d'), 1e12, { overlay: true });
 });
