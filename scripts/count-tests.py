@@ -1,7 +1,7 @@
 """Counts the test cases behind meson test logs: GoogleTest cases from each gtest program's
-result lines, pytest's from its summary line, one case for any other test. With one log,
-prints 'tests: N passed, M failed'; with several (one per build), a line for each and then
-that line for them all."""
+result lines, pytest's from its summary line, node's test runner's from its closing '# pass N'
+and '# fail N' (web/), one case for any other test. With one log, prints 'tests: N passed,
+M failed'; with several (one per build), a line for each and then that line for them all."""
 import json
 import re
 import sys
@@ -22,6 +22,10 @@ def count(path):
                 words = dict((w, int(n)) for n, w in re.findall(r"(\d+) (\w+)", summary[-1]))
                 ok = words.get("passed", 0)
                 bad = words.get("failed", 0) + words.get("error", 0) + words.get("errors", 0)
+            node_pass = re.search(r"^# pass (\d+)$", out, re.M)
+            node_fail = re.search(r"^# fail (\d+)$", out, re.M)
+            if node_pass and node_fail:
+                ok, bad = ok + int(node_pass.group(1)), bad + int(node_fail.group(1))
             if ok or bad:
                 passed, failed = passed + ok, failed + bad
                 if test["result"] != "OK" and not bad:
