@@ -69,9 +69,12 @@ MouthShape generic_mouth() { return {250, 0, 0, 40, 0, 0}; }
 bool Animator::apply(const pfap::MarkupEvent& event, int64_t time_ns) {
   time_ns = std::max(time_ns, last_ns_);
   last_ns_ = time_ns;
-  if (event.kind == PFAP_EVENT_COMPLETE) state_.reset();
+  if (event.kind == PFAP_EVENT_COMPLETE) {
+    state_.apply_complete(event.faps, time_ns);
+  } else {
+    for (const pfap::Fap& fap : event.faps) state_.apply(fap, time_ns);
+  }
   for (const pfap::Fap& fap : event.faps) {
-    state_.apply(fap, time_ns);
     end_ns_ = std::max(end_ns_, time_ns + int64_t{fap.transition_ms} * pfap::kNsPerMs);
   }
   if (event.kind != PFAP_EVENT_PHONEME) return true;

@@ -70,4 +70,9 @@ Fap FapState::recovery_entry(int index, int64_t time_ns) const {
 
 void FapState::reset() { tracks_.fill(Track{}); }
 
+void FapState::apply_complete(std::span<const Fap> entries, int64_t time_ns) {
+  reset();
+  for (const Fap& entry : entries) apply(entry, time_ns);
+}
+
 }  // namespace pfap
