@@ -376,6 +376,19 @@ TEST(PfapFace, EventEarlierThanTheLastIsAppliedAtItsTimeWithAWarning) {
   unref_all(frames);
 }
 
+TEST(PfapFace, EarlierEventsAreWarnedAboutAtThe1st2nd4th8th) {
+  // 200 events in reverse time order: 199 go back, 8 warnings (the 1st to the 128th).
+  Face face;
+  for (int i = 199; i >= 0; --i) face.push(phoneme("AA", i * 10 * kMs, 10));
+  face.eos();
+  std::vector<GstBuffer*> frames = face.frames_until_eos();
+  EXPECT_FALSE(frames.empty());
+  const std::vector<std::string> warnings = face.warnings();
+  ASSERT_EQ(warnings.size(), 8u);
+  EXPECT_NE(warnings.back().find("earlier than the one before"), std::string::npos);
+  unref_all(frames);
+}
+
 TEST(PfapFace, UnknownAlphabetWarnsOnceAndStillMovesTheMouth) {
   Face face(kSmallCaps, "application/x-pfap, alphabet=(string)x-klingon");
   for (int i = 0; i < 5; ++i) face.push(phoneme("AA", i * 200 * kMs, 200));

@@ -112,6 +112,15 @@ class PfapTextEncTest : public ::testing::Test {
     return text;
   }
 
+  guint64 stat(const char* field) {
+    GstStructure* stats = nullptr;
+    g_object_get(h_->element, "stats", &stats, nullptr);
+    guint64 value = G_MAXUINT64;
+    EXPECT_TRUE(gst_structure_get_uint64(stats, field, &value)) << field;
+    gst_structure_free(stats);
+    return value;
+  }
+
   GstHarness* h_;
   GstBus* bus_;
 };
@@ -280,6 +289,30 @@ TEST_F(PfapTextEncTest, EarlierEventIsWrittenAtThePreviousTimeWithAWarning) {
             (std::vector<std::string>{"0 1 100 120 -\n", "200 2 100 120 -\n", "200 3 100 120 -\n",
                                       "200 4 100 120 -\n", "300 5 100 120 -\n"}));
   EXPECT_EQ(read_back(lines).size(), 5u);
+}
+
+TEST_F(PfapTextEncTest, EarlierEventsAreWarnedAboutAtThe1st2nd4th8thAndAllCounted) {
+  // 2000 events in reverse time order: 1999 go back, 11 warnings (the 1st to the 1024th).
+  for (int i = 1999; i >= 0; --i) push(phoneme(1, 10), static_cast<GstClockTime>(i) * 10 * kMs);
+  EXPECT_EQ(pull_lines().size(), 2000u);
+  size_t warnings = 0;
+  while (!pop_warning().empty()) ++warnings;
+  EXPECT_EQ(warnings, 11u);
+  EXPECT_EQ(stat("earlier"), 1999u);
+  EXPECT_EQ(stat("events"), 2000u);
+}
+
+TEST_F(PfapTextEncTest, MalformedBuffersAreWarnedAboutAtThe1st2nd4th8thAndAllCounted) {
+  for (int i = 0; i < 20; ++i) {
+    GstBuffer* bad = gst_buffer_new_allocate(nullptr, 3, nullptr);
+    gst_buffer_memset(bad, 0, 0xff, 3);
+    push(bad);
+  }
+  size_t warnings = 0;
+  while (!pop_warning().empty()) ++warnings;
+  EXPECT_EQ(warnings, 5u);
+  EXPECT_EQ(stat("malformed"), 20u);
+  EXPECT_EQ(stat("events"), 0u);
 }
 
 TEST_F(PfapTextEncTest, MalformedBufferIsDroppedWithAWarningAndTheNextWritten) {
