@@ -223,6 +223,24 @@ TEST_F(RtpPfapDepayTest, EachPhonemeBecomesABufferWithItsFapsAndTime) {
   EXPECT_EQ(stat(h_, "faps"), 3u);
 }
 
+TEST_F(RtpPfapDepayTest, PacketWithOnlyADtsTimesEveryPhonemeFromIt) {
+  // pcapparse gives each packet a DTS and no PTS.
+  const Phoneme a{.symbol = 42, .duration_ms = 100, .f0 = 60};
+  const Phoneme b{.symbol = 7, .duration_ms = 80, .f0 = 255};
+  Packet packet;
+  packet.add_phoneme(a, {});
+  packet.add_phoneme(b, {});
+  const GstClockTime t = 2 * GST_SECOND;
+  start_stream(h_, 0, t);
+  GstBuffer* buffer = rtp_packet(encode(packet), 1, t);
+  GST_BUFFER_PTS(buffer) = GST_CLOCK_TIME_NONE;
+  GST_BUFFER_DTS(buffer) = t;
+  const std::vector<Event> got = push(h_, buffer);
+  ASSERT_EQ(got.size(), 2u);
+  EXPECT_EQ(got[0].pts, t);
+  EXPECT_EQ(got[1].pts, t + 100 * GST_MSECOND);
+}
+
 TEST_F(RtpPfapDepayTest, SentenceStartComesOnlyFromTheMarkerBitOnTheFirstPhoneme) {
   const Phoneme p{.symbol = 1, .duration_ms = 10};
   Packet packet;
