@@ -13,6 +13,7 @@
 #include "pfap/packetizer.h"
 #include "pfap/payload.h"
 #include "pfap_buffers.h"
+#include "rtp_packet.h"
 
 namespace pfap {
 namespace {
@@ -34,19 +35,13 @@ Bytes encode(const Packet& packet) {
 // An RTP packet whose PTS is `pts` and whose timestamp is `pts` on a `clock_rate` clock.
 GstBuffer* rtp_packet(const Bytes& payload, guint16 seqnum, GstClockTime pts, bool marker = false,
                       uint32_t clock_rate = kDefaultClockRate) {
-  GstBuffer* buffer = gst_rtp_buffer_new_allocate(static_cast<guint>(payload.size()), 0, 0);
-  GstRTPBuffer rtp = GST_RTP_BUFFER_INIT;
-  EXPECT_TRUE(gst_rtp_buffer_map(buffer, GST_MAP_WRITE, &rtp));
-  gst_rtp_buffer_set_payload_type(&rtp, 96);
-  gst_rtp_buffer_set_ssrc(&rtp, kSsrc);
-  gst_rtp_buffer_set_seq(&rtp, seqnum);
-  gst_rtp_buffer_set_timestamp(&rtp, rtp_ticks(static_cast<int64_t>(pts), clock_rate));
-  gst_rtp_buffer_set_marker(&rtp, marker);
-  std::copy(payload.begin(), payload.end(),
-            static_cast<uint8_t*>(gst_rtp_buffer_get_payload(&rtp)));
-  gst_rtp_buffer_unmap(&rtp);
-  GST_BUFFER_PTS(buffer) = pts;
-  return buffer;
+  return testing::rtp_packet(
+      payload,
+      {.seqnum = seqnum,
+       .timestamp = rtp_ticks(static_cast<int64_t>(pts), clock_rate),
+       .ssrc = kSsrc,
+       .marker = marker},
+      pts);
 }
 
 // The same packet from another sender.
