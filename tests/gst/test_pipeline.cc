@@ -31,6 +31,7 @@
 #include "lip_sync.h"
 #include "pfap/markup.h"
 #include "pfap/model.h"
+#include "live_source.h"
 #include "pfap_buffers.h"
 #include "pipeline.h"
 #include "random_markup.h"
@@ -76,16 +77,14 @@ std::string describe(const Event& e) {
   return s.str();
 }
 
-GstBuffer* make_buffer(const Event& e) {
-  return pfap::testing::phoneme_buffer(e.phoneme, e.faps, e.pts,
-                                       (e.flags & PFAP_FLAG_SENTENCE_START) != 0);
-}
+GstBuffer* make_buffer(const Event& e) { return pfap::testing::phoneme_buffer(e); }
 
 using pfap::testing::bound_port;
 using pfap::testing::end_of_stream;
 using pfap::testing::fast_rtcp;
 using pfap::testing::Pipeline;
 using pfap::testing::plugin_available;
+using pfap::testing::push_live;
 using pfap::testing::pull_all;
 using pfap::testing::push;
 
@@ -586,22 +585,6 @@ std::vector<Event> live_phonemes() {
   events.back().phoneme.end_of_text = true;
   events.back().flags |= PFAP_FLAG_END_OF_TEXT;
   return events;
-}
-
-// The sender's side of the phoneme stream: pushes each phoneme when the pipeline's running
-// time reaches its start, as a live TTS source would.
-void push_live(GstElement* appsrc, GstClock* clock, GstClockTime base_time,
-               const std::vector<Event>& events, const std::atomic<bool>& stop) {
-  for (const Event& e : events) {
-    for (;;) {
-      if (stop) return;
-      const GstClockTime now = gst_clock_get_time(clock);
-      if (now >= base_time + e.pts) break;
-      const GstClockTime wait = std::min<GstClockTime>(base_time + e.pts - now, 20 * GST_MSECOND);
-      std::this_thread::sleep_for(std::chrono::nanoseconds(wait));
-    }
-    if (push(appsrc, make_buffer(e)) != GST_FLOW_OK) return;
-  }
 }
 
 TEST(LoopbackUdp, PhonemesKeepLipSyncWithAudio) {

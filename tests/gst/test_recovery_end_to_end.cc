@@ -46,6 +46,7 @@
 #include "pfap/fap_state.h"
 #include "pfap/markup.h"
 #include "pfap/model.h"
+#include "live_source.h"
 #include "pfap_buffers.h"
 #include "pipeline.h"
 #include "speech_session.h"
@@ -135,17 +136,14 @@ using pfap::testing::bound_port;
 using pfap::testing::fast_rtcp;
 using pfap::testing::Pipeline;
 using pfap::testing::plugin_available;
+using pfap::testing::push_live;
 
 GstFlowReturn push(GstElement* appsrc, const Event& e) {
-  return pfap::testing::push(
-      appsrc, pfap::testing::phoneme_buffer(e.phoneme, e.faps, e.pts,
-                                            (e.flags & PFAP_FLAG_SENTENCE_START) != 0));
+  return pfap::testing::push(appsrc, pfap::testing::phoneme_buffer(e));
 }
 
 GstFlowReturn push_harness(GstHarness* h, const Event& e) {
-  return gst_harness_push(h,
-                          pfap::testing::phoneme_buffer(e.phoneme, e.faps, e.pts,
-                                                        (e.flags & PFAP_FLAG_SENTENCE_START) != 0));
+  return gst_harness_push(h, pfap::testing::phoneme_buffer(e));
 }
 
 // Whether an RTP packet is a complete recovery (C = 1 in the payload's first byte).
@@ -217,22 +215,6 @@ constexpr const char* kReceiveCaps =
 
 GstCaps* on_request_pt_map(GstElement*, guint, guint pt, gpointer) {
   return pt == 97 ? gst_caps_from_string(kReceiveCaps) : nullptr;
-}
-
-// Pushes each phoneme when the pipeline's running time reaches its start, as a live TTS
-// source would.
-void push_live(GstElement* appsrc, GstClock* clock, GstClockTime base_time,
-               const std::vector<Event>& events, const std::atomic<bool>& stop) {
-  for (const Event& e : events) {
-    for (;;) {
-      if (stop) return;
-      const GstClockTime now = gst_clock_get_time(clock);
-      if (now >= base_time + e.pts) break;
-      const GstClockTime wait = std::min<GstClockTime>(base_time + e.pts - now, 20 * GST_MSECOND);
-      std::this_thread::sleep_for(std::chrono::nanoseconds(wait));
-    }
-    if (push(appsrc, e) != GST_FLOW_OK) return;
-  }
 }
 
 TEST(RecoveryLoop, PliBringsACompleteStateAfterALongBurst) {
