@@ -5,7 +5,6 @@
 #include <cmath>
 
 namespace pfap {
-namespace {}  // namespace
 
 void FapState::apply(const Fap& fap, int64_t start_ns) {
   assert(is_valid(fap));

@@ -135,10 +135,6 @@ size_t encoded_size(const Packet& packet) {
          kPhonemeDescriptorBytes * packet.phonemes.size();
 }
 
-}  // namespace pfap
-
-namespace pfap {
-
 const char* to_string(DecodeStatus status) {
   switch (status) {
     case DecodeStatus::kOk:
