@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "element_harness.h"
 #include "pfap/markup.h"
 #include "pfap/markup_event.h"
 #include "pfap/text.h"
@@ -51,16 +52,10 @@ std::vector<pfap::TextEvent> read_back(const std::vector<std::string>& lines) {
   return events;
 }
 
-class PfapTextEncTest : public ::testing::Test {
+class PfapTextEncTest : public ::testing::Test, public pfap::testing::ElementHarness {
  protected:
-  PfapTextEncTest() : h_(gst_harness_new("pfaptextenc")), bus_(gst_bus_new()) {
-    gst_element_set_bus(h_->element, bus_);
+  PfapTextEncTest() : ElementHarness("pfaptextenc") {
     gst_harness_set_src_caps_str(h_, PFAP_MARKUP_CAPS);
-  }
-  ~PfapTextEncTest() override {
-    gst_harness_teardown(h_);
-    gst_bus_set_flushing(bus_, TRUE);  // its messages hold the element
-    gst_object_unref(bus_);
   }
 
   void push(GstBuffer* buffer) { ASSERT_EQ(gst_harness_push(h_, buffer), GST_FLOW_OK); }
@@ -112,17 +107,6 @@ class PfapTextEncTest : public ::testing::Test {
     return text;
   }
 
-  guint64 stat(const char* field) {
-    GstStructure* stats = nullptr;
-    g_object_get(h_->element, "stats", &stats, nullptr);
-    guint64 value = G_MAXUINT64;
-    EXPECT_TRUE(gst_structure_get_uint64(stats, field, &value)) << field;
-    gst_structure_free(stats);
-    return value;
-  }
-
-  GstHarness* h_;
-  GstBus* bus_;
 };
 
 TEST_F(PfapTextEncTest, OutputCapsAreUtf8Text) {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "element_harness.h"
 #include "pfap/packetizer.h"
 #include "pfap/payload.h"
 #include "pfap_buffers.h"
@@ -169,27 +170,16 @@ void start_stream(GstHarness* h, guint16 seqnum, GstClockTime pts = 0) {
 const Fap kJoy{69, 40, 2000, Curve::kSpline};
 const Fap kJaw{3, -500, 120, Curve::kLinear};
 
-class RtpPfapDepayTest : public ::testing::Test {
+class RtpPfapDepayTest : public ::testing::Test, public testing::ElementHarness {
  protected:
-  RtpPfapDepayTest() : h_(gst_harness_new("rtppfapdepay")) {}
-  ~RtpPfapDepayTest() override {
-    if (bus_) {
-      gst_bus_set_flushing(bus_, TRUE);  // its messages hold the element
-      gst_object_unref(bus_);
-    }
-    gst_harness_teardown(h_);
-  }
+  RtpPfapDepayTest() : ElementHarness("rtppfapdepay") {}
   void SetUp() override { gst_harness_set_src_caps_str(h_, kCaps); }
 
   // The element's messages, which the harness alone would drop.
-  GstBus* watch_bus() {
-    bus_ = gst_bus_new();
-    gst_element_set_bus(h_->element, bus_);
-    return bus_;
-  }
-
-  GstHarness* h_;
-  GstBus* bus_ = nullptr;
+  GstBus* watch_bus() { return bus_; }
+  // The tests' stat(h, field), which the fixture's own stat(field) would hide.
+  using ElementHarness::stat;
+  static guint64 stat(GstHarness* h, const char* field) { return pfap::stat(h, field); }
 };
 
 TEST_F(RtpPfapDepayTest, EachPhonemeBecomesABufferWithItsFapsAndTime) {

@@ -13,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "element_harness.h"
 #include "pfap/markup.h"
 #include "pfap/packetizer.h"
 #include "pfap/payload.h"
@@ -65,27 +66,15 @@ std::vector<Input> sentence(GstClockTime start, int count, uint16_t duration_ms,
   return inputs;
 }
 
-class Payloader {
+class Payloader : public pfap::testing::ElementHarness {
  public:
   // `downstream` restricts the caps the payloader may send (e.g. a clock-rate), as a
   // capsfilter after it would.
   explicit Payloader(const char* input_caps = PFAP_MARKUP_CAPS, const char* downstream = nullptr)
-      : h_(gst_harness_new("rtppfappay")), bus_(gst_bus_new()) {
-    gst_element_set_bus(h_->element, bus_);
+      : ElementHarness("rtppfappay") {
     if (downstream != nullptr) gst_harness_set_sink_caps_str(h_, downstream);
     gst_harness_set_src_caps_str(h_, input_caps);
   }
-  ~Payloader() {
-    gst_harness_teardown(h_);
-    gst_bus_set_flushing(bus_, TRUE);  // its messages hold the element
-    gst_object_unref(bus_);
-  }
-  Payloader(const Payloader&) = delete;
-  Payloader& operator=(const Payloader&) = delete;
-
-  GstHarness* harness() { return h_; }
-  GstElement* element() { return h_->element; }
-  GstBus* bus() { return bus_; }
 
   void push(GstBuffer* buffer) { ASSERT_EQ(gst_harness_push(h_, buffer), GST_FLOW_OK); }
   void push(const Input& in) {
@@ -133,15 +122,6 @@ class Payloader {
   // An event sent upstream into the payloader's src pad, as a downstream element would.
   bool push_upstream(GstEvent* event) { return gst_harness_push_upstream_event(h_, event); }
 
-  guint64 stat(const char* field) {
-    GstStructure* stats = nullptr;
-    g_object_get(h_->element, "stats", &stats, nullptr);
-    guint64 value = G_MAXUINT64;
-    EXPECT_TRUE(gst_structure_get_uint64(stats, field, &value)) << field;
-    gst_structure_free(stats);
-    return value;
-  }
-
   // The GError of the next warning posted, or nullptr (the caller frees it).
   GError* pop_warning() {
     GstMessage* message = gst_bus_pop_filtered(bus_, GST_MESSAGE_WARNING);
@@ -161,10 +141,6 @@ class Payloader {
     gst_caps_unref(caps);
     return result;
   }
-
- private:
-  GstHarness* h_;
-  GstBus* bus_;
 };
 
 // The phonemes of `packets` in order, each with its FAPs.
