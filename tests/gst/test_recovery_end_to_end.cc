@@ -48,6 +48,7 @@
 #include "pfap/model.h"
 #include "live_source.h"
 #include "pfap_buffers.h"
+#include "rtpbin_sessions.h"
 #include "pipeline.h"
 #include "speech_session.h"
 
@@ -137,6 +138,8 @@ using pfap::testing::fast_rtcp;
 using pfap::testing::Pipeline;
 using pfap::testing::plugin_available;
 using pfap::testing::push_live;
+using pfap::testing::rtpbin_receive_session;
+using pfap::testing::rtpbin_send_session;
 
 GstFlowReturn push(GstElement* appsrc, const Event& e) {
   return pfap::testing::push(appsrc, pfap::testing::phoneme_buffer(e));
@@ -231,24 +234,16 @@ TEST(RecoveryLoop, PliBringsACompleteStateAfterALongBurst) {
   record.drop_to = 17;
   std::atomic<int> force_key_units{0};
 
-  Pipeline receiver(std::string("rtpbin name=rtpbin rtp-profile=avpf "
-                                "udpsrc name=rtp address=127.0.0.1 port=0 caps=\"") +
-                    kReceiveCaps +
-                    "\" ! rtpbin.recv_rtp_sink_0 "
-                    "udpsrc name=rtcp address=127.0.0.1 port=0 ! rtpbin.recv_rtcp_sink_0 "
-                    "rtpbin.send_rtcp_src_0 ! udpsink name=rr host=127.0.0.1 sync=false "
-                    "async=false "
+  Pipeline receiver("rtpbin name=rtpbin rtp-profile=avpf " +
+                    rtpbin_receive_session(0, "", kReceiveCaps) +
                     "rtpbin. ! rtppfapdepay name=depay ! appsink name=sink sync=false "
                     "emit-signals=true");
   ASSERT_TRUE(receiver.ok()) << receiver.error();
-  Pipeline sender(
-      "rtpbin name=rtpbin rtp-profile=avpf "
-      "appsrc name=src is-live=true format=time caps=application/x-pfap "
-      "! rtppfappay name=pay pt=97 recovery-depth=1 complete-recovery-interval=0 "
-      "! rtpbin.send_rtp_sink_0 "
-      "rtpbin.send_rtp_src_0 ! udpsink name=rtp host=127.0.0.1 sync=false async=false "
-      "rtpbin.send_rtcp_src_0 ! udpsink name=rtcp host=127.0.0.1 sync=false async=false "
-      "udpsrc name=rr address=127.0.0.1 port=0 ! rtpbin.recv_rtcp_sink_0");
+  Pipeline sender("rtpbin name=rtpbin rtp-profile=avpf " +
+                  rtpbin_send_session(0, "",
+                                      "appsrc name=src is-live=true format=time "
+                                      "caps=application/x-pfap ! rtppfappay name=pay pt=97 "
+                                      "recovery-depth=1 complete-recovery-interval=0"));
   ASSERT_TRUE(sender.ok()) << sender.error();
 
   GstElement* receiver_rtpbin = receiver.by_name("rtpbin");
