@@ -88,15 +88,11 @@ GST_DEBUG_CATEGORY_STATIC(rtppfappay_debug);
 
 namespace {
 
-// Below rtpbin's default jitterbuffer latency of 200 ms, so a live receiver still gets each
-// phoneme in time to show it in lip sync with the audio.
-constexpr guint kDefaultMaxDelayMs = 100;
-// A burst of up to 4 lost packets (400 ms of speech in 100 ms packets) needs no complete
-// state, for 6 bytes per FAP still in effect in the 4 packets before.
-constexpr guint kDefaultRecoveryDepth = 4;
-// Late joiners of shared RTSP media on 1.22 have no request path (rtsp-server does not
-// necessarily pass on the PLI of a new joiner) and wait for the periodic packet.
-constexpr guint kDefaultCompleteIntervalMs = 1000;
+// The library's defaults (pfap/sender.h says why each).
+constexpr pfap::SenderConfig kDefaults{};
+constexpr guint kDefaultMaxDelayMs = kDefaults.max_delay_ns / pfap::kNsPerMs;
+constexpr guint kDefaultRecoveryDepth = kDefaults.recovery_depth;
+constexpr guint kDefaultCompleteIntervalMs = kDefaults.complete_interval_ns / pfap::kNsPerMs;
 
 enum { PROP_0, PROP_MAX_DELAY, PROP_RECOVERY_DEPTH, PROP_COMPLETE_RECOVERY_INTERVAL, PROP_STATS };
 
