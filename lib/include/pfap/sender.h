@@ -73,7 +73,8 @@ class Sender {
   void configure(const SenderConfig& config);
   const SenderConfig& config() const { return config_; }
 
-  // Adds a phoneme and the FAPs that start with it. The packets it finishes come from next().
+  // Adds a phoneme and the FAPs that start with it. The packets it finishes come from next(),
+  // which the caller calls until it returns nullptr before the next push or drain.
   void push(const TimedPhoneme& phoneme, std::span<const Fap> faps);
   // Finishes the pending packet: no later phoneme may join it (end of stream, a gap, new caps
   // or segment).
