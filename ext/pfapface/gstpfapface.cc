@@ -53,7 +53,9 @@
 #include "face/animator.h"
 #include "face/renderer.h"
 #include "pfap/phoneme_table.h"
-#include "pfapbuffer.h"
+#include "markupbuffer.h"
+#include "pfap/timeline.h"
+#include "warning.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapface_debug);
 #define GST_CAT_DEFAULT pfapface_debug
@@ -77,6 +79,8 @@ struct Stream {
   int64_t covered_until = -1;  // running time up to which a GAP said no markup comes
   bool warned_mouth = false;   // the warning for phonemes without a mouth shape was posted
   pfap::MarkupEvent event;     // reused, so that steady streaming does not allocate
+  pfap::EventTimeline timeline;  // the input events' running times
+  uint64_t malformed = 0;        // input buffers dropped, for the warning's rate limit
 };
 
 }  // namespace
@@ -132,6 +136,7 @@ GST_ELEMENT_REGISTER_DEFINE(pfapface, "pfapface", GST_RANK_NONE, GST_TYPE_PFAP_F
 static void reset(GstPfapFace* self) {
   Stream& s = *self->stream;
   s.animator.reset();
+  s.timeline.reset();
   s.frame = 0;
   s.covered_until = -1;
   s.warned_mouth = false;
@@ -156,20 +161,16 @@ static void apply_event(GstPfapFace* self, GstBuffer* buffer, int64_t at) {
   Stream& s = *self->stream;
   pfap::MarkupEvent& event = s.event;
   if (!pfap_buffer_read(buffer, event)) {
-    PFAP_WARN_MALFORMED_EVENT(self, buffer);
+    PFAP_WARN_MALFORMED_EVENT(self, buffer, ++s.malformed);
     return;
   }
-  // The animator takes an earlier time as its last one.
-  const int64_t last = s.animator.last_ns();
-  if (at < 0) {
-    at = last;
-  } else if (at < last) {
-    GST_ELEMENT_WARNING(self, STREAM, FORMAT,
-                        ("A PFAP event is earlier than the one before it; applied at that "
-                         "one's time."),
-                        ("running time %" GST_STIME_FORMAT " is before %" GST_STIME_FORMAT,
-                         GST_STIME_ARGS(at), GST_STIME_ARGS(last)));
+  if (at < 0) at = s.animator.last_ns();
+  if (s.timeline.earlier(at)) {
+    PFAP_WARN_EARLIER_EVENT(self, "applied", at, s.timeline.previous_ns(),
+                            s.timeline.earlier_count());
+    at = s.timeline.previous_ns();
   }
+  s.timeline.add(at, 0);
   if (!s.animator.apply(event, at) && !s.warned_mouth) {
     s.warned_mouth = true;
     GST_ELEMENT_WARNING(self, STREAM, FORMAT,

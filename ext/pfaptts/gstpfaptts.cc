@@ -43,7 +43,7 @@
 #include <vector>
 
 #include "pfap/markup.h"
-#include "pfapbuffer.h"
+#include "markupbuffer.h"
 #include "speech.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfaptts_debug);

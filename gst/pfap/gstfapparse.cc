@@ -60,7 +60,9 @@
 #include "pfap/fap_animation.h"
 #include "pfap/fap_file.h"
 #include "pfap/phoneme_table.h"
-#include "pfapbuffer.h"
+#include "markupbuffer.h"
+#include "ratelimit.h"
+#include "sparse.h"
 
 GST_DEBUG_CATEGORY_STATIC(fapparse_debug);
 #define GST_CAT_DEFAULT fapparse_debug

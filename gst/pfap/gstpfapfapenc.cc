@@ -45,7 +45,9 @@
 
 #include "pfap/fap_animation.h"
 #include "pfap/fap_file.h"
-#include "pfapbuffer.h"
+#include "markupbuffer.h"
+#include "ratelimit.h"
+#include "warning.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapfapenc_debug);
 #define GST_CAT_DEFAULT pfapfapenc_debug
@@ -99,7 +101,7 @@ static GstFlowReturn gst_pfap_fap_enc_chain(GstPad*, GstObject* parent, GstBuffe
   GstPfapFapEnc* self = GST_PFAP_FAP_ENC(parent);
   Stream& s = *self->stream;
   if (!pfap_buffer_read(buffer, s.event)) {
-    if (pfap_warn_at(++s.malformed)) PFAP_WARN_MALFORMED_EVENT(self, buffer);
+    PFAP_WARN_MALFORMED_EVENT(self, buffer, ++s.malformed);
     gst_buffer_unref(buffer);
     return GST_FLOW_OK;
   }

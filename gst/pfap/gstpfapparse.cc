@@ -46,7 +46,8 @@
 
 #include "pfap/model.h"
 #include "pfap/text.h"
-#include "pfapbuffer.h"
+#include "markupbuffer.h"
+#include "sparse.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapparse_debug);
 #define GST_CAT_DEFAULT pfapparse_debug

@@ -17,7 +17,9 @@
  * An event without a PTS starts where the previous one ended (a phoneme lasts its duration,
  * a state event none), the first one where the segment begins. An event earlier than the
  * one before it is written at that one's time, with a warning: the format wants times that
- * never go back. A malformed buffer is dropped with a warning and the stream goes on.
+ * never go back. A malformed buffer is dropped with a warning and the stream goes on. Both
+ * faults are counted in #GstPfapTextEnc:stats and warned about at their 1st, 2nd, 4th, 8th,
+ * ... occurrence, so that a stream of them does not flood the bus.
  *
  * The format has no flag for an event the receiver is unsure of (its FAP state may be
  * incomplete after a loss): such a line ends with the comment `# uncertain`, which readers
@@ -37,9 +39,11 @@
 #include <optional>
 #include <string>
 
+#include "markupbuffer.h"
 #include "pfap/model.h"
 #include "pfap/text.h"
-#include "pfapbuffer.h"
+#include "pfap/timeline.h"
+#include "warning.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfaptextenc_debug);
 #define GST_CAT_DEFAULT pfaptextenc_debug
@@ -53,8 +57,7 @@ struct Stream {
 
   GstSegment segment;
   std::optional<int64_t> origin_ns;  // the first event's running time: line time 0
-  int64_t last_ns = 0;               // the previous event's running time, once there is one
-  int64_t end_ns = 0;                // where the previous event ended
+  pfap::EventTimeline timeline;      // the events' running times
   // Reused for every buffer so that steady streaming does not allocate.
   pfap::TextEvent text;
   std::string line;
@@ -75,11 +78,20 @@ std::optional<int64_t> running_time(const GstSegment& segment, GstClockTime pts)
 
 }  // namespace
 
+enum { PROP_0, PROP_STATS };
+
+struct Stats {
+  guint64 events = 0;     // lines written
+  guint64 malformed = 0;  // input buffers dropped: not valid x-pfap events
+  guint64 earlier = 0;    // events earlier than the one before, written at that one's time
+};
+
 struct _GstPfapTextEnc {
   GstElement parent;
   GstPad* sinkpad;
   GstPad* srcpad;
   Stream* stream;
+  Stats stats;  // under the object lock: the property is read from any thread
 };
 
 static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
@@ -95,34 +107,27 @@ GST_ELEMENT_REGISTER_DEFINE(pfaptextenc, "pfaptextenc", GST_RANK_NONE, GST_TYPE_
 static void reset(GstPfapTextEnc* self) {
   gst_segment_init(&self->stream->segment, GST_FORMAT_TIME);
   self->stream->origin_ns.reset();
+  self->stream->timeline.reset();
 }
 
 // The line time of the event just read, whose buffer has `pts`.
 static int64_t line_time_ms(GstPfapTextEnc* self, GstClockTime pts) {
   Stream& s = *self->stream;
-  int64_t time = 0;
-  if (const std::optional<int64_t> t = running_time(s.segment, pts)) {
-    time = *t;
-  } else {
-    // Phonemes follow one another, so a source that leaves the PTS out means the previous
-    // event's end; a first event is where the segment begins, whose running time is base.
-    time = s.origin_ns ? s.end_ns : static_cast<int64_t>(s.segment.base);
-  }
-  if (!s.origin_ns) {
-    s.origin_ns = time;
-  } else if (time < s.last_ns) {
-    GST_ELEMENT_WARNING(self, STREAM, FORMAT,
-                        ("A PFAP event is earlier than the one before it; written at that "
-                         "one's time."),
-                        ("PTS %" GST_TIME_FORMAT ", running time %" GST_STIME_FORMAT
-                         " is before %" GST_STIME_FORMAT,
-                         GST_TIME_ARGS(pts), GST_STIME_ARGS(time), GST_STIME_ARGS(s.last_ns)));
-    time = s.last_ns;
+  // A first event without a PTS is where the segment begins, whose running time is base.
+  int64_t time =
+      s.timeline.start(running_time(s.segment, pts), static_cast<int64_t>(s.segment.base));
+  if (!s.origin_ns) s.origin_ns = time;
+  if (s.timeline.earlier(time)) {
+    const guint64 count = s.timeline.earlier_count();
+    GST_OBJECT_LOCK(self);
+    self->stats.earlier = count;
+    GST_OBJECT_UNLOCK(self);
+    PFAP_WARN_EARLIER_EVENT(self, "written", time, s.timeline.previous_ns(), count);
+    time = s.timeline.previous_ns();
   }
   const pfap::MarkupEvent& event = s.text.event;
-  s.last_ns = time;
-  s.end_ns =
-      time + (event.kind == PFAP_EVENT_PHONEME ? event.phoneme.duration_ms * pfap::kNsPerMs : 0);
+  s.timeline.add(time,
+                 event.kind == PFAP_EVENT_PHONEME ? event.phoneme.duration_ms * pfap::kNsPerMs : 0);
   return (time - *s.origin_ns + pfap::kNsPerMs / 2) / pfap::kNsPerMs;
 }
 
@@ -130,7 +135,10 @@ static GstFlowReturn gst_pfap_text_enc_chain(GstPad*, GstObject* parent, GstBuff
   GstPfapTextEnc* self = GST_PFAP_TEXT_ENC(parent);
   Stream& s = *self->stream;
   if (!pfap_buffer_read(buffer, s.text.event)) {
-    PFAP_WARN_MALFORMED_EVENT(self, buffer);
+    GST_OBJECT_LOCK(self);
+    const guint64 malformed = ++self->stats.malformed;
+    GST_OBJECT_UNLOCK(self);
+    PFAP_WARN_MALFORMED_EVENT(self, buffer, malformed);
     gst_buffer_unref(buffer);
     return GST_FLOW_OK;
   }
@@ -140,6 +148,9 @@ static GstFlowReturn gst_pfap_text_enc_chain(GstPad*, GstObject* parent, GstBuff
   pfap::format_text_line(s.text, s.line);
   // The format has no flag for it; a comment tells the reader and pfapparse skips it.
   if (s.text.event.uncertain) s.line += " # uncertain";
+  GST_OBJECT_LOCK(self);
+  self->stats.events++;
+  GST_OBJECT_UNLOCK(self);
   GST_LOG_OBJECT(self, "%s", s.line.c_str());
   s.line += '\n';
 
@@ -184,9 +195,37 @@ static gboolean gst_pfap_text_enc_sink_event(GstPad* pad, GstObject* parent, Gst
   return gst_pad_event_default(pad, parent, event);
 }
 
+static void gst_pfap_text_enc_get_property(GObject* object, guint prop_id, GValue* value,
+                                           GParamSpec* pspec) {
+  GstPfapTextEnc* self = GST_PFAP_TEXT_ENC(object);
+  switch (prop_id) {
+    case PROP_STATS: {
+      GST_OBJECT_LOCK(self);
+      const Stats s = self->stats;
+      GST_OBJECT_UNLOCK(self);
+      g_value_take_boxed(value, gst_structure_new("application/x-pfap-text-enc-stats", "events",
+                                                  G_TYPE_UINT64, s.events, "malformed",
+                                                  G_TYPE_UINT64, s.malformed, "earlier",
+                                                  G_TYPE_UINT64, s.earlier, nullptr));
+      break;
+    }
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
+}
+
 static GstStateChangeReturn gst_pfap_text_enc_change_state(GstElement* element,
                                                            GstStateChange transition) {
-  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) reset(GST_PFAP_TEXT_ENC(element));
+  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) {
+    GstPfapTextEnc* self = GST_PFAP_TEXT_ENC(element);
+    reset(self);
+    // The counters start again, as the other elements' do; earlier_count is the timeline's.
+    self->stream->timeline = pfap::EventTimeline{};
+    GST_OBJECT_LOCK(self);
+    self->stats = {};
+    GST_OBJECT_UNLOCK(self);
+  }
   return GST_ELEMENT_CLASS(gst_pfap_text_enc_parent_class)->change_state(element, transition);
 }
 
@@ -202,6 +241,26 @@ static void gst_pfap_text_enc_class_init(GstPfapTextEncClass* klass) {
   GST_DEBUG_CATEGORY_INIT(pfaptextenc_debug, "pfaptextenc", 0, "PFAP text writer");
 
   gobject_class->finalize = gst_pfap_text_enc_finalize;
+  gobject_class->get_property = gst_pfap_text_enc_get_property;
+
+  /**
+   * GstPfapTextEnc:stats:
+   *
+   * Counters since the element last went from READY to PAUSED (a flush keeps them), all
+   * guint64, in an application/x-pfap-text-enc-stats structure:
+   *
+   * - events: lines written
+   * - malformed: input buffers dropped because they are not valid x-pfap events
+   * - earlier: events earlier than the one before them, written at that one's time
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_STATS,
+      g_param_spec_boxed("stats", "Statistics",
+                         "Counters since READY to PAUSED (guint64): events (lines written), "
+                         "malformed (input buffers dropped), earlier (events earlier than the "
+                         "one before, written at its time)",
+                         GST_TYPE_STRUCTURE,
+                         static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
 
   gst_element_class_add_static_pad_template(element_class, &sink_template);
   gst_element_class_add_static_pad_template(element_class, &src_template);
@@ -216,6 +275,7 @@ static void gst_pfap_text_enc_class_init(GstPfapTextEncClass* klass) {
 
 static void gst_pfap_text_enc_init(GstPfapTextEnc* self) {
   self->stream = new Stream{};
+  self->stats = {};
   self->sinkpad = gst_pad_new_from_static_template(&sink_template, "sink");
   gst_pad_set_chain_function(self->sinkpad, gst_pfap_text_enc_chain);
   gst_pad_set_event_function(self->sinkpad, gst_pfap_text_enc_sink_event);

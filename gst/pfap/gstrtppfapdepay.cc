@@ -62,14 +62,14 @@
 #include <array>
 #include <cstdint>
 #include <iterator>
-#include <memory>
-#include <new>
 #include <optional>
 #include <span>
 
 #include "pfap/payload.h"
 #include "pfap/recovery.h"
-#include "pfapbuffer.h"
+#include "markupbuffer.h"
+#include "ratelimit.h"
+#include "sparse.h"
 
 GST_DEBUG_CATEGORY_STATIC(rtp_pfap_depay_debug);
 #define GST_CAT_DEFAULT rtp_pfap_depay_debug
@@ -124,16 +124,20 @@ struct Stats {
   guint64 packet_lost_events = 0;
 };
 
-}  // namespace
-
-struct _GstRtpPfapDepay {
-  GstRTPBaseDepayload parent;
-
-  // C++ members: constructed in init, destroyed in finalize.
+// What the streaming thread keeps between packets. GObject runs no C++ constructors, so it
+// lives behind a pointer made in init and deleted in finalize.
+struct Stream {
   pfap::Packet packet;      // reused, so decoding stops allocating
   pfap::MarkupEvent event;  // one output event, reused
   pfap::RecoveryReceiver receiver;
   std::optional<guint32> ssrc;  // the stream's; none until a good packet starts one
+};
+
+}  // namespace
+
+struct _GstRtpPfapDepay {
+  GstRTPBaseDepayload parent;
+  Stream* stream;
   // Under the object lock: the stats property is read from any thread.
   Stats stats;
   // A gboolean, atomic: the property may be set from any thread.
@@ -165,7 +169,7 @@ static void update_stats(GstRtpPfapDepay* self, Update&& update) {
 
 // Forgets the stream (FLUSH_STOP, READY to PAUSED): the next good packet starts a new one,
 // as a new SSRC does. The stats are counters and outlive a flush.
-static void reset(GstRtpPfapDepay* self) { self->ssrc.reset(); }
+static void reset(GstRtpPfapDepay* self) { self->stream->ssrc.reset(); }
 
 static gboolean gst_rtp_pfap_depay_set_caps(GstRTPBaseDepayload* depay, GstCaps* caps) {
   const GstStructure* s = gst_caps_get_structure(caps, 0);
@@ -240,7 +244,7 @@ static void drop_malformed(GstRtpPfapDepay* self, pfap::DecodeResult result, gui
 static bool fits_x_pfap(GstRtpPfapDepay* self, guint16 seqnum, std::span<const uint8_t> payload) {
   // Every FAP takes a descriptor on the wire: a smaller payload cannot hold too many.
   if (payload.size() < (G_MAXUINT16 + 1) * pfap::kFapDescriptorBytes) return true;
-  const pfap::Packet& packet = self->packet;
+  const pfap::Packet& packet = self->stream->packet;
   size_t most = packet.recovery.size();
   for (size_t i = 0; i < packet.phonemes.size(); ++i) {
     most = std::max(most, packet.faps_of(i).size());
@@ -254,10 +258,10 @@ static bool fits_x_pfap(GstRtpPfapDepay* self, guint16 seqnum, std::span<const u
   return false;
 }
 
-// self->event as a buffer. It always fits: fits_x_pfap checked the counts and the decoder
+// The output event as a buffer. It always fits: fits_x_pfap checked the counts and the decoder
 // every value.
 static GstBuffer* event_buffer(GstRtpPfapDepay* self, GstClockTime pts, GstClockTime duration) {
-  GstBuffer* buffer = pfap_buffer_new(self->event);
+  GstBuffer* buffer = pfap_buffer_new(self->stream->event);
   g_assert(buffer);
   GST_BUFFER_PTS(buffer) = pts;
   GST_BUFFER_DURATION(buffer) = duration;
@@ -267,22 +271,22 @@ static GstBuffer* event_buffer(GstRtpPfapDepay* self, GstClockTime pts, GstClock
 // The decoded packet's recovery entries as a recovered or complete event at `pts`.
 static GstBuffer* state_buffer(GstRtpPfapDepay* self, PfapEventKind kind, bool uncertain,
                                GstClockTime pts) {
-  pfap::MarkupEvent& event = self->event;
+  pfap::MarkupEvent& event = self->stream->event;
   event.kind = kind;
   event.phoneme = {};
   event.sentence_start = false;
   event.uncertain = uncertain;
-  event.faps = self->packet.recovery;
+  event.faps = self->stream->packet.recovery;
   return event_buffer(self, pts, GST_CLOCK_TIME_NONE);
 }
 
 // Phoneme i of the decoded packet, starting at `pts`.
 static GstBuffer* phoneme_buffer(GstRtpPfapDepay* self, size_t i, bool sentence_start,
                                  bool uncertain, GstClockTime pts) {
-  const std::span<const pfap::Fap> faps = self->packet.faps_of(i);
-  pfap::MarkupEvent& event = self->event;
+  const std::span<const pfap::Fap> faps = self->stream->packet.faps_of(i);
+  pfap::MarkupEvent& event = self->stream->event;
   event.kind = PFAP_EVENT_PHONEME;
-  event.phoneme = self->packet.phonemes[i].phoneme;
+  event.phoneme = self->stream->packet.phonemes[i].phoneme;
   event.sentence_start = sentence_start;
   event.uncertain = uncertain;
   event.faps.assign(faps.begin(), faps.end());
@@ -305,7 +309,7 @@ static GstBuffer* gst_rtp_pfap_depay_process_rtp_packet(GstRTPBaseDepayload* dep
   const std::span<const uint8_t> payload(
       static_cast<const uint8_t*>(gst_rtp_buffer_get_payload(rtp)),
       gst_rtp_buffer_get_payload_len(rtp));
-  const pfap::DecodeResult result = pfap::decode_payload(payload, self->packet);
+  const pfap::DecodeResult result = pfap::decode_payload(payload, self->stream->packet);
   update_stats(self, [](Stats& s) { ++s.packets; });
   if (!result.ok()) {
     drop_malformed(self, result, seqnum);
@@ -316,16 +320,19 @@ static GstBuffer* gst_rtp_pfap_depay_process_rtp_packet(GstRTPBaseDepayload* dep
   // A new SSRC is a new sender, or one restarted: its sequence numbers and FAP state owe
   // nothing to the last one's.
   const guint32 ssrc = gst_rtp_buffer_get_ssrc(rtp);
-  if (self->ssrc != ssrc) {
+  if (self->stream->ssrc != ssrc) {
     GST_DEBUG_OBJECT(self, "new stream, SSRC %08x", ssrc);
-    self->receiver.reset(/*joined_mid_stream=*/true);
-    self->ssrc = ssrc;
+    self->stream->receiver.reset(/*joined_mid_stream=*/true);
+    self->stream->ssrc = ssrc;
   }
-  const pfap::Packet& packet = self->packet;
+  const pfap::Packet& packet = self->stream->packet;
   // The base class derives no time from the RTP timestamp: the PTS comes from upstream
   // (rtpjitterbuffer), and DISCONT after a gap is set on our first buffer by the base class.
-  const GstClockTime packet_pts = GST_BUFFER_PTS(rtp->buffer);
-  const pfap::ReceiveResult r = self->receiver.receive(
+  // A source that gives only a DTS (pcapparse) means the packet's time by it.
+  const GstClockTime packet_pts = GST_BUFFER_PTS_IS_VALID(rtp->buffer)
+                                      ? GST_BUFFER_PTS(rtp->buffer)
+                                      : GST_BUFFER_DTS(rtp->buffer);
+  const pfap::ReceiveResult r = self->stream->receiver.receive(
       packet, seqnum, GST_CLOCK_TIME_IS_VALID(packet_pts) ? static_cast<int64_t>(packet_pts) : 0);
   const bool uncertain = !r.state_whole;
 
@@ -352,15 +359,12 @@ static GstBuffer* gst_rtp_pfap_depay_process_rtp_packet(GstRTPBaseDepayload* dep
     output(state_buffer(self, recovered ? PFAP_EVENT_RECOVERED : PFAP_EVENT_COMPLETE, uncertain,
                         packet_pts));
   }
-  GstClockTime offset = 0;
-  for (size_t i = 0; i < packet.phonemes.size(); ++i) {
-    const bool sentence_start = i == 0 && gst_rtp_buffer_get_marker(rtp);
+  const bool marker = gst_rtp_buffer_get_marker(rtp);
+  packet.for_each_phoneme(0, [&](size_t i, int64_t offset_ns) {
     const GstClockTime pts =
-        GST_CLOCK_TIME_IS_VALID(packet_pts) ? packet_pts + offset : GST_CLOCK_TIME_NONE;
-    GstBuffer* buffer = phoneme_buffer(self, i, sentence_start, uncertain, pts);
-    offset += GST_BUFFER_DURATION(buffer);
-    output(buffer);
-  }
+        GST_CLOCK_TIME_IS_VALID(packet_pts) ? packet_pts + offset_ns : GST_CLOCK_TIME_NONE;
+    output(phoneme_buffer(self, i, i == 0 && marker, uncertain, pts));
+  });
   update_stats(self, [&](Stats& s) {
     s.phonemes += packet.phonemes.size();
     s.faps += packet.faps.size();
@@ -394,7 +398,7 @@ static gboolean gst_rtp_pfap_depay_packet_lost(GstRTPBaseDepayload* depay, GstEv
   update_stats(self, [](Stats& s) { ++s.packet_lost_events; });
   if (!gst_structure_has_field(gst_event_get_structure(event), "seqnum")) {
     GST_DEBUG_OBJECT(self, "packet lost without a sequence number: state uncertain");
-    self->receiver.lost_unknown();
+    self->stream->receiver.lost_unknown();
   }
   return GST_RTP_BASE_DEPAYLOAD_CLASS(gst_rtp_pfap_depay_parent_class)->packet_lost(depay, event);
 }
@@ -462,19 +466,13 @@ static void gst_rtp_pfap_depay_init(GstRtpPfapDepay* self) {
   // with a bare not-negotiated. A source that fixates against the template, like udpsrc,
   // gets clock-rate=1 instead, before we can say anything.
   GST_PAD_SET_ACCEPT_INTERSECT(GST_RTP_BASE_DEPAYLOAD_SINKPAD(self));
-  new (&self->packet) pfap::Packet();
-  new (&self->event) pfap::MarkupEvent();
-  new (&self->receiver) pfap::RecoveryReceiver();
-  new (&self->ssrc) std::optional<guint32>();
-  new (&self->stats) Stats();
+  self->stream = new Stream{};
+  self->stats = {};
   self->request_recovery = kDefaultRequestRecovery;
 }
 
 static void gst_rtp_pfap_depay_finalize(GObject* object) {
-  GstRtpPfapDepay* self = GST_RTP_PFAP_DEPAY(object);
-  std::destroy_at(&self->packet);
-  std::destroy_at(&self->event);
-  std::destroy_at(&self->receiver);
+  delete GST_RTP_PFAP_DEPAY(object)->stream;
   G_OBJECT_CLASS(gst_rtp_pfap_depay_parent_class)->finalize(object);
 }
 

@@ -7,6 +7,9 @@
  * draft-ietf-avt-rtp-pfap-00 defines them. Each application/x-pfap input buffer is one
  * phoneme and the FAPs (bookmarks) that start with it; its PTS is the phoneme's start.
  *
+ * The element is glue around the library's pfap::Sender, which turns phonemes into packets
+ * and decides when a complete state is due; its rules are these.
+ *
  * How phonemes are grouped is the library's pfap::Packetizer: a packet starts at each
  * sentence start (the RTP M bit marks it), ends at end of text (sent at once, without
  * waiting for more input), holds only phonemes contiguous in time, stays within the
@@ -34,6 +37,9 @@
  *   FLUSH) starts with one, so that a receiver knows from the start that its state is whole,
  *   even without RTCP; one goes before a data packet each
  *   #GstRtpPfapPay:complete-recovery-interval of stream time; and one answers a request.
+ *   The interval counts stream time that moves forward: input whose timestamps go back
+ *   (a new segment, a confused source) gets no extra complete packet for it, so there is
+ *   never more than one per interval of speech sent plus one per request.
  * - A request is an upstream GstForceKeyUnit event on the src pad: what rtpbin's session
  *   sends when a receiver sends RTCP PLI or FIR for our SSRC, and what an application can
  *   send. If the stream is idle the packet goes out at once, with the state at the end of
@@ -48,7 +54,9 @@
  *   later.
  *
  * A complete-recovery packet has PTS = the time whose state it holds, M = 0 and no
- * duration. #GstRtpPfapPay:stats counts packets and requests.
+ * duration. #GstRtpPfapPay:stats counts packets, requests and faults. A fault that repeats
+ * (an oversized phoneme, a malformed buffer, a complete state over the MTU) is warned about
+ * at its 1st, 2nd, 4th, 8th, ... occurrence.
  *
  * The RTP clock rate is the one downstream asks for (e.g. a capsfilter with
  * `application/x-rtp,clock-rate=90000`), else the draft's 44100 Hz. The sink caps' `alphabet`
@@ -68,27 +76,23 @@
 #include <cstdint>
 #include <iterator>
 #include <optional>
-#include <vector>
 
-#include "pfap/packetizer.h"
+#include "markupbuffer.h"
 #include "pfap/payload.h"
-#include "pfap/recovery.h"
-#include "pfapbuffer.h"
+#include "pfap/sender.h"
+#include "pfap/timeline.h"
+#include "warning.h"
 
 GST_DEBUG_CATEGORY_STATIC(rtppfappay_debug);
 #define GST_CAT_DEFAULT rtppfappay_debug
 
 namespace {
 
-// Below rtpbin's default jitterbuffer latency of 200 ms, so a live receiver still gets each
-// phoneme in time to show it in lip sync with the audio.
-constexpr guint kDefaultMaxDelayMs = 100;
-// A burst of up to 4 lost packets (400 ms of speech in 100 ms packets) needs no complete
-// state, for 6 bytes per FAP still in effect in the 4 packets before.
-constexpr guint kDefaultRecoveryDepth = 4;
-// Late joiners of shared RTSP media on 1.22 have no request path (rtsp-server does not
-// necessarily pass on the PLI of a new joiner) and wait for the periodic packet.
-constexpr guint kDefaultCompleteIntervalMs = 1000;
+// The library's defaults (pfap/sender.h says why each).
+constexpr pfap::SenderConfig kDefaults{};
+constexpr guint kDefaultMaxDelayMs = kDefaults.max_delay_ns / pfap::kNsPerMs;
+constexpr guint kDefaultRecoveryDepth = kDefaults.recovery_depth;
+constexpr guint kDefaultCompleteIntervalMs = kDefaults.complete_interval_ns / pfap::kNsPerMs;
 
 enum { PROP_0, PROP_MAX_DELAY, PROP_RECOVERY_DEPTH, PROP_COMPLETE_RECOVERY_INTERVAL, PROP_STATS };
 
@@ -99,26 +103,18 @@ struct Stats {
   guint64 requests = 0;
   guint64 requests_served = 0;     // complete packets that answered at least one request
   guint64 complete_too_large = 0;  // complete states not sent: larger than the MTU allows
+  guint64 oversized = 0;           // data packets over the MTU: one phoneme's FAPs alone
+  guint64 malformed = 0;           // input buffers dropped: not valid x-pfap events
 };
 
 // What the streaming thread keeps between buffers, under the sink pad's stream lock (the
 // src event handler sends requested packets under it too). GObject runs no C++
 // constructors, so it lives behind a pointer made in init and deleted in finalize.
 struct Stream {
-  pfap::Packetizer packetizer{pfap::PacketizerConfig{}};
-  uint32_t clock_rate = pfap::kDefaultClockRate;
-  GstClockTime next_start = GST_CLOCK_TIME_NONE;    // where a phoneme without PTS starts
-  unsigned recovery_depth = kDefaultRecoveryDepth;  // the sender's
-  pfap::RecoverySender sender{kDefaultRecoveryDepth};
-  // The end of the last data packet sent (start + duration): where the stream is now. None
-  // until the stream's first data packet, which a complete packet must precede.
-  std::optional<int64_t> position;
-  int64_t last_complete_ns = 0;  // the time of the last complete packet, once position is set
+  pfap::Sender sender;
+  pfap::EventTimeline timeline;  // where a phoneme without PTS starts
   bool pushing = false;          // inside a push: a request from this thread must wait
-  // Reused for every buffer so that steady streaming does not allocate.
-  pfap::MarkupEvent event;
-  std::vector<pfap::PlannedPacket> planned;
-  pfap::Packet complete;
+  pfap::MarkupEvent event;       // reused for every buffer so that streaming does not allocate
 };
 
 }  // namespace
@@ -175,47 +171,35 @@ static GstStaticPadTemplate src_template = GST_STATIC_PAD_TEMPLATE(
 G_DEFINE_TYPE(GstRtpPfapPay, gst_rtp_pfap_pay, GST_TYPE_RTP_BASE_PAYLOAD)
 GST_ELEMENT_REGISTER_DEFINE(rtppfappay, "rtppfappay", GST_RANK_NONE, GST_TYPE_RTP_PFAP_PAY)
 
-// Forgets the pending packet, the stream position and what was sent: the next data packet
-// starts a new stream, after a complete packet (state changes, FLUSH). Under the stream
-// lock, which the streaming thread already holds at FLUSH_STOP, because a request may send
-// from another thread.
+template <typename Update>
+static void update_stats(GstRtpPfapPay* self, Update&& update) {
+  GST_OBJECT_LOCK(self);
+  update(self->stats);
+  GST_OBJECT_UNLOCK(self);
+}
+
+// Forgets the stream: the next data packet starts a new one, after a complete packet (state
+// changes, FLUSH). Under the stream lock, which the streaming thread already holds at
+// FLUSH_STOP, because a request may send from another thread.
 static void reset(GstRtpPfapPay* self) {
   GstPad* sinkpad = GST_RTP_BASE_PAYLOAD_SINKPAD(self);
   GST_PAD_STREAM_LOCK(sinkpad);
-  Stream& stream = *self->stream;
-  stream.packetizer.reset();
-  stream.next_start = GST_CLOCK_TIME_NONE;
-  stream.sender.reset();
-  stream.position.reset();
+  self->stream->sender.reset();
+  self->stream->timeline.reset();
   GST_PAD_STREAM_UNLOCK(sinkpad);
 }
 
-static pfap::PacketizerConfig current_config(GstRtpPfapPay* self) {
-  pfap::PacketizerConfig config;
+// The properties and the MTU as the sender's settings; it puts each into effect when it may.
+static pfap::SenderConfig current_config(GstRtpPfapPay* self) {
+  pfap::SenderConfig config;
   config.max_payload_size =
       gst_rtp_buffer_calc_payload_len(GST_RTP_BASE_PAYLOAD_MTU(GST_RTP_BASE_PAYLOAD(self)), 0, 0);
   GST_OBJECT_LOCK(self);
   config.max_delay_ns = int64_t{self->max_delay_ms} * pfap::kNsPerMs;
+  config.recovery_depth = self->recovery_depth;
+  config.complete_interval_ns = int64_t{self->complete_interval_ms} * pfap::kNsPerMs;
   GST_OBJECT_UNLOCK(self);
-  config.clock_rate = self->stream->clock_rate;
   return config;
-}
-
-// Puts mtu, max-delay and clock rate changes into effect. Only between packets: a packet
-// keeps the limits it was started with.
-static void update_config(GstRtpPfapPay* self) {
-  pfap::Packetizer& packetizer = self->stream->packetizer;
-  if (packetizer.has_pending()) return;
-  const pfap::PacketizerConfig config = current_config(self);
-  const pfap::PacketizerConfig& old = packetizer.config();
-  if (config.max_payload_size != old.max_payload_size || config.max_delay_ns != old.max_delay_ns ||
-      config.clock_rate != old.clock_rate) {
-    GST_DEBUG_OBJECT(
-        self,
-        "max payload %" G_GSIZE_FORMAT " bytes, max delay %" GST_TIME_FORMAT ", clock rate %u",
-        config.max_payload_size, GST_TIME_ARGS(config.max_delay_ns), config.clock_rate);
-    packetizer = pfap::Packetizer(config);
-  }
 }
 
 // An RTP buffer with `packet` as its payload, or nullptr (with an error posted) if it cannot
@@ -240,7 +224,71 @@ static GstBuffer* make_buffer(GstRtpPfapPay* self, const pfap::Packet& packet, b
   return buffer;
 }
 
-static GstFlowReturn push_buffer(GstRtpPfapPay* self, GstBuffer* buffer) {
+// Counts `out` and warns about what is wrong with it (rate-limited: the same fault may come
+// with every phoneme or every interval).
+static void account(GstRtpPfapPay* self, const pfap::OutgoingPacket& out, bool requested) {
+  using Kind = pfap::OutgoingPacket::Kind;
+  guint64 faults = 0;
+  update_stats(self, [&](Stats& s) {
+    switch (out.kind) {
+      case Kind::kData:
+        s.packets++;
+        s.recovery_entries += out.packet->recovery.size();
+        if (out.oversized) faults = ++s.oversized;
+        break;
+      case Kind::kComplete:
+        s.complete_recoveries++;
+        s.requests_served += requested;
+        break;
+      case Kind::kCompleteTooLarge:
+        faults = ++s.complete_too_large;
+        break;
+    }
+  });
+  if (!pfap_warn_at(faults)) return;
+  const guint mtu = GST_RTP_BASE_PAYLOAD_MTU(GST_RTP_BASE_PAYLOAD(self));
+  if (out.kind == Kind::kData) {
+    GST_ELEMENT_WARNING(self, STREAM, ENCODE, ("A phoneme and its FAPs do not fit in the MTU."),
+                        ("sending a %" G_GSIZE_FORMAT "-byte payload at %" GST_TIME_FORMAT
+                         "; mtu %u leaves room for %" G_GSIZE_FORMAT " bytes (%" G_GUINT64_FORMAT
+                         " times so far, warned at the 1st, 2nd, 4th, 8th, ...)",
+                         pfap::encoded_size(*out.packet), GST_TIME_ARGS(out.pts_ns), mtu,
+                         out.max_payload_size, faults));
+  } else {
+    GST_ELEMENT_WARNING(
+        self, STREAM, ENCODE, ("The complete FAP state does not fit in the MTU."),
+        ("%" G_GSIZE_FORMAT " non-zero FAPs at %" GST_TIME_FORMAT " need %" G_GSIZE_FORMAT
+         " bytes, mtu %u leaves %" G_GSIZE_FORMAT "; not sent (%" G_GUINT64_FORMAT
+         " times so far, warned at the 1st, 2nd, 4th, 8th, ...)",
+         out.packet->recovery.size(), GST_TIME_ARGS(out.pts_ns), pfap::encoded_size(*out.packet),
+         mtu, out.max_payload_size, faults));
+  }
+}
+
+// Sends `out` (a complete state too large for the MTU is only counted). A complete packet
+// answers every request made before it.
+static GstFlowReturn push_packet(GstRtpPfapPay* self, const pfap::OutgoingPacket& out) {
+  using Kind = pfap::OutgoingPacket::Kind;
+  bool requested = false;
+  if (out.kind != Kind::kData) {
+    GST_OBJECT_LOCK(self);
+    requested = self->complete_requested;
+    self->complete_requested = false;
+    GST_OBJECT_UNLOCK(self);
+  }
+  account(self, out, requested);
+  if (out.kind == Kind::kCompleteTooLarge) return GST_FLOW_OK;
+  GstBuffer* buffer = make_buffer(self, *out.packet, out.marker);
+  if (buffer == nullptr) return GST_FLOW_ERROR;
+  // The base class makes the RTP timestamp from the PTS.
+  GST_BUFFER_PTS(buffer) = out.pts_ns;
+  GST_BUFFER_DURATION(buffer) = out.duration_ns;
+  GST_LOG_OBJECT(self,
+                 "%s packet at %" GST_TIME_FORMAT ": %" G_GSIZE_FORMAT " phonemes, %" G_GSIZE_FORMAT
+                 " bytes, M=%d, %" G_GSIZE_FORMAT " recovery entries",
+                 out.kind == Kind::kData ? "data" : "complete-recovery", GST_TIME_ARGS(out.pts_ns),
+                 out.packet->phonemes.size(), gst_buffer_get_size(buffer), out.marker,
+                 out.packet->recovery.size());
   Stream& stream = *self->stream;
   stream.pushing = true;
   const GstFlowReturn ret = gst_rtp_base_payload_push(GST_RTP_BASE_PAYLOAD(self), buffer);
@@ -248,131 +296,21 @@ static GstFlowReturn push_buffer(GstRtpPfapPay* self, GstBuffer* buffer) {
   return ret;
 }
 
-// Sends the FAP state at `time_ns` as a complete-recovery packet; it answers every request
-// made before. A state too large for the MTU is not sent at all, since a receiver takes
-// every FAP it leaves out for 0; it counts as sent for the interval, so that the warning
-// and the attempt come at most once per interval or request.
-static GstFlowReturn push_complete(GstRtpPfapPay* self, int64_t time_ns) {
-  Stream& stream = *self->stream;
-  GST_OBJECT_LOCK(self);
-  const bool requested = self->complete_requested;
-  self->complete_requested = false;
-  GST_OBJECT_UNLOCK(self);
-  const size_t max_size = stream.packetizer.config().max_payload_size;
-  if (!stream.sender.make_complete(stream.complete, time_ns, max_size)) {
-    stream.last_complete_ns = time_ns;
-    GST_OBJECT_LOCK(self);
-    const guint64 too_large = ++self->stats.complete_too_large;
-    GST_OBJECT_UNLOCK(self);
-    // A state that stays too large must not flood the bus.
-    if (pfap_warn_at(too_large)) {
-      GST_ELEMENT_WARNING(
-          self, STREAM, ENCODE, ("The complete FAP state does not fit in the MTU."),
-          ("%" G_GSIZE_FORMAT " non-zero FAPs at %" GST_TIME_FORMAT " need %" G_GSIZE_FORMAT
-           " bytes, mtu %u leaves %" G_GSIZE_FORMAT "; not sent (%" G_GUINT64_FORMAT
-           " times so far, warned at the 1st, 2nd, 4th, 8th, ...)",
-           stream.complete.recovery.size(), GST_TIME_ARGS(time_ns),
-           pfap::encoded_size(stream.complete),
-           GST_RTP_BASE_PAYLOAD_MTU(GST_RTP_BASE_PAYLOAD(self)), max_size, too_large));
-    }
-    return GST_FLOW_OK;
-  }
-  GstBuffer* buffer = make_buffer(self, stream.complete, false);
-  if (buffer == nullptr) return GST_FLOW_ERROR;
-  GST_BUFFER_PTS(buffer) = time_ns;
-  GST_BUFFER_DURATION(buffer) = 0;
-  GST_LOG_OBJECT(self, "complete recovery of %" G_GSIZE_FORMAT " FAPs at %" GST_TIME_FORMAT,
-                 stream.complete.recovery.size(), GST_TIME_ARGS(time_ns));
-  const GstFlowReturn ret = push_buffer(self, buffer);
-  // The packet took a sequence number whatever downstream did with it: it counts.
-  stream.sender.sent(stream.complete, time_ns);
-  stream.last_complete_ns = time_ns;
-  GST_OBJECT_LOCK(self);
-  self->stats.complete_recoveries++;
-  if (requested) self->stats.requests_served++;
-  GST_OBJECT_UNLOCK(self);
-  return ret;
-}
-
-// Whether a complete packet must go before a data packet starting at `start_ns`: the
-// stream's first, a request, or the interval since the last one is over.
-static bool complete_due(GstRtpPfapPay* self, int64_t start_ns) {
-  const Stream& stream = *self->stream;
-  if (!stream.position) return true;
-  GST_OBJECT_LOCK(self);
-  const bool requested = self->complete_requested;
-  const int64_t interval_ns = int64_t{self->complete_interval_ms} * pfap::kNsPerMs;
-  GST_OBJECT_UNLOCK(self);
-  // Stream time that goes back (a new segment) would otherwise hold the next one back.
-  const int64_t since = start_ns - stream.last_complete_ns;
-  return requested || (interval_ns > 0 && (since < 0 || since >= interval_ns));
-}
-
-// Puts a recovery-depth change into effect before the next data packet; the sender keeps
-// the FAP state and never claims coverage of packets it no longer holds.
-static void update_recovery_depth(GstRtpPfapPay* self) {
-  Stream& stream = *self->stream;
-  GST_OBJECT_LOCK(self);
-  const unsigned depth = self->recovery_depth;
-  GST_OBJECT_UNLOCK(self);
-  if (depth == stream.recovery_depth) return;
-  GST_DEBUG_OBJECT(self, "recovery depth %u", depth);
-  stream.sender.set_depth(depth);
-  stream.recovery_depth = depth;
-}
-
-static GstFlowReturn push_packet(GstRtpPfapPay* self, pfap::PlannedPacket& planned) {
-  Stream& stream = *self->stream;
-  update_recovery_depth(self);
-  if (complete_due(self, planned.start_ns)) {
-    // Sampled before this packet's bookmarks: the state a receiver has when it arrives.
-    const GstFlowReturn ret = push_complete(self, planned.start_ns);
-    if (ret != GST_FLOW_OK) return ret;
-  }
-
-  const size_t max_size = stream.packetizer.config().max_payload_size;
-  const size_t data_size = pfap::encoded_size(planned.packet);
-  if (planned.oversized) {
-    GST_ELEMENT_WARNING(self, STREAM, ENCODE, ("A phoneme and its FAPs do not fit in the MTU."),
-                        ("sending a %" G_GSIZE_FORMAT "-byte payload at %" GST_TIME_FORMAT
-                         "; mtu %u leaves room for %" G_GSIZE_FORMAT " bytes",
-                         data_size, GST_TIME_ARGS(planned.start_ns),
-                         GST_RTP_BASE_PAYLOAD_MTU(GST_RTP_BASE_PAYLOAD(self)), max_size));
-  }
-  stream.sender.add_dynamic(planned.packet, planned.start_ns,
-                            data_size < max_size ? max_size - data_size : 0);
-  GstBuffer* buffer = make_buffer(self, planned.packet, planned.marker);
-  if (buffer == nullptr) return GST_FLOW_ERROR;
-
-  uint32_t duration_ms = 0;
-  for (const pfap::PacketPhoneme& p : planned.packet.phonemes) duration_ms += p.phoneme.duration_ms;
-  // The base class makes the RTP timestamp from the PTS.
-  GST_BUFFER_PTS(buffer) = planned.start_ns;
-  GST_BUFFER_DURATION(buffer) = duration_ms * GST_MSECOND;
-  GST_LOG_OBJECT(self,
-                 "packet of %" G_GSIZE_FORMAT " phonemes, %" G_GSIZE_FORMAT
-                 " bytes, M=%d, %" G_GSIZE_FORMAT " recovery entries covering %u packets",
-                 planned.packet.phonemes.size(), pfap::encoded_size(planned.packet), planned.marker,
-                 planned.packet.recovery.size(), planned.packet.covered_packets);
-  const GstFlowReturn ret = push_buffer(self, buffer);
-  stream.sender.sent(planned.packet, planned.start_ns);
-  stream.position = planned.start_ns + int64_t{duration_ms} * pfap::kNsPerMs;
-  GST_OBJECT_LOCK(self);
-  self->stats.packets++;
-  self->stats.recovery_entries += planned.packet.recovery.size();
-  GST_OBJECT_UNLOCK(self);
-  return ret;
-}
-
-// Sends the packets the packetizer completed, one push each: the base class gives all the
-// packets of a buffer list the RTP timestamp of the first.
-static GstFlowReturn push_planned(GstRtpPfapPay* self) {
+// Sends every packet the sender has ready, one push each: the base class gives all the
+// packets of a buffer list the RTP timestamp of the first. A request made while pushing is
+// answered before the next data packet.
+static GstFlowReturn push_ready(GstRtpPfapPay* self) {
+  pfap::Sender& sender = self->stream->sender;
   GstFlowReturn ret = GST_FLOW_OK;
-  for (pfap::PlannedPacket& planned : self->stream->planned) {
-    ret = push_packet(self, planned);
-    if (ret != GST_FLOW_OK) break;
+  while (true) {
+    GST_OBJECT_LOCK(self);
+    const bool requested = self->complete_requested;
+    GST_OBJECT_UNLOCK(self);
+    const pfap::OutgoingPacket* out = sender.next(requested);
+    if (out == nullptr) break;
+    // After an error the rest is not pushed, but taken, so that the next buffer starts clean.
+    if (ret == GST_FLOW_OK) ret = push_packet(self, *out);
   }
-  self->stream->planned.clear();
   return ret;
 }
 
@@ -380,45 +318,48 @@ static GstFlowReturn push_planned(GstRtpPfapPay* self) {
 // stream's first data packet there is nothing to send yet: the complete packet that goes
 // before it answers. Under the stream lock.
 static GstFlowReturn serve_request(GstRtpPfapPay* self) {
-  const Stream& stream = *self->stream;
-  if (!stream.position || stream.pushing) return GST_FLOW_OK;
+  Stream& stream = *self->stream;
+  if (stream.pushing) return GST_FLOW_OK;
   GST_OBJECT_LOCK(self);
   const bool requested = self->complete_requested;
   GST_OBJECT_UNLOCK(self);
-  return requested ? push_complete(self, *stream.position) : GST_FLOW_OK;
+  if (!requested) return GST_FLOW_OK;
+  const pfap::OutgoingPacket* out = stream.sender.complete_now();
+  return out != nullptr ? push_packet(self, *out) : GST_FLOW_OK;
 }
 
 // Sends the pending packet now: no later phoneme may join it.
 static GstFlowReturn drain(GstRtpPfapPay* self) {
-  self->stream->packetizer.flush(self->stream->planned);
-  return push_planned(self);
+  self->stream->sender.drain();
+  return push_ready(self);
 }
 
 static GstFlowReturn gst_rtp_pfap_pay_handle_buffer(GstRTPBasePayload* payload, GstBuffer* buffer) {
   GstRtpPfapPay* self = GST_RTP_PFAP_PAY(payload);
   Stream& stream = *self->stream;
-  GstClockTime start = GST_BUFFER_PTS(buffer);
+  const GstClockTime pts = GST_BUFFER_PTS(buffer);
   pfap::MarkupEvent& event = stream.event;
-  const bool ok = pfap_buffer_read(buffer, event);
-  if (!ok) PFAP_WARN_MALFORMED_EVENT(self, buffer);
+  if (!pfap_buffer_read(buffer, event)) {
+    guint64 malformed = 0;
+    update_stats(self, [&](Stats& s) { malformed = ++s.malformed; });
+    PFAP_WARN_MALFORMED_EVENT(self, buffer, malformed);
+    gst_buffer_unref(buffer);
+    return GST_FLOW_OK;
+  }
   gst_buffer_unref(buffer);
-  if (!ok) return GST_FLOW_OK;
   if (event.kind != PFAP_EVENT_PHONEME) {
     GST_DEBUG_OBJECT(self, "dropping state event (kind %d) at %" GST_TIME_FORMAT, event.kind,
-                     GST_TIME_ARGS(start));
+                     GST_TIME_ARGS(pts));
     return GST_FLOW_OK;
   }
 
-  if (!GST_CLOCK_TIME_IS_VALID(start)) {
-    start = GST_CLOCK_TIME_IS_VALID(stream.next_start) ? stream.next_start : payload->segment.start;
-  }
-  stream.next_start = start + event.phoneme.duration_ms * GST_MSECOND;
-
-  const pfap::TimedPhoneme phoneme{static_cast<int64_t>(start), event.phoneme,
-                                   event.sentence_start};
-  update_config(self);
-  stream.packetizer.push(phoneme, event.faps, stream.planned);
-  return push_planned(self);
+  const int64_t start = stream.timeline.start(
+      GST_CLOCK_TIME_IS_VALID(pts) ? std::optional<int64_t>(pts) : std::nullopt,
+      static_cast<int64_t>(payload->segment.start));
+  stream.timeline.add(start, int64_t{event.phoneme.duration_ms} * pfap::kNsPerMs);
+  stream.sender.configure(current_config(self));
+  stream.sender.push({start, event.phoneme, event.sentence_start}, event.faps);
+  return push_ready(self);
 }
 
 // The clock rate downstream insists on (a fixed clock-rate in its caps), else 44100 Hz.
@@ -436,9 +377,8 @@ static uint32_t downstream_clock_rate(GstRTPBasePayload* payload) {
 }
 
 static gboolean gst_rtp_pfap_pay_set_caps(GstRTPBasePayload* payload, GstCaps* caps) {
-  GstRtpPfapPay* self = GST_RTP_PFAP_PAY(payload);
-  self->stream->clock_rate = downstream_clock_rate(payload);
-  gst_rtp_base_payload_set_options(payload, "application", TRUE, "PFAP", self->stream->clock_rate);
+  gst_rtp_base_payload_set_options(payload, "application", TRUE, "PFAP",
+                                   downstream_clock_rate(payload));
   // Copied as a string: only string fields become SDP a=fmtp parameters.
   const gchar* alphabet = gst_structure_get_string(gst_caps_get_structure(caps, 0), "alphabet");
   if (alphabet != nullptr) {
@@ -503,7 +443,8 @@ static GstStructure* stats_structure(GstRtpPfapPay* self) {
                            "complete-recoveries", G_TYPE_UINT64, s.complete_recoveries, "requests",
                            G_TYPE_UINT64, s.requests, "requests-served", G_TYPE_UINT64,
                            s.requests_served, "complete-too-large", G_TYPE_UINT64,
-                           s.complete_too_large, nullptr);
+                           s.complete_too_large, "oversized", G_TYPE_UINT64, s.oversized,
+                           "malformed", G_TYPE_UINT64, s.malformed, nullptr);
 }
 
 static GstStateChangeReturn gst_rtp_pfap_pay_change_state(GstElement* element,
@@ -687,6 +628,11 @@ static void gst_rtp_pfap_pay_class_init(GstRtpPfapPayClass* klass) {
    * - requests-served: complete-recovery packets that answered requests (requests that
    *   arrive before one is sent share it)
    * - complete-too-large: complete states not sent because they do not fit in the MTU
+   * - oversized: data packets larger than the MTU: one phoneme whose FAPs alone do not fit
+   * - malformed: input buffers dropped because they are not valid x-pfap events
+   *
+   * The faults counted in the last three are each warned about at their 1st, 2nd, 4th, 8th,
+   * ... occurrence only, so that a lasting fault does not flood the bus.
    */
   g_object_class_install_property(
       gobject_class, PROP_STATS,
@@ -695,7 +641,8 @@ static void gst_rtp_pfap_pay_class_init(GstRtpPfapPayClass* klass) {
                          "recovery-entries (dynamic, in them), complete-recoveries, requests "
                          "(GstForceKeyUnit received), requests-served (complete packets that "
                          "answered requests), complete-too-large (complete states not sent: "
-                         "over the MTU)",
+                         "over the MTU), oversized (data packets over the MTU), malformed "
+                         "(input buffers dropped)",
                          GST_TYPE_STRUCTURE,
                          static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
 

@@ -208,8 +208,7 @@ bool FapRecorder::apply(const MarkupEvent& event, int64_t time_ns) {
   time_ns = std::max(time_ns, last_ns_);
   last_ns_ = time_ns;
   if (!sample_before(time_ns)) return false;
-  if (event.kind == PFAP_EVENT_COMPLETE) state_.reset();
-  for (const Fap& fap : event.faps) state_.apply(fap, time_ns);
+  apply_markup(event, time_ns, state_);
   return true;
 }
 

@@ -5,7 +5,6 @@
 #include <cmath>
 
 namespace pfap {
-namespace {}  // namespace
 
 void FapState::apply(const Fap& fap, int64_t start_ns) {
   assert(is_valid(fap));
@@ -69,5 +68,10 @@ Fap FapState::recovery_entry(int index, int64_t time_ns) const {
 }
 
 void FapState::reset() { tracks_.fill(Track{}); }
+
+void FapState::apply_complete(std::span<const Fap> entries, int64_t time_ns) {
+  reset();
+  for (const Fap& entry : entries) apply(entry, time_ns);
+}
 
 }  // namespace pfap

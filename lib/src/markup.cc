@@ -143,8 +143,11 @@ bool read_markup(std::span<const uint8_t> bytes, MarkupEvent& out) {
 }
 
 void apply_markup(const MarkupEvent& event, int64_t time_ns, FapState& state) {
-  if (event.kind == PFAP_EVENT_COMPLETE) state.reset();
-  for (const Fap& fap : event.faps) state.apply(fap, time_ns);
+  if (event.kind == PFAP_EVENT_COMPLETE) {
+    state.apply_complete(event.faps, time_ns);
+  } else {
+    for (const Fap& fap : event.faps) state.apply(fap, time_ns);
+  }
 }
 
 }  // namespace pfap

@@ -16,7 +16,7 @@ size_t phoneme_bytes(size_t fap_count) {
 }
 
 // Moves the pending packet to `out`; `pending` is left empty, ready for the next packet.
-void complete(PlannedPacket& pending, std::vector<PlannedPacket>& out) {
+void finish(PlannedPacket& pending, std::vector<PlannedPacket>& out) {
   out.push_back(std::move(pending));
   pending = PlannedPacket{};
 }
@@ -49,13 +49,12 @@ void Packetizer::push(const TimedPhoneme& phoneme, std::span<const Fap> faps,
     if (phoneme.sentence_start || !contiguous ||
         phoneme.start_ns - pending_.start_ns >= config_.max_delay_ns ||
         pending_size_ + bytes > config_.max_payload_size) {
-      complete(pending_, out);
+      finish(pending_, out);
     }
   }
 
   if (!has_pending()) {
     pending_.start_ns = phoneme.start_ns;
-    pending_.rtp_timestamp = rtp_ticks(phoneme.start_ns, config_.clock_rate);
     pending_.marker = phoneme.sentence_start;
     pending_.oversized = kPacketDescriptorBytes + bytes > config_.max_payload_size;
     pending_size_ = kPacketDescriptorBytes;
@@ -66,18 +65,18 @@ void Packetizer::push(const TimedPhoneme& phoneme, std::span<const Fap> faps,
   // Summed from the first start in whole milliseconds, so clock jitter does not accumulate.
   pending_end_ns_ += int64_t{phoneme.phoneme.duration_ms} * kNsPerMs;
 
-  // Complete at once when no later phoneme may join: end of text, the delay bound reached,
+  // Finished at once when no later phoneme may join: end of text, the delay bound reached,
   // or no room for another phoneme (which an oversized packet never has).
   if (phoneme.phoneme.end_of_text || pending_end_ns_ - pending_.start_ns >= config_.max_delay_ns ||
       pending_size_ + kPhonemeDescriptorBytes > config_.max_payload_size) {
-    complete(pending_, out);
+    finish(pending_, out);
   }
 }
 
-void Packetizer::flush(std::vector<PlannedPacket>& out) {
-  if (has_pending()) complete(pending_, out);
+void Packetizer::drain(std::vector<PlannedPacket>& out) {
+  if (has_pending()) finish(pending_, out);
 }
 
-void Packetizer::reset() { pending_ = PlannedPacket{}; }
+void Packetizer::drop() { pending_ = PlannedPacket{}; }
 
 }  // namespace pfap

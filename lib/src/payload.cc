@@ -8,14 +8,15 @@
 //   +-+-+-+-+-+-+-+-+
 //   IB: 00 phoneme follows, 01 FAP follows, 10 end of packet, 11 reserved
 //
-// Recovery information, type 1 (6.4), 48 bits, only when T = 01:
+// Recovery information, type 1 (6.4), 48 bits, only when T = 01 (wider than the formatter's
+// column limit, so it is left alone):
+// clang-format off
 //    0                   1                   2                   3                   4
-//    0 1 2 3 4 5 6 7 8 9 0 1 2 3 4 5 6 7 8 9 0 1 2 3 4 5 6 7 8 9 0 1 2 3 4 5 6 7 8 9 0 1 2 3 4 5 6
-//    7
+//    0 1 2 3 4 5 6 7 8 9 0 1 2 3 4 5 6 7 8 9 0 1 2 3 4 5 6 7 8 9 0 1 2 3 4 5 6 7 8 9 0 1 2 3 4 5 6 7
 //   +-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+
-//   |   FAPind    |s|              Amplitude (22)               |     Transition (14)       | C |IB
-//   |
+//   |   FAPind    |s|              Amplitude (22)               |     Transition (14)       | C |IB |
 //   +-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+-+
+// clang-format on
 //   IB: 00 another entry follows, 01 and 10 reserved, 11 end of recovery information
 //
 // Phoneme descriptor (6.2), 32 bits:
@@ -124,15 +125,15 @@ std::span<const Fap> Packet::faps_of(size_t i) const {
   return std::span<const Fap>(faps).subspan(begin, phonemes[i].fap_end - begin);
 }
 
+int64_t Packet::duration_ns() const {
+  return for_each_phoneme(0, [](size_t, int64_t) {});
+}
+
 size_t encoded_size(const Packet& packet) {
   return kPacketDescriptorBytes +
          kFapDescriptorBytes * (packet.recovery.size() + packet.faps.size()) +
          kPhonemeDescriptorBytes * packet.phonemes.size();
 }
-
-}  // namespace pfap
-
-namespace pfap {
 
 const char* to_string(DecodeStatus status) {
   switch (status) {

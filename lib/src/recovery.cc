@@ -9,13 +9,13 @@ namespace {
 
 // Entries for the FAPs the packets bookmarked whose effect is not over at `time_ns`, one
 // per FAP index in index order, written from the sender's state.
-void entries_for(std::span<const std::vector<RecoverySender::Bookmark>> packets,
+void entries_for(std::span<const std::vector<RecoverySender::SentFap>> packets,
                  const FapState& state, int64_t time_ns, std::vector<Fap>& out) {
   // A triangle that is over changed nothing a FAP holds (FapState): the draft leaves it out.
   std::array<bool, kFapCount> in_effect{};
   size_t count = 0;
   for (const auto& packet : packets) {
-    for (const RecoverySender::Bookmark& b : packet) {
+    for (const RecoverySender::SentFap& b : packet) {
       const bool over = time_ns - b.start_ns >= int64_t{b.fap.transition_ms} * kNsPerMs;
       const bool effect = b.fap.curve != Curve::kTriangle || !over;
       count += effect && !in_effect[b.fap.index];
@@ -64,7 +64,7 @@ bool RecoverySender::make_complete(Packet& out, int64_t time_ns, size_t room) co
 }
 
 void RecoverySender::sent(const Packet& packet, int64_t time_ns) {
-  std::vector<Bookmark>* bookmarks = nullptr;  // this packet's place in the window
+  std::vector<SentFap>* bookmarks = nullptr;  // this packet's place in the window
   if (window_.size() < depth_) {
     bookmarks = &window_.emplace_back();
   } else {
@@ -77,14 +77,12 @@ void RecoverySender::sent(const Packet& packet, int64_t time_ns) {
       bookmarks->clear();
     }
   }
-  int64_t start_ns = time_ns;
-  for (size_t i = 0; i < packet.phonemes.size(); ++i) {
+  packet.for_each_phoneme(time_ns, [&](size_t i, int64_t start_ns) {
     for (const Fap& fap : packet.faps_of(i)) {
       if (bookmarks != nullptr) bookmarks->push_back({fap, start_ns});
       state_.apply(fap, start_ns);
     }
-    start_ns += int64_t{packet.phonemes[i].phoneme.duration_ms} * kNsPerMs;
-  }
+  });
 }
 
 void RecoverySender::set_depth(unsigned depth) {
@@ -114,8 +112,7 @@ ReceiveResult RecoveryReceiver::receive(const Packet& packet, uint16_t seqnum, i
     // Only the settled values are compared, so only they are kept, not the whole state.
     std::array<int32_t, kFapCount> before{};
     for (int f = kMinFapIndex; f <= kMaxFapIndex; ++f) before[f] = state_.settled(f);
-    state_.reset();
-    for (const Fap& entry : packet.recovery) state_.apply(entry, time_ns);
+    state_.apply_complete(packet.recovery, time_ns);
     for (int f = kMinFapIndex; f <= kMaxFapIndex && !result.changed; ++f) {
       result.changed = state_.settled(f) != before[f];
     }
@@ -138,11 +135,9 @@ ReceiveResult RecoveryReceiver::receive(const Packet& packet, uint16_t seqnum, i
     last_request_ns_ = time_ns;
   }
 
-  int64_t start_ns = time_ns;
-  for (size_t i = 0; i < packet.phonemes.size(); ++i) {
+  packet.for_each_phoneme(time_ns, [&](size_t i, int64_t start_ns) {
     for (const Fap& fap : packet.faps_of(i)) state_.apply(fap, start_ns);
-    start_ns += int64_t{packet.phonemes[i].phoneme.duration_ms} * kNsPerMs;
-  }
+  });
   result.state_whole = whole_;
   return result;
 }

@@ -18,7 +18,10 @@
 // time. Printed: each run, then the medians, items/s and the ratio to rtpgst.
 //
 // Run: meson test -C build --benchmark --verbose elements
-//  or: GST_PLUGIN_PATH=build/gst:build/ext build/tests/bench/bench_elements [N [repetitions]]
+//  or: GST_PLUGIN_PATH=build/gst:build/ext build/tests/bench/bench_elements [N [repetitions
+//      [ONLY]]]
+// ONLY runs only the variant whose payloader is ONLY (e.g. "rtpklvpay", or "rtppfappay
+// max-delay=0"), for profiling one pipeline (docs/performance.md).
 #include <gst/gst.h>
 
 #include <atomic>
@@ -213,7 +216,8 @@ int main(int argc, char** argv) {
   gst_init(&argc, &argv);
   const int n = argc > 1 ? std::atoi(argv[1]) : 100000;
   const int repetitions = argc > 2 ? std::atoi(argv[2]) : 7;
-  if (n <= 0 || repetitions <= 0) fail("usage: bench_elements [N [repetitions]]");
+  if (n <= 0 || repetitions <= 0) fail("usage: bench_elements [N [repetitions [ONLY]]]");
+  const std::string only = argc > 3 ? argv[3] : "";
   for (const char* name :
        {"rtppfappay", "rtppfapdepay", "rtpklvpay", "rtpklvdepay", "rtpgstpay", "rtpgstdepay"}) {
     GstElementFactory* f = gst_element_factory_find(name);
@@ -264,13 +268,19 @@ int main(int argc, char** argv) {
        {}},
       {"rtpgstpay ! rtpgstdepay", kPfapCaps, "rtpgstpay", "rtpgstdepay", plain, {}, {}},
   };
+  auto selected = [&](const Variant& v) {
+    return only.empty() || only == v.payloader;
+  };
   // Warm-up: the registry, plugin loading and first allocations are not measured.
-  for (Variant& v : variants) run(v.caps, v.payloader, v.depayloader, v.buffers);
+  for (Variant& v : variants) {
+    if (selected(v)) run(v.caps, v.payloader, v.depayloader, v.buffers);
+  }
   for (int r = 0; r < repetitions; ++r) {
     std::printf("run %d:", r + 1);
     // Rotate the order so that no variant always runs first or last.
     for (size_t k = 0; k < variants.size(); ++k) {
       Variant& v = variants[(k + static_cast<size_t>(r)) % variants.size()];
+      if (!selected(v)) continue;
       const Timing t = run(v.caps, v.payloader, v.depayloader, v.buffers);
       v.cpu.push_back(t.cpu);
       v.wall.push_back(t.wall);
@@ -281,12 +291,13 @@ int main(int argc, char** argv) {
   }
 
   const Variant& reference = variants.back();
-  const double rc = median(reference.cpu);
+  const double rc = selected(reference) ? median(reference.cpu) : 0;
   std::printf(
       "\nmedian of %d                      CPU time   items/s (CPU)   RTP packets   vs rtpgst "
       "(items/s)\n",
       repetitions);
   for (const Variant& v : variants) {
+    if (!selected(v)) continue;
     const double c = median(v.cpu);
     std::printf("%-32s %8.4f s %13.0f %13ld %12.3f\n", v.name, c, n / c, v.packets, rc / c);
   }

@@ -38,6 +38,7 @@
 #include "pfap/payload.h"
 #include "pfap/recovery.h"
 #include "random_markup.h"
+#include "rtp_packet.h"
 
 namespace {
 
@@ -248,19 +249,8 @@ double run_library(LibraryDepay& depay, const Case& c, uint16_t& seqnum, int64_t
 
 GstBuffer* rtp_packet(std::span<const uint8_t> payload, guint16 seqnum, guint32 rtp_time,
                       guint32 ssrc, bool marker, GstClockTime pts) {
-  GstBuffer* buffer = gst_rtp_buffer_new_allocate(static_cast<guint>(payload.size()), 0, 0);
-  GstRTPBuffer rtp = GST_RTP_BUFFER_INIT;
-  if (!gst_rtp_buffer_map(buffer, GST_MAP_WRITE, &rtp)) fail("cannot map an RTP buffer");
-  gst_rtp_buffer_set_payload_type(&rtp, 96);
-  gst_rtp_buffer_set_ssrc(&rtp, ssrc);
-  gst_rtp_buffer_set_seq(&rtp, seqnum);
-  gst_rtp_buffer_set_timestamp(&rtp, rtp_time);
-  gst_rtp_buffer_set_marker(&rtp, marker);
-  std::copy(payload.begin(), payload.end(),
-            static_cast<uint8_t*>(gst_rtp_buffer_get_payload(&rtp)));
-  gst_rtp_buffer_unmap(&rtp);
-  GST_BUFFER_PTS(buffer) = pts;
-  return buffer;
+  return pfap::testing::rtp_packet(
+      payload, {.seqnum = seqnum, .timestamp = rtp_time, .ssrc = ssrc, .marker = marker}, pts);
 }
 
 // Everything the harness holds but the output buffers it drops: events both ways.

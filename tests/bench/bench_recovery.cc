@@ -66,6 +66,7 @@
 #include "pfap/fap_state.h"
 #include "pfap/markup.h"
 #include "pfap/model.h"
+#include "rtp_packet.h"
 #include "speech_session.h"
 
 namespace {
@@ -293,18 +294,13 @@ GstPadProbeReturn count_redundant(GstPad*, GstPadProbeInfo* info, gpointer data)
 // An RTP packet from a RED packet's header fields and one of its blocks.
 GstBuffer* rtp_from_block(GstRTPBuffer& red, uint16_t seq, uint32_t timestamp, uint8_t pt,
                           bool marker, const uint8_t* data, size_t size) {
-  GstBuffer* out = gst_rtp_buffer_new_allocate(static_cast<guint>(size), 0, 0);
-  GstRTPBuffer rtp = GST_RTP_BUFFER_INIT;
-  gst_rtp_buffer_map(out, GST_MAP_WRITE, &rtp);
-  gst_rtp_buffer_set_ssrc(&rtp, gst_rtp_buffer_get_ssrc(&red));
-  gst_rtp_buffer_set_seq(&rtp, seq);
-  gst_rtp_buffer_set_timestamp(&rtp, timestamp);
-  gst_rtp_buffer_set_payload_type(&rtp, pt);
-  gst_rtp_buffer_set_marker(&rtp, marker);
-  std::copy(data, data + size, static_cast<uint8_t*>(gst_rtp_buffer_get_payload(&rtp)));
-  gst_rtp_buffer_unmap(&rtp);
-  GST_BUFFER_PTS(out) = GST_BUFFER_PTS(red.buffer);
-  return out;
+  return pfap::testing::rtp_packet({data, size},
+                                   {.seqnum = seq,
+                                    .timestamp = timestamp,
+                                    .ssrc = gst_rtp_buffer_get_ssrc(&red),
+                                    .marker = marker,
+                                    .payload_type = pt},
+                                   GST_BUFFER_PTS(red.buffer));
 }
 
 // RFC 2198 decoded as a receiver could for a stream whose packets are not evenly spaced:

@@ -25,6 +25,7 @@
 #include "fuzz_check.h"
 #include "pfap/markup_event.h"
 #include "pfap/payload.h"
+#include "rtp_packet.h"
 
 namespace {
 
@@ -78,18 +79,12 @@ constexpr std::array<const char*, pfap::kDecodeStatusCount> kMalformedFields = {
 
 GstBuffer* rtp_packet(std::span<const uint8_t> payload, guint16 seqnum, guint32 ssrc,
                       bool marker, GstClockTime pts) {
-  GstBuffer* buffer = gst_rtp_buffer_new_allocate(static_cast<guint>(payload.size()), 0, 0);
-  GstRTPBuffer rtp = GST_RTP_BUFFER_INIT;
-  FUZZ_CHECK(gst_rtp_buffer_map(buffer, GST_MAP_WRITE, &rtp));
-  gst_rtp_buffer_set_payload_type(&rtp, 96);
-  gst_rtp_buffer_set_ssrc(&rtp, ssrc);
-  gst_rtp_buffer_set_seq(&rtp, seqnum);
-  gst_rtp_buffer_set_timestamp(&rtp, static_cast<guint32>(pts / GST_MSECOND * 441 / 10));
-  gst_rtp_buffer_set_marker(&rtp, marker);
-  std::copy(payload.begin(), payload.end(), static_cast<uint8_t*>(gst_rtp_buffer_get_payload(&rtp)));
-  gst_rtp_buffer_unmap(&rtp);
-  GST_BUFFER_PTS(buffer) = pts;
-  return buffer;
+  return pfap::testing::rtp_packet(payload,
+                                   {.seqnum = seqnum,
+                                    .timestamp = static_cast<guint32>(pts / GST_MSECOND * 441 / 10),
+                                    .ssrc = ssrc,
+                                    .marker = marker},
+                                   pts);
 }
 
 GstEvent* packet_lost(guint16 seqnum, GstClockTime pts) {

@@ -53,6 +53,11 @@ inline GstBuffer* phoneme_buffer(const Phoneme& p, const std::vector<Fap>& faps,
   return buffer;
 }
 
+// The phoneme buffer of `e`, a phoneme Event (its flags say whether it starts a sentence).
+inline GstBuffer* phoneme_buffer(const Event& e) {
+  return phoneme_buffer(e.phoneme, e.faps, e.pts, (e.flags & PFAP_FLAG_SENTENCE_START) != 0);
+}
+
 // A buffer of any event at `pts`, made through the library's writer; a phoneme lasts its
 // duration.
 inline GstBuffer* markup_buffer(const MarkupEvent& event, GstClockTime pts) {

@@ -23,6 +23,7 @@
 #include <thread>
 #include <vector>
 
+#include "element_harness.h"
 #include "pfap/markup_event.h"
 #include "pfap/phoneme_table.h"
 #include "pfap_buffers.h"
@@ -38,7 +39,6 @@ using pfap::MarkupEvent;
 using pfap::Phoneme;
 using pfap::testing::markup_buffer;
 using pfap::testing::Pipeline;
-using pfap::testing::pop_messages;
 using pfap::testing::TempDir;
 
 constexpr GstClockTime kMs = GST_MSECOND;
@@ -103,25 +103,14 @@ double mean_difference(const Picture& a, const Picture& b, int x0 = 0, int y0 = 
 }
 
 // pfapface in a harness, with a bus for its warnings.
-class Face {
+class Face : public pfap::testing::ElementHarness {
  public:
   explicit Face(const char* output_caps = kSmallCaps,
                 const char* input_caps = "application/x-pfap, alphabet=(string)x-pfap-arpabet")
-      : h_(gst_harness_new("pfapface")), bus_(gst_bus_new()) {
-    gst_element_set_bus(h_->element, bus_);
+      : ElementHarness("pfapface") {
     if (output_caps != nullptr) gst_harness_set_sink_caps_str(h_, output_caps);
     gst_harness_set_src_caps_str(h_, input_caps);
   }
-  ~Face() {
-    gst_harness_teardown(h_);
-    gst_bus_set_flushing(bus_, TRUE);  // its messages hold the element
-    gst_object_unref(bus_);
-  }
-  Face(const Face&) = delete;
-  Face& operator=(const Face&) = delete;
-
-  GstHarness* harness() { return h_; }
-  GstElement* element() { return h_->element; }
 
   void push(GstBuffer* buffer) { ASSERT_EQ(gst_harness_push(h_, buffer), GST_FLOW_OK); }
   void push_gap(GstClockTime pts, GstClockTime duration) {
@@ -164,12 +153,6 @@ class Face {
     gst_caps_unref(caps);
     return text;
   }
-  std::vector<std::string> warnings() { return pop_messages(bus_, GST_MESSAGE_WARNING); }
-  std::vector<std::string> errors() { return pop_messages(bus_, GST_MESSAGE_ERROR); }
-
- private:
-  GstHarness* h_;
-  GstBus* bus_;
 };
 
 void unref_all(std::vector<GstBuffer*>& buffers) {
@@ -373,6 +356,19 @@ TEST(PfapFace, EventEarlierThanTheLastIsAppliedAtItsTimeWithAWarning) {
   std::vector<GstBuffer*> frames = face.frames_until_eos();
   EXPECT_EQ(frames.size(), 15u);
   EXPECT_EQ(face.warnings().size(), 1u);
+  unref_all(frames);
+}
+
+TEST(PfapFace, EarlierEventsAreWarnedAboutAtThe1st2nd4th8th) {
+  // 200 events in reverse time order: 199 go back, 8 warnings (the 1st to the 128th).
+  Face face;
+  for (int i = 199; i >= 0; --i) face.push(phoneme("AA", i * 10 * kMs, 10));
+  face.eos();
+  std::vector<GstBuffer*> frames = face.frames_until_eos();
+  EXPECT_FALSE(frames.empty());
+  const std::vector<std::string> warnings = face.warnings();
+  ASSERT_EQ(warnings.size(), 8u);
+  EXPECT_NE(warnings.back().find("earlier than the one before"), std::string::npos);
   unref_all(frames);
 }
 

@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "element_harness.h"
 #include "pfap/markup.h"
 #include "pfap/model.h"
 #include "pfap_buffers.h"
@@ -21,7 +22,6 @@ namespace {
 using pfap::Curve;
 using pfap::Fap;
 using pfap::testing::Event;
-using pfap::testing::pop_messages;
 
 constexpr GstClockTime kMs = GST_MSECOND;
 
@@ -46,23 +46,12 @@ GstBuffer* text_buffer(std::string_view text) {
   return gst_buffer_new_memdup(text.data(), text.size());
 }
 
-class Parser {
+class Parser : public pfap::testing::ElementHarness {
  public:
-  explicit Parser(bool skip_bad_lines = false)
-      : h_(gst_harness_new("pfapparse")), bus_(gst_bus_new()) {
-    gst_element_set_bus(h_->element, bus_);
+  explicit Parser(bool skip_bad_lines = false) : ElementHarness("pfapparse") {
     g_object_set(h_->element, "skip-bad-lines", skip_bad_lines, nullptr);
     gst_harness_set_src_caps_str(h_, "text/x-raw, format=(string)utf8");
   }
-  ~Parser() {
-    gst_harness_teardown(h_);
-    gst_bus_set_flushing(bus_, TRUE);  // its messages hold the element
-    gst_object_unref(bus_);
-  }
-  Parser(const Parser&) = delete;
-  Parser& operator=(const Parser&) = delete;
-
-  GstHarness* harness() { return h_; }
 
   GstFlowReturn push(std::string_view text) { return gst_harness_push(h_, text_buffer(text)); }
   // `text` in chunks of the given sizes, the last one taking what is left.
@@ -97,12 +86,6 @@ class Parser {
     }
     return types;
   }
-  std::vector<std::string> errors() { return pop_messages(bus_, GST_MESSAGE_ERROR); }
-  std::vector<std::string> warnings() { return pop_messages(bus_, GST_MESSAGE_WARNING); }
-
- private:
-  GstHarness* h_;
-  GstBus* bus_;
 };
 
 std::vector<Event> parse(std::string_view text) {

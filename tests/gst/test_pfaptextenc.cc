@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "element_harness.h"
 #include "pfap/markup.h"
 #include "pfap/markup_event.h"
 #include "pfap/text.h"
@@ -51,16 +52,10 @@ std::vector<pfap::TextEvent> read_back(const std::vector<std::string>& lines) {
   return events;
 }
 
-class PfapTextEncTest : public ::testing::Test {
+class PfapTextEncTest : public ::testing::Test, public pfap::testing::ElementHarness {
  protected:
-  PfapTextEncTest() : h_(gst_harness_new("pfaptextenc")), bus_(gst_bus_new()) {
-    gst_element_set_bus(h_->element, bus_);
+  PfapTextEncTest() : ElementHarness("pfaptextenc") {
     gst_harness_set_src_caps_str(h_, PFAP_MARKUP_CAPS);
-  }
-  ~PfapTextEncTest() override {
-    gst_harness_teardown(h_);
-    gst_bus_set_flushing(bus_, TRUE);  // its messages hold the element
-    gst_object_unref(bus_);
   }
 
   void push(GstBuffer* buffer) { ASSERT_EQ(gst_harness_push(h_, buffer), GST_FLOW_OK); }
@@ -112,8 +107,6 @@ class PfapTextEncTest : public ::testing::Test {
     return text;
   }
 
-  GstHarness* h_;
-  GstBus* bus_;
 };
 
 TEST_F(PfapTextEncTest, OutputCapsAreUtf8Text) {
@@ -280,6 +273,30 @@ TEST_F(PfapTextEncTest, EarlierEventIsWrittenAtThePreviousTimeWithAWarning) {
             (std::vector<std::string>{"0 1 100 120 -\n", "200 2 100 120 -\n", "200 3 100 120 -\n",
                                       "200 4 100 120 -\n", "300 5 100 120 -\n"}));
   EXPECT_EQ(read_back(lines).size(), 5u);
+}
+
+TEST_F(PfapTextEncTest, EarlierEventsAreWarnedAboutAtThe1st2nd4th8thAndAllCounted) {
+  // 2000 events in reverse time order: 1999 go back, 11 warnings (the 1st to the 1024th).
+  for (int i = 1999; i >= 0; --i) push(phoneme(1, 10), static_cast<GstClockTime>(i) * 10 * kMs);
+  EXPECT_EQ(pull_lines().size(), 2000u);
+  size_t warnings = 0;
+  while (!pop_warning().empty()) ++warnings;
+  EXPECT_EQ(warnings, 11u);
+  EXPECT_EQ(stat("earlier"), 1999u);
+  EXPECT_EQ(stat("events"), 2000u);
+}
+
+TEST_F(PfapTextEncTest, MalformedBuffersAreWarnedAboutAtThe1st2nd4th8thAndAllCounted) {
+  for (int i = 0; i < 20; ++i) {
+    GstBuffer* bad = gst_buffer_new_allocate(nullptr, 3, nullptr);
+    gst_buffer_memset(bad, 0, 0xff, 3);
+    push(bad);
+  }
+  size_t warnings = 0;
+  while (!pop_warning().empty()) ++warnings;
+  EXPECT_EQ(warnings, 5u);
+  EXPECT_EQ(stat("malformed"), 20u);
+  EXPECT_EQ(stat("events"), 0u);
 }
 
 TEST_F(PfapTextEncTest, MalformedBufferIsDroppedWithAWarningAndTheNextWritten) {

@@ -31,7 +31,9 @@
 #include "lip_sync.h"
 #include "pfap/markup.h"
 #include "pfap/model.h"
+#include "live_source.h"
 #include "pfap_buffers.h"
+#include "rtpbin_sessions.h"
 #include "pipeline.h"
 #include "random_markup.h"
 #include "speech_session.h"
@@ -76,16 +78,16 @@ std::string describe(const Event& e) {
   return s.str();
 }
 
-GstBuffer* make_buffer(const Event& e) {
-  return pfap::testing::phoneme_buffer(e.phoneme, e.faps, e.pts,
-                                       (e.flags & PFAP_FLAG_SENTENCE_START) != 0);
-}
+GstBuffer* make_buffer(const Event& e) { return pfap::testing::phoneme_buffer(e); }
 
 using pfap::testing::bound_port;
 using pfap::testing::end_of_stream;
 using pfap::testing::fast_rtcp;
 using pfap::testing::Pipeline;
 using pfap::testing::plugin_available;
+using pfap::testing::push_live;
+using pfap::testing::rtpbin_receive_session;
+using pfap::testing::rtpbin_send_session;
 using pfap::testing::pull_all;
 using pfap::testing::push;
 
@@ -588,22 +590,6 @@ std::vector<Event> live_phonemes() {
   return events;
 }
 
-// The sender's side of the phoneme stream: pushes each phoneme when the pipeline's running
-// time reaches its start, as a live TTS source would.
-void push_live(GstElement* appsrc, GstClock* clock, GstClockTime base_time,
-               const std::vector<Event>& events, const std::atomic<bool>& stop) {
-  for (const Event& e : events) {
-    for (;;) {
-      if (stop) return;
-      const GstClockTime now = gst_clock_get_time(clock);
-      if (now >= base_time + e.pts) break;
-      const GstClockTime wait = std::min<GstClockTime>(base_time + e.pts - now, 20 * GST_MSECOND);
-      std::this_thread::sleep_for(std::chrono::nanoseconds(wait));
-    }
-    if (push(appsrc, make_buffer(e)) != GST_FLOW_OK) return;
-  }
-}
-
 TEST(LoopbackUdp, PhonemesKeepLipSyncWithAudio) {
   ASSERT_TRUE(plugin_available(kElements));
   const std::vector<Event> sent = live_phonemes();
@@ -614,34 +600,29 @@ TEST(LoopbackUdp, PhonemesKeepLipSyncWithAudio) {
   ReceiverLinks links{nullptr, nullptr, &received};
 
   Pipeline receiver(
-      "rtpbin name=rtpbin buffer-mode=none "
-      "udpsrc name=audio_rtp address=127.0.0.1 port=0 caps=\"application/x-rtp,media=audio,"
-      "clock-rate=44100,encoding-name=L16,channels=1,payload=96\" ! rtpbin.recv_rtp_sink_0 "
-      "udpsrc name=audio_rtcp address=127.0.0.1 port=0 ! rtpbin.recv_rtcp_sink_0 "
-      "rtpbin.send_rtcp_src_0 ! udpsink name=audio_rr host=127.0.0.1 sync=false async=false "
-      "udpsrc name=pfap_rtp address=127.0.0.1 port=0 caps=\"application/x-rtp,"
-      "media=application,clock-rate=44100,encoding-name=PFAP,payload=97,"
-      "alphabet=(string)x-sampa\" ! rtpbin.recv_rtp_sink_1 "
-      "udpsrc name=pfap_rtcp address=127.0.0.1 port=0 ! rtpbin.recv_rtcp_sink_1 "
-      "rtpbin.send_rtcp_src_1 ! udpsink name=pfap_rr host=127.0.0.1 sync=false async=false "
+      "rtpbin name=rtpbin buffer-mode=none " +
+      rtpbin_receive_session(0, "audio_",
+                             "application/x-rtp,media=audio,clock-rate=44100,"
+                             "encoding-name=L16,channels=1,payload=96") +
+      rtpbin_receive_session(1, "pfap_",
+                             "application/x-rtp,media=application,clock-rate=44100,"
+                             "encoding-name=PFAP,payload=97,alphabet=(string)x-sampa") +
       "rtpL16depay name=audio_depay ! appsink name=audio_sink sync=false emit-signals=true "
       "rtppfapdepay name=pfap_depay ! appsink name=pfap_sink sync=false emit-signals=true");
   ASSERT_TRUE(receiver.ok()) << receiver.error();
   Pipeline sender(
       "rtpbin name=rtpbin "
-      "sdes=\"application/x-rtp-source-sdes,cname=(string)pfap-test-sender\" "
-      "audiotestsrc is-live=true wave=white-noise samplesperbuffer=441 "
-      "! audio/x-raw,rate=44100,channels=1 ! audioconvert "
-      "! rtpL16pay name=audio_pay pt=96 ! rtpbin.send_rtp_sink_0 "
-      "rtpbin.send_rtp_src_0 ! udpsink name=audio_rtp host=127.0.0.1 async=false "
-      "rtpbin.send_rtcp_src_0 ! udpsink name=audio_rtcp host=127.0.0.1 sync=false async=false "
-      "udpsrc name=audio_rr address=127.0.0.1 port=0 ! rtpbin.recv_rtcp_sink_0 "
-      "appsrc name=pfap_src is-live=true format=time "
-      "caps=\"application/x-pfap,alphabet=(string)x-sampa\" "
-      "! rtppfappay pt=97 ! rtpbin.send_rtp_sink_1 "
-      "rtpbin.send_rtp_src_1 ! udpsink name=pfap_rtp host=127.0.0.1 async=false "
-      "rtpbin.send_rtcp_src_1 ! udpsink name=pfap_rtcp host=127.0.0.1 sync=false async=false "
-      "udpsrc name=pfap_rr address=127.0.0.1 port=0 ! rtpbin.recv_rtcp_sink_1");
+      "sdes=\"application/x-rtp-source-sdes,cname=(string)pfap-test-sender\" " +
+      rtpbin_send_session(0, "audio_",
+                          "audiotestsrc is-live=true wave=white-noise samplesperbuffer=441 "
+                          "! audio/x-raw,rate=44100,channels=1 ! audioconvert "
+                          "! rtpL16pay name=audio_pay pt=96",
+                          /*sync_rtp=*/true) +
+      rtpbin_send_session(1, "pfap_",
+                          "appsrc name=pfap_src is-live=true format=time "
+                          "caps=\"application/x-pfap,alphabet=(string)x-sampa\" "
+                          "! rtppfappay pt=97",
+                          /*sync_rtp=*/true));
   ASSERT_TRUE(sender.ok()) << sender.error();
 
   links.audio_depay = receiver.by_name("audio_depay");

@@ -10,9 +10,11 @@
 #include <string>
 #include <vector>
 
+#include "element_harness.h"
 #include "pfap/packetizer.h"
 #include "pfap/payload.h"
 #include "pfap_buffers.h"
+#include "rtp_packet.h"
 
 namespace pfap {
 namespace {
@@ -34,19 +36,13 @@ Bytes encode(const Packet& packet) {
 // An RTP packet whose PTS is `pts` and whose timestamp is `pts` on a `clock_rate` clock.
 GstBuffer* rtp_packet(const Bytes& payload, guint16 seqnum, GstClockTime pts, bool marker = false,
                       uint32_t clock_rate = kDefaultClockRate) {
-  GstBuffer* buffer = gst_rtp_buffer_new_allocate(static_cast<guint>(payload.size()), 0, 0);
-  GstRTPBuffer rtp = GST_RTP_BUFFER_INIT;
-  EXPECT_TRUE(gst_rtp_buffer_map(buffer, GST_MAP_WRITE, &rtp));
-  gst_rtp_buffer_set_payload_type(&rtp, 96);
-  gst_rtp_buffer_set_ssrc(&rtp, kSsrc);
-  gst_rtp_buffer_set_seq(&rtp, seqnum);
-  gst_rtp_buffer_set_timestamp(&rtp, rtp_ticks(static_cast<int64_t>(pts), clock_rate));
-  gst_rtp_buffer_set_marker(&rtp, marker);
-  std::copy(payload.begin(), payload.end(),
-            static_cast<uint8_t*>(gst_rtp_buffer_get_payload(&rtp)));
-  gst_rtp_buffer_unmap(&rtp);
-  GST_BUFFER_PTS(buffer) = pts;
-  return buffer;
+  return testing::rtp_packet(
+      payload,
+      {.seqnum = seqnum,
+       .timestamp = rtp_ticks(static_cast<int64_t>(pts), clock_rate),
+       .ssrc = kSsrc,
+       .marker = marker},
+      pts);
 }
 
 // The same packet from another sender.
@@ -174,27 +170,16 @@ void start_stream(GstHarness* h, guint16 seqnum, GstClockTime pts = 0) {
 const Fap kJoy{69, 40, 2000, Curve::kSpline};
 const Fap kJaw{3, -500, 120, Curve::kLinear};
 
-class RtpPfapDepayTest : public ::testing::Test {
+class RtpPfapDepayTest : public ::testing::Test, public testing::ElementHarness {
  protected:
-  RtpPfapDepayTest() : h_(gst_harness_new("rtppfapdepay")) {}
-  ~RtpPfapDepayTest() override {
-    if (bus_) {
-      gst_bus_set_flushing(bus_, TRUE);  // its messages hold the element
-      gst_object_unref(bus_);
-    }
-    gst_harness_teardown(h_);
-  }
+  RtpPfapDepayTest() : ElementHarness("rtppfapdepay") {}
   void SetUp() override { gst_harness_set_src_caps_str(h_, kCaps); }
 
   // The element's messages, which the harness alone would drop.
-  GstBus* watch_bus() {
-    bus_ = gst_bus_new();
-    gst_element_set_bus(h_->element, bus_);
-    return bus_;
-  }
-
-  GstHarness* h_;
-  GstBus* bus_ = nullptr;
+  GstBus* watch_bus() { return bus_; }
+  // The tests' stat(h, field), which the fixture's own stat(field) would hide.
+  using ElementHarness::stat;
+  static guint64 stat(GstHarness* h, const char* field) { return pfap::stat(h, field); }
 };
 
 TEST_F(RtpPfapDepayTest, EachPhonemeBecomesABufferWithItsFapsAndTime) {
@@ -221,6 +206,24 @@ TEST_F(RtpPfapDepayTest, EachPhonemeBecomesABufferWithItsFapsAndTime) {
   EXPECT_EQ(stat(h_, "packets"), 2u);  // with the complete state
   EXPECT_EQ(stat(h_, "phonemes"), 3u);
   EXPECT_EQ(stat(h_, "faps"), 3u);
+}
+
+TEST_F(RtpPfapDepayTest, PacketWithOnlyADtsTimesEveryPhonemeFromIt) {
+  // pcapparse gives each packet a DTS and no PTS.
+  const Phoneme a{.symbol = 42, .duration_ms = 100, .f0 = 60};
+  const Phoneme b{.symbol = 7, .duration_ms = 80, .f0 = 255};
+  Packet packet;
+  packet.add_phoneme(a, {});
+  packet.add_phoneme(b, {});
+  const GstClockTime t = 2 * GST_SECOND;
+  start_stream(h_, 0, t);
+  GstBuffer* buffer = rtp_packet(encode(packet), 1, t);
+  GST_BUFFER_PTS(buffer) = GST_CLOCK_TIME_NONE;
+  GST_BUFFER_DTS(buffer) = t;
+  const std::vector<Event> got = push(h_, buffer);
+  ASSERT_EQ(got.size(), 2u);
+  EXPECT_EQ(got[0].pts, t);
+  EXPECT_EQ(got[1].pts, t + 100 * GST_MSECOND);
 }
 
 TEST_F(RtpPfapDepayTest, SentenceStartComesOnlyFromTheMarkerBitOnTheFirstPhoneme) {

@@ -13,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "element_harness.h"
 #include "pfap/markup.h"
 #include "pfap/packetizer.h"
 #include "pfap/payload.h"
@@ -65,27 +66,15 @@ std::vector<Input> sentence(GstClockTime start, int count, uint16_t duration_ms,
   return inputs;
 }
 
-class Payloader {
+class Payloader : public pfap::testing::ElementHarness {
  public:
   // `downstream` restricts the caps the payloader may send (e.g. a clock-rate), as a
   // capsfilter after it would.
   explicit Payloader(const char* input_caps = PFAP_MARKUP_CAPS, const char* downstream = nullptr)
-      : h_(gst_harness_new("rtppfappay")), bus_(gst_bus_new()) {
-    gst_element_set_bus(h_->element, bus_);
+      : ElementHarness("rtppfappay") {
     if (downstream != nullptr) gst_harness_set_sink_caps_str(h_, downstream);
     gst_harness_set_src_caps_str(h_, input_caps);
   }
-  ~Payloader() {
-    gst_harness_teardown(h_);
-    gst_bus_set_flushing(bus_, TRUE);  // its messages hold the element
-    gst_object_unref(bus_);
-  }
-  Payloader(const Payloader&) = delete;
-  Payloader& operator=(const Payloader&) = delete;
-
-  GstHarness* harness() { return h_; }
-  GstElement* element() { return h_->element; }
-  GstBus* bus() { return bus_; }
 
   void push(GstBuffer* buffer) { ASSERT_EQ(gst_harness_push(h_, buffer), GST_FLOW_OK); }
   void push(const Input& in) {
@@ -133,15 +122,6 @@ class Payloader {
   // An event sent upstream into the payloader's src pad, as a downstream element would.
   bool push_upstream(GstEvent* event) { return gst_harness_push_upstream_event(h_, event); }
 
-  guint64 stat(const char* field) {
-    GstStructure* stats = nullptr;
-    g_object_get(h_->element, "stats", &stats, nullptr);
-    guint64 value = G_MAXUINT64;
-    EXPECT_TRUE(gst_structure_get_uint64(stats, field, &value)) << field;
-    gst_structure_free(stats);
-    return value;
-  }
-
   // The GError of the next warning posted, or nullptr (the caller frees it).
   GError* pop_warning() {
     GstMessage* message = gst_bus_pop_filtered(bus_, GST_MESSAGE_WARNING);
@@ -161,10 +141,6 @@ class Payloader {
     gst_caps_unref(caps);
     return result;
   }
-
- private:
-  GstHarness* h_;
-  GstBus* bus_;
 };
 
 // The phonemes of `packets` in order, each with its FAPs.
@@ -446,45 +422,39 @@ TEST(RtpPfapPay, MaxDelayChangeAsksThePipelineToRecomputeLatency) {
   gst_message_unref(message);
 }
 
-TEST(RtpPfapPay, EosSendsThePendingPacket) {
+// Each event after which no later phoneme may join the pending packet.
+struct DrainingEvent {
+  const char* name;
+  GstEvent* (*make)();
+};
+
+class RtpPfapPayDrain : public ::testing::TestWithParam<DrainingEvent> {};
+
+TEST_P(RtpPfapPayDrain, EventSendsThePendingPacket) {
   Payloader pay;
   g_object_set(pay.element(), "max-delay", 5000u, nullptr);
   const std::vector<Input> inputs = sentence(0, 3, 40, false);
   pay.push(inputs);
   EXPECT_EQ(gst_harness_buffers_received(pay.harness()), 0u);
-  pay.push_event(gst_event_new_eos());
+  pay.push_event(GetParam().make());
 
   const std::vector<RtpPacket> packets = pay.pull_data();
   ASSERT_EQ(packets.size(), 1u);
   expect_same_phonemes(inputs, received(packets));
 }
 
-TEST(RtpPfapPay, GapSendsThePendingPacket) {
-  Payloader pay;
-  g_object_set(pay.element(), "max-delay", 5000u, nullptr);
-  const std::vector<Input> inputs = sentence(0, 3, 40, false);
-  pay.push(inputs);
-  pay.push_event(gst_event_new_gap(120 * kMs, GST_SECOND));
-
-  const std::vector<RtpPacket> packets = pay.pull_data();
-  ASSERT_EQ(packets.size(), 1u);
-  expect_same_phonemes(inputs, received(packets));
-}
-
-TEST(RtpPfapPay, NewSegmentSendsThePendingPacket) {
-  Payloader pay;
-  g_object_set(pay.element(), "max-delay", 5000u, nullptr);
-  const std::vector<Input> inputs = sentence(0, 3, 40, false);
-  pay.push(inputs);
-  GstSegment segment;
-  gst_segment_init(&segment, GST_FORMAT_TIME);
-  segment.base = 10 * GST_SECOND;
-  pay.push_event(gst_event_new_segment(&segment));
-
-  const std::vector<RtpPacket> packets = pay.pull_data();
-  ASSERT_EQ(packets.size(), 1u);
-  expect_same_phonemes(inputs, received(packets));
-}
+INSTANTIATE_TEST_SUITE_P(
+    RtpPfapPay, RtpPfapPayDrain,
+    ::testing::Values(DrainingEvent{"Eos", [] { return gst_event_new_eos(); }},
+                      DrainingEvent{"Gap", [] { return gst_event_new_gap(120 * kMs, GST_SECOND); }},
+                      DrainingEvent{"NewSegment",
+                                    [] {
+                                      GstSegment segment;
+                                      gst_segment_init(&segment, GST_FORMAT_TIME);
+                                      segment.base = 10 * GST_SECOND;
+                                      return gst_event_new_segment(&segment);
+                                    }}),
+    [](const ::testing::TestParamInfo<DrainingEvent>& info) { return info.param.name; });
 
 TEST(RtpPfapPay, FlushDropsThePendingPacket) {
   Payloader pay;
@@ -561,6 +531,52 @@ TEST(RtpPfapPay, OversizedPhonemeStillGoesOutWithAWarning) {
   EXPECT_TRUE(g_error_matches(warning, GST_STREAM_ERROR, GST_STREAM_ERROR_ENCODE));
   g_error_free(warning);
   EXPECT_EQ(pay.pop_warning(), nullptr) << "one warning per oversized packet";
+}
+
+// Posted warnings, counted and taken off the bus.
+size_t count_warnings(Payloader& pay) {
+  size_t n = 0;
+  while (GError* warning = pay.pop_warning()) {
+    g_error_free(warning);
+    ++n;
+  }
+  return n;
+}
+
+TEST(RtpPfapPay, OversizedPhonemesAreWarnedAboutAtThe1st2nd4th8thAndAllCounted) {
+  Payloader pay;
+  g_object_set(pay.element(), "mtu", 28u, "max-delay", 0u, nullptr);  // 16-byte payloads
+  std::vector<Input> inputs = sentence(0, 100, 40, true);
+  // 23 bytes each; at 0 they leave the complete state empty, so only the data is too large.
+  for (Input& in : inputs) in.faps = {fap(3, 0), fap(4, 0), fap(5, 0)};
+  pay.push(inputs);
+  expect_same_phonemes(inputs, received(pay.pull_data()));
+  EXPECT_EQ(pay.stat("oversized"), 100u);
+  EXPECT_EQ(count_warnings(pay), 7u) << "the 1st, 2nd, 4th, ..., 64th";
+}
+
+TEST(RtpPfapPay, MalformedBuffersAreWarnedAboutAtThe1st2nd4th8thAndAllCounted) {
+  Payloader pay;
+  const guint8 garbage[] = {PFAP_EVENT_PHONEME, 0, 1, 60, 0, 40, 0, 3};  // 3 FAPs missing
+  for (int i = 0; i < 20; ++i) pay.push(gst_buffer_new_memdup(garbage, sizeof garbage));
+  EXPECT_EQ(pay.stat("malformed"), 20u);
+  EXPECT_EQ(count_warnings(pay), 5u) << "the 1st, 2nd, 4th, 8th and 16th";
+  EXPECT_EQ(gst_harness_buffers_received(pay.harness()), 0u);
+}
+
+TEST(RtpPfapPay, BackwardTimestampsSendNoMoreCompleteStatesThanForwardOnes) {
+  // 300 phonemes of 100 ms, one packet each, forward and in reverse time order: one complete
+  // state per second of speech either way (30), not one per packet.
+  for (const bool reversed : {false, true}) {
+    SCOPED_TRACE(reversed ? "reversed" : "forward");
+    Payloader pay;
+    g_object_set(pay.element(), "max-delay", 0u, nullptr);
+    std::vector<Input> inputs = sentence(0, 300, 100, false);
+    if (reversed) std::reverse(inputs.begin(), inputs.end());
+    pay.push(inputs);
+    EXPECT_EQ(pay.stat("packets"), 300u);
+    EXPECT_EQ(pay.stat("complete-recoveries"), 30u);
+  }
 }
 
 TEST(RtpPfapPay, StateEventsAreDroppedWithoutAWarning) {

@@ -80,10 +80,10 @@ std::vector<Fap> faps(size_t count, int seed = 0) {
 }
 
 PacketizerConfig config(size_t max_payload_size = 1388, int64_t max_delay_ns = 10 * kSecond) {
-  return {max_payload_size, max_delay_ns, kDefaultClockRate};
+  return {max_payload_size, max_delay_ns};
 }
 
-// Pushes `count` contiguous 1 ms phonemes with `fap_count` FAPs each, then flushes.
+// Pushes `count` contiguous 1 ms phonemes with `fap_count` FAPs each, then drains.
 std::vector<PlannedPacket> plan_uniform(const PacketizerConfig& cfg, size_t count,
                                         size_t fap_count) {
   Packetizer packetizer(cfg);
@@ -91,7 +91,7 @@ std::vector<PlannedPacket> plan_uniform(const PacketizerConfig& cfg, size_t coun
   for (size_t i = 0; i < count; ++i) {
     packetizer.push(phoneme_at(static_cast<int64_t>(i) * kMs, 1), faps(fap_count, int(i)), out);
   }
-  packetizer.flush(out);
+  packetizer.drain(out);
   return out;
 }
 
@@ -109,24 +109,14 @@ TEST(Packetizer, NewPacketTakesStartTimestampAndMarkerFromItsFirstPhoneme) {
   std::vector<PlannedPacket> out;
   packetizer.push(phoneme_at(2 * kSecond, 10, true), faps(2), out);
   packetizer.push(phoneme_at(2 * kSecond + 10 * kMs, 10), {}, out);
-  packetizer.flush(out);
+  packetizer.drain(out);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].start_ns, 2 * kSecond);
-  EXPECT_EQ(out[0].rtp_timestamp, 2u * 44100);
   EXPECT_TRUE(out[0].marker);
   EXPECT_FALSE(out[0].oversized);
   EXPECT_EQ(out[0].packet.recovery_kind, RecoveryKind::kNone);
   EXPECT_TRUE(out[0].packet.recovery.empty());
   EXPECT_EQ(phoneme_counts(out), (std::vector<size_t>{2}));
-}
-
-TEST(Packetizer, RtpTimestampUsesConfiguredClockRate) {
-  Packetizer packetizer({1388, kSecond, 90000});
-  std::vector<PlannedPacket> out;
-  packetizer.push(phoneme_at(kSecond / 2, 10), {}, out);
-  packetizer.flush(out);
-  ASSERT_EQ(out.size(), 1u);
-  EXPECT_EQ(out[0].rtp_timestamp, 45000u);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -141,7 +131,7 @@ TEST(Packetizer, FapsNeverSplitFromTheirPhonemeAtAnySizeBoundary) {
       pushed.push_back(faps(static_cast<size_t>(i % 4), i));
       packetizer.push(phoneme_at(i * kMs, 1), pushed.back(), out);
     }
-    packetizer.flush(out);
+    packetizer.drain(out);
 
     size_t next = 0;
     for (const PlannedPacket& p : out) {
@@ -161,7 +151,7 @@ TEST(Packetizer, FapsNeverSplitFromTheirPhonemeAtAnySizeBoundary) {
 TEST(Packetizer, FlushWithNothingPendingAppendsNoEmptyPacket) {
   Packetizer packetizer(config());
   std::vector<PlannedPacket> out;
-  packetizer.flush(out);
+  packetizer.drain(out);
   EXPECT_TRUE(out.empty());
   EXPECT_FALSE(packetizer.has_pending());
 }
@@ -179,7 +169,7 @@ TEST(Packetizer, SentenceStartBeginsANewPacketWithMarker) {
   ASSERT_EQ(out.size(), 1u);  // completed by the sentence start, before it
   EXPECT_FALSE(out[0].marker);
   packetizer.push(phoneme_at(30 * kMs, 10), {}, out);
-  packetizer.flush(out);
+  packetizer.drain(out);
   ASSERT_EQ(out.size(), 2u);
   EXPECT_EQ(phoneme_counts(out), (std::vector<size_t>{2, 2}));
   EXPECT_TRUE(out[1].marker);
@@ -199,7 +189,7 @@ TEST(Packetizer, EndOfTextCompletesThePacketAtOnce) {
 
   // The next phoneme, contiguous or not, starts a packet of its own.
   packetizer.push(phoneme_at(20 * kMs, 10), {}, out);
-  packetizer.flush(out);
+  packetizer.drain(out);
   EXPECT_EQ(phoneme_counts(out), (std::vector<size_t>{2, 1}));
   EXPECT_FALSE(out[1].marker);
 }
@@ -221,7 +211,7 @@ TEST(Packetizer, GapStartsANewPacketWhileSubMillisecondJitterDoesNot) {
     std::vector<PlannedPacket> out;
     packetizer.push(phoneme_at(kSecond, 40), {}, out);
     packetizer.push(phoneme_at(kSecond + 40 * kMs + c.offset_ns, 40), {}, out);
-    packetizer.flush(out);
+    packetizer.drain(out);
     EXPECT_EQ(out.size(), c.packets) << "offset " << c.offset_ns << " ns";
   }
 }
@@ -232,7 +222,7 @@ TEST(Packetizer, ContiguityIsMeasuredFromTheFirstStartSoRoundingDoesNotAccumulat
   Packetizer packetizer(config());
   std::vector<PlannedPacket> out;
   for (int i = 0; i < 4; ++i) packetizer.push(phoneme_at(i * 10'400'000, 10), {}, out);
-  packetizer.flush(out);
+  packetizer.drain(out);
   EXPECT_EQ(phoneme_counts(out), (std::vector<size_t>{2, 2}));
 
   // Jitter around the first start plus the durations keeps one packet.
@@ -241,7 +231,7 @@ TEST(Packetizer, ContiguityIsMeasuredFromTheFirstStartSoRoundingDoesNotAccumulat
     const int64_t jitter_ns = i == 0 ? 0 : i % 2 ? 400'000 : -400'000;
     packetizer.push(phoneme_at(i * 10 * kMs + jitter_ns, 10), {}, out);
   }
-  packetizer.flush(out);
+  packetizer.drain(out);
   EXPECT_EQ(phoneme_counts(out), (std::vector<size_t>{8}));
 }
 
@@ -270,7 +260,7 @@ TEST(Packetizer, PacketCompletesAtOnceWhenItsSpanReachesMaxDelay) {
       start += d * kMs;
     }
     EXPECT_EQ(packetizer.has_pending(), !c.completed_at_once) << c.durations_ms.size();
-    packetizer.flush(out);
+    packetizer.drain(out);
     EXPECT_EQ(phoneme_counts(out), (std::vector<size_t>{c.durations_ms.size()}));
   }
 }
@@ -292,7 +282,7 @@ TEST(Packetizer, PhonemeStartingMaxDelayAfterThePacketStartBeginsANewPacket) {
     packetizer.push(phoneme_at(0, 99), {}, out);
     ASSERT_TRUE(packetizer.has_pending());
     packetizer.push(phoneme_at(c.next_start_ns, 10), {}, out);
-    packetizer.flush(out);
+    packetizer.drain(out);
     EXPECT_EQ(phoneme_counts(out), c.packets) << c.next_start_ns;
   }
 }
@@ -379,7 +369,7 @@ TEST(Packetizer, PhonemeWhoseFapsDoNotFitGoesAloneFlaggedOversized) {
   EXPECT_EQ(encoded_size(out[1].packet), 17u);
 
   packetizer.push(phoneme_at(20 * kMs, 10), {}, out);
-  packetizer.flush(out);
+  packetizer.drain(out);
   EXPECT_EQ(phoneme_counts(out), (std::vector<size_t>{1, 1, 1}));
   EXPECT_FALSE(out[2].oversized);
 }
@@ -400,15 +390,15 @@ TEST(Packetizer, FlushCompletesThePendingPacketOnce) {
   packetizer.push(phoneme_at(10 * kMs, 10), {}, out);
   EXPECT_TRUE(packetizer.has_pending());
   EXPECT_TRUE(out.empty());
-  packetizer.flush(out);
+  packetizer.drain(out);
   EXPECT_FALSE(packetizer.has_pending());
   EXPECT_EQ(phoneme_counts(out), (std::vector<size_t>{2}));
-  packetizer.flush(out);
+  packetizer.drain(out);
   EXPECT_EQ(out.size(), 1u);
 
   // The next phoneme is contiguous but starts a new packet.
   packetizer.push(phoneme_at(20 * kMs, 10), {}, out);
-  packetizer.flush(out);
+  packetizer.drain(out);
   EXPECT_EQ(phoneme_counts(out), (std::vector<size_t>{2, 1}));
   EXPECT_EQ(out[1].start_ns, 20 * kMs);
 }
@@ -417,14 +407,14 @@ TEST(Packetizer, ResetDropsThePendingPacket) {
   Packetizer packetizer(config());
   std::vector<PlannedPacket> out;
   packetizer.push(phoneme_at(0, 10, true), faps(3), out);
-  packetizer.reset();
+  packetizer.drop();
   EXPECT_FALSE(packetizer.has_pending());
-  packetizer.flush(out);
+  packetizer.drain(out);
   EXPECT_TRUE(out.empty());
 
   // Nothing of the dropped packet leaks into the next one.
   packetizer.push(phoneme_at(500 * kMs, 10), faps(1, 7), out);
-  packetizer.flush(out);
+  packetizer.drain(out);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].start_ns, 500 * kMs);
   EXPECT_FALSE(out[0].marker);
@@ -472,7 +462,6 @@ PacketizerConfig random_config(testing::RandomMarkup& rng) {
   cfg.max_payload_size =
       rng.chance(0.5) ? sizes[rng.uniform(0, 6)] : static_cast<size_t>(rng.uniform(1, 300));
   cfg.max_delay_ns = rng.uniform(0, 500) * kMs + rng.uniform(0, 999'999);
-  cfg.clock_rate = rng.chance(0.5) ? 44100 : 90000;
   return cfg;
 }
 
@@ -500,7 +489,7 @@ void check_session(const PacketizerConfig& cfg, const std::vector<Input>& sessio
     packetizer.push(session[i].phoneme, session[i].faps, out);
     completed_by.resize(out.size(), i);
   }
-  packetizer.flush(out);
+  packetizer.drain(out);
   completed_by.resize(out.size(), session.size());
 
   size_t next = 0;  // index into session
@@ -516,7 +505,6 @@ void check_session(const PacketizerConfig& cfg, const std::vector<Input>& sessio
     EXPECT_EQ(p.recovery_kind, RecoveryKind::kNone);
     EXPECT_TRUE(p.recovery.empty());
     EXPECT_EQ(planned.start_ns, first.phoneme.start_ns);
-    EXPECT_EQ(planned.rtp_timestamp, rtp_ticks(first.phoneme.start_ns, cfg.clock_rate));
     EXPECT_EQ(planned.marker, first.phoneme.sentence_start);
 
     const size_t size = encoded_size(p);

@@ -43,7 +43,7 @@ std::vector<SentPacket> send_session(uint32_t seed, int phonemes, unsigned depth
     packetizer.push({t, p, i == 0 || random.chance(0.02)}, faps, planned);
     t += p.duration_ms * kNsPerMs + (p.end_of_text ? 300 * kNsPerMs : 0);
   }
-  packetizer.flush(planned);
+  packetizer.drain(planned);
 
   std::vector<SentPacket> sent;
   const auto send = [&](Packet packet, int64_t time_ns) {

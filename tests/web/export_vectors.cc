@@ -438,7 +438,7 @@ int export_recovery() {
     for (const auto& p : session) {
       packetizer.push({p.start_ns, p.phoneme, p.sentence_start}, p.faps, planned);
     }
-    packetizer.flush(planned);
+    packetizer.drain(planned);
 
     pfap::RecoverySender sender(s.depth);
     pfap::RecoveryReceiver receiver;

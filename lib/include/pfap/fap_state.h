@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 
 #include "pfap/model.h"
 
@@ -39,6 +40,9 @@ class FapState {
   Fap recovery_entry(int index, int64_t time_ns) const;
   // Every FAP back to 0 with no transition running, as after construction.
   void reset();
+  // Takes a complete state (C=1) at `time_ns`: every FAP not among `entries` is 0, so the
+  // state is reset, then each entry applied.
+  void apply_complete(std::span<const Fap> entries, int64_t time_ns);
 
  private:
   struct Track {

@@ -10,9 +10,13 @@
 //    alone do not fit, which goes alone and is flagged `oversized`;
 //  - no phoneme waits longer than max_delay_ns of stream time for its packet: a phoneme
 //    joins a packet only if it starts less than max_delay_ns after the packet's first one,
-//    and a packet whose phonemes reach max_delay_ns is complete at once. After a gap the
-//    pending packet waits for the next push or a flush(), so a live caller flushes on a
+//    and a packet whose phonemes reach max_delay_ns is finished at once. After a gap the
+//    pending packet waits for the next push or a drain(), so a live caller drains on a
 //    timer.
+//
+// Words: a packet is "finished" when no phoneme may join it and it moves to the output;
+// drain() finishes the pending packet, drop() forgets it. "Complete" means only complete
+// recovery (C=1), which pfap::Sender adds.
 #pragma once
 
 #include <cstddef>
@@ -34,7 +38,6 @@ uint32_t rtp_ticks(int64_t time_ns, uint32_t clock_rate);
 struct PacketizerConfig {
   size_t max_payload_size = 1400 - 12;  // GStreamer's default MTU less the RTP header
   int64_t max_delay_ns = 100'000'000;
-  uint32_t clock_rate = kDefaultClockRate;
 };
 
 struct TimedPhoneme {
@@ -45,7 +48,6 @@ struct TimedPhoneme {
 
 struct PlannedPacket {
   int64_t start_ns = 0;        // the first phoneme's start
-  uint32_t rtp_timestamp = 0;  // start_ns on the configured clock
   bool marker = false;         // the first phoneme starts a sentence
   bool oversized = false;      // one phoneme with more FAPs than max_payload_size holds
   Packet packet;
@@ -55,13 +57,14 @@ class Packetizer {
  public:
   explicit Packetizer(const PacketizerConfig& config);
 
-  // Adds a phoneme and the FAPs that start with it; appends any packets it completes.
+  // Adds a phoneme and the FAPs that start with it; appends any packets it finishes.
   void push(const TimedPhoneme& phoneme, std::span<const Fap> faps,
             std::vector<PlannedPacket>& out);
-  // Completes the pending packet, if any (EOS, or a caller-side timeout).
-  void flush(std::vector<PlannedPacket>& out);
-  // Drops the pending packet (FLUSH).
-  void reset();
+  // Finishes the pending packet, if any, and appends it: no later phoneme may join it (EOS,
+  // GAP, or a caller-side timeout).
+  void drain(std::vector<PlannedPacket>& out);
+  // Forgets the pending packet (GStreamer's FLUSH).
+  void drop();
 
   bool has_pending() const { return !pending_.packet.phonemes.empty(); }
   const PacketizerConfig& config() const { return config_; }

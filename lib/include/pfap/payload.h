@@ -52,6 +52,19 @@ struct Packet {
   void add_phoneme(const Phoneme& phoneme, std::span<const Fap> faps_before);
   // The FAPs that start with phonemes[i].
   std::span<const Fap> faps_of(size_t i) const;
+  // The phonemes' total duration: the packet's time to the last phoneme's end.
+  int64_t duration_ns() const;
+  // Calls f(i, start_ns) for each phoneme i in order, start_ns being where it starts when the
+  // packet's time (its first phoneme's start) is `time_ns`: phonemes follow one another.
+  // Returns where the last one ends.
+  template <typename F>
+  int64_t for_each_phoneme(int64_t time_ns, F&& f) const {
+    for (size_t i = 0; i < phonemes.size(); ++i) {
+      f(i, time_ns);
+      time_ns += int64_t{phonemes[i].phoneme.duration_ms} * kNsPerMs;
+    }
+    return time_ns;
+  }
 };
 
 // Every class of bad payload the decoder tells apart.

@@ -47,15 +47,16 @@ class RecoverySender {
 
   void reset();
 
-  // A FAP a packet bookmarked, kept while the packet is within the depth.
-  struct Bookmark {
+  // A FAP a sent packet bookmarked, with its start, kept while the packet is within the
+  // depth.
+  struct SentFap {
     Fap fap;
     int64_t start_ns;
   };
 
  private:
   unsigned depth_;
-  std::vector<std::vector<Bookmark>> window_;  // the last `depth` packets, oldest first
+  std::vector<std::vector<SentFap>> window_;  // the last `depth` packets, oldest first
   // The window holds every packet since the stream began: there is nothing older to cover.
   bool whole_history_ = true;
   FapState state_;

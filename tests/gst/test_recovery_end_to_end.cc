@@ -46,7 +46,9 @@
 #include "pfap/fap_state.h"
 #include "pfap/markup.h"
 #include "pfap/model.h"
+#include "live_source.h"
 #include "pfap_buffers.h"
+#include "rtpbin_sessions.h"
 #include "pipeline.h"
 #include "speech_session.h"
 
@@ -135,17 +137,16 @@ using pfap::testing::bound_port;
 using pfap::testing::fast_rtcp;
 using pfap::testing::Pipeline;
 using pfap::testing::plugin_available;
+using pfap::testing::push_live;
+using pfap::testing::rtpbin_receive_session;
+using pfap::testing::rtpbin_send_session;
 
 GstFlowReturn push(GstElement* appsrc, const Event& e) {
-  return pfap::testing::push(
-      appsrc, pfap::testing::phoneme_buffer(e.phoneme, e.faps, e.pts,
-                                            (e.flags & PFAP_FLAG_SENTENCE_START) != 0));
+  return pfap::testing::push(appsrc, pfap::testing::phoneme_buffer(e));
 }
 
 GstFlowReturn push_harness(GstHarness* h, const Event& e) {
-  return gst_harness_push(h,
-                          pfap::testing::phoneme_buffer(e.phoneme, e.faps, e.pts,
-                                                        (e.flags & PFAP_FLAG_SENTENCE_START) != 0));
+  return gst_harness_push(h, pfap::testing::phoneme_buffer(e));
 }
 
 // Whether an RTP packet is a complete recovery (C = 1 in the payload's first byte).
@@ -219,22 +220,6 @@ GstCaps* on_request_pt_map(GstElement*, guint, guint pt, gpointer) {
   return pt == 97 ? gst_caps_from_string(kReceiveCaps) : nullptr;
 }
 
-// Pushes each phoneme when the pipeline's running time reaches its start, as a live TTS
-// source would.
-void push_live(GstElement* appsrc, GstClock* clock, GstClockTime base_time,
-               const std::vector<Event>& events, const std::atomic<bool>& stop) {
-  for (const Event& e : events) {
-    for (;;) {
-      if (stop) return;
-      const GstClockTime now = gst_clock_get_time(clock);
-      if (now >= base_time + e.pts) break;
-      const GstClockTime wait = std::min<GstClockTime>(base_time + e.pts - now, 20 * GST_MSECOND);
-      std::this_thread::sleep_for(std::chrono::nanoseconds(wait));
-    }
-    if (push(appsrc, e) != GST_FLOW_OK) return;
-  }
-}
-
 TEST(RecoveryLoop, PliBringsACompleteStateAfterALongBurst) {
   ASSERT_TRUE(plugin_available(kElements));
   // About 4 s of speech from 300 ms on; nearly every phoneme moves a FAP, so the burst surely
@@ -249,24 +234,16 @@ TEST(RecoveryLoop, PliBringsACompleteStateAfterALongBurst) {
   record.drop_to = 17;
   std::atomic<int> force_key_units{0};
 
-  Pipeline receiver(std::string("rtpbin name=rtpbin rtp-profile=avpf "
-                                "udpsrc name=rtp address=127.0.0.1 port=0 caps=\"") +
-                    kReceiveCaps +
-                    "\" ! rtpbin.recv_rtp_sink_0 "
-                    "udpsrc name=rtcp address=127.0.0.1 port=0 ! rtpbin.recv_rtcp_sink_0 "
-                    "rtpbin.send_rtcp_src_0 ! udpsink name=rr host=127.0.0.1 sync=false "
-                    "async=false "
+  Pipeline receiver("rtpbin name=rtpbin rtp-profile=avpf " +
+                    rtpbin_receive_session(0, "", kReceiveCaps) +
                     "rtpbin. ! rtppfapdepay name=depay ! appsink name=sink sync=false "
                     "emit-signals=true");
   ASSERT_TRUE(receiver.ok()) << receiver.error();
-  Pipeline sender(
-      "rtpbin name=rtpbin rtp-profile=avpf "
-      "appsrc name=src is-live=true format=time caps=application/x-pfap "
-      "! rtppfappay name=pay pt=97 recovery-depth=1 complete-recovery-interval=0 "
-      "! rtpbin.send_rtp_sink_0 "
-      "rtpbin.send_rtp_src_0 ! udpsink name=rtp host=127.0.0.1 sync=false async=false "
-      "rtpbin.send_rtcp_src_0 ! udpsink name=rtcp host=127.0.0.1 sync=false async=false "
-      "udpsrc name=rr address=127.0.0.1 port=0 ! rtpbin.recv_rtcp_sink_0");
+  Pipeline sender("rtpbin name=rtpbin rtp-profile=avpf " +
+                  rtpbin_send_session(0, "",
+                                      "appsrc name=src is-live=true format=time "
+                                      "caps=application/x-pfap ! rtppfappay name=pay pt=97 "
+                                      "recovery-depth=1 complete-recovery-interval=0"));
   ASSERT_TRUE(sender.ok()) << sender.error();
 
   GstElement* receiver_rtpbin = receiver.by_name("rtpbin");
