@@ -21,6 +21,7 @@ constexpr int64_t kMaxTimeMs = INT64_MAX / kNsPerMs - kMaxPhonemeDurationMs;
 static_assert(kMaxTimeMs < kSaturatedMagnitude);
 
 constexpr std::string_view kStateKeyword = "state";
+constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";  // U+FEFF in UTF-8
 constexpr std::string_view kRecovered = "recovered";
 constexpr std::string_view kComplete = "complete";
 // The flag letters in the order they must appear, and what each one sets.
@@ -156,7 +157,10 @@ TextResult TextReader::read_line(std::string_view line, TextEvent& out, bool& ha
   // No field contains '#', so a comment starts at the first one wherever it is.
   const std::string_view content = line.substr(0, line.find('#'));
 
-  size_t pos = 0;
+  // Editors on Windows start UTF-8 files with a byte order mark; it is no field. Skipping it
+  // in place keeps every column a byte offset in the line as given.
+  size_t pos = first_line_ && content.starts_with(kByteOrderMark) ? kByteOrderMark.size() : 0;
+  first_line_ = false;
   const Field time = next_field(content, pos);
   if (time.text.empty()) return {};  // blank or comment line
 

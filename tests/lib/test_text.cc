@@ -84,6 +84,35 @@ void expect_errors(std::initializer_list<ErrorCase> cases) {
   }
 }
 
+TEST(ReadLine, SkipsAByteOrderMarkOnlyAtTheStartOfTheFirstLine) {
+  constexpr std::string_view kBom = "\xEF\xBB\xBF";
+  TextReader reader;
+  TextEvent out;
+  bool has_event = false;
+  ASSERT_TRUE(reader.read_line(std::string(kBom) + "120 17 85 200 SW", out, has_event).ok());
+  ASSERT_TRUE(has_event);
+  EXPECT_EQ(out.time_ms, 120);
+  EXPECT_EQ(out.event.phoneme.symbol, 17);
+
+  // Later lines: a byte order mark is a bad time, at column 0 of the line as given.
+  const TextResult later = reader.read_line(std::string(kBom) + "200 17 85 200 -", out, has_event);
+  EXPECT_EQ(later.status, TextStatus::kBadTime);
+  EXPECT_EQ(later.column, 0u);
+
+  // A comment line first takes the mark too; errors after it count its bytes.
+  TextReader commented;
+  ASSERT_TRUE(commented.read_line(std::string(kBom) + "# a session", out, has_event).ok());
+  EXPECT_FALSE(has_event);
+  TextReader bad;
+  const TextResult result = bad.read_line(std::string(kBom) + "12 x 85 200 -", out, has_event);
+  EXPECT_EQ(result.status, TextStatus::kBadSymbol);
+  EXPECT_EQ(result.column, kBom.size() + 3);
+
+  // After reset() the next line is a first line again.
+  reader.reset();
+  EXPECT_TRUE(reader.read_line(std::string(kBom) + "0 1 10 0 -", out, has_event).ok());
+}
+
 TEST(ReadLine, PhonemeFieldsGoToTheirPlaces) {
   TextReader reader;
   TextEvent out;

@@ -54,6 +54,8 @@ class TextReader {
  public:
   // Parses one line, without its line end. Blank and comment lines give kOk with `has_event`
   // false. On error nothing is kept from the line (it may be skipped and reading go on).
+  // A UTF-8 byte order mark at the start of the stream's first line is skipped (columns
+  // still count its 3 bytes).
   TextResult read_line(std::string_view line, TextEvent& out, bool& has_event);
   // Back to the start of a stream.
   void reset();
@@ -61,6 +63,7 @@ class TextReader {
  private:
   int64_t last_time_ms_ = 0;
   bool next_starts_sentence_ = true;
+  bool first_line_ = true;  // where a byte order mark may be
 };
 
 // Appends the canonical line of `event` (no line end): integers separated by one space, f0
