@@ -132,6 +132,27 @@ static void send_events(GstPfapParse* self) {
   gst_pad_push_event(self->srcpad, gst_event_new_segment(&segment));
 }
 
+// Where the text comes from, for messages: ` of file "PATH"` when upstream reads a file
+// (filesrc answers the URI query), ` of "URI"` for another URI, else nothing (appsrc, fdsrc).
+static std::string source_name(GstPfapParse* self) {
+  std::string name;
+  GstQuery* query = gst_query_new_uri();
+  gchar* uri = nullptr;
+  if (gst_pad_peer_query(self->sinkpad, query)) gst_query_parse_uri(query, &uri);
+  gst_query_unref(query);
+  if (uri == nullptr) return name;
+  if (gchar* path = g_filename_from_uri(uri, nullptr, nullptr)) {
+    gchar* display = g_filename_display_name(path);
+    name = std::string(" of file \"") + display + "\"";
+    g_free(display);
+    g_free(path);
+  } else {
+    name = std::string(" of \"") + uri + "\"";
+  }
+  g_free(uri);
+  return name;
+}
+
 // A line that cannot be read: an error, or with skip-bad-lines a warning and reading goes on.
 // `column` is a byte offset in the line.
 static GstFlowReturn bad_line(GstPfapParse* self, size_t column, const std::string& what) {
@@ -139,17 +160,18 @@ static GstFlowReturn bad_line(GstPfapParse* self, size_t column, const std::stri
   const bool skip = self->skip_bad_lines;
   GST_OBJECT_UNLOCK(self);
   const uint64_t line = self->stream->line;
+  const std::string source = source_name(self);
   if (skip) {
     GST_ELEMENT_WARNING(self, STREAM, DECODE,
-                        ("Skipped .pfap line %" G_GUINT64_FORMAT ", column %zu: %s", line,
-                         column + 1, what.c_str()),
+                        ("Skipped .pfap line %" G_GUINT64_FORMAT ", column %zu%s: %s", line,
+                         column + 1, source.c_str(), what.c_str()),
                         (nullptr));
     return GST_FLOW_OK;
   }
-  GST_ELEMENT_ERROR(
-      self, STREAM, DECODE,
-      ("Bad .pfap line %" G_GUINT64_FORMAT ", column %zu: %s", line, column + 1, what.c_str()),
-      ("set skip-bad-lines to warn and go on"));
+  GST_ELEMENT_ERROR(self, STREAM, DECODE,
+                    ("Bad .pfap line %" G_GUINT64_FORMAT ", column %zu%s: %s", line, column + 1,
+                     source.c_str(), what.c_str()),
+                    ("set skip-bad-lines to warn and go on"));
   return GST_FLOW_ERROR;
 }
 
