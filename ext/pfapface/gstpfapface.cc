@@ -76,6 +76,7 @@ struct Stream {
   uint64_t frame = 0;          // the next frame's number since the output segment's start
   int64_t covered_until = -1;  // running time up to which a GAP said no markup comes
   bool warned_mouth = false;   // the warning for phonemes without a mouth shape was posted
+  bool untimed_input = false;  // a segment not in TIME came: an error was posted
   pfap::MarkupEvent event;     // reused, so that steady streaming does not allocate
 };
 
@@ -135,6 +136,7 @@ static void reset(GstPfapFace* self) {
   s.frame = 0;
   s.covered_until = -1;
   s.warned_mouth = false;
+  s.untimed_input = false;
   GstAggregatorPad* srcpad = GST_AGGREGATOR_PAD(GST_AGGREGATOR_SRC_PAD(self));
   GST_OBJECT_LOCK(self);
   srcpad->segment.position = GST_CLOCK_TIME_NONE;
@@ -228,6 +230,7 @@ static GstFlowReturn push_frame(GstPfapFace* self, GstClockTime pts, GstClockTim
 static GstFlowReturn gst_pfap_face_aggregate(GstAggregator* agg, gboolean timeout) {
   GstPfapFace* self = GST_PFAP_FACE(agg);
   Stream& s = *self->stream;
+  if (s.untimed_input) return GST_FLOW_ERROR;
   if (!s.negotiated) return GST_FLOW_NOT_NEGOTIATED;
 
   for (;;) {
@@ -290,6 +293,22 @@ static gboolean gst_pfap_face_sink_event(GstAggregator* agg, GstAggregatorPad* p
     case GST_EVENT_STREAM_START:
       reset(self);
       break;
+    case GST_EVENT_SEGMENT: {
+      // Bytes (filesrc without pfapparse) have no times to draw at.
+      const GstSegment* segment;
+      gst_event_parse_segment(event, &segment);
+      if (segment->format != GST_FORMAT_TIME) {
+        self->stream->untimed_input = true;
+        GST_ELEMENT_ERROR(self, STREAM, WRONG_TYPE,
+                          ("The input is not a timed PFAP stream: read .pfap files through "
+                           "pfapparse (filesrc ! pfapparse ! pfapface)."),
+                          ("%s segment: x-pfap streams have TIME segments",
+                           gst_format_get_name(segment->format)));
+        gst_event_unref(event);
+        return FALSE;
+      }
+      break;
+    }
     default:
       break;
   }
