@@ -83,6 +83,11 @@ namespace {
 // Below rtpbin's default jitterbuffer latency of 200 ms, so a live receiver still gets each
 // phoneme in time to show it in lip sync with the audio.
 constexpr guint kDefaultMaxDelayMs = 100;
+// The property ranges: a minute's wait is far past any use (the element adds it to its
+// latency), an hour between complete states far past any recovery; a negative number given
+// to gst-launch reads as a huge one and is refused, not taken.
+constexpr guint kMaxMaxDelayMs = 60'000;
+constexpr guint kMaxCompleteIntervalMs = 3'600'000;
 // A burst of up to 4 lost packets (400 ms of speech in 100 ms packets) needs no complete
 // state, for 6 bytes per FAP still in effect in the 4 packets before.
 constexpr guint kDefaultRecoveryDepth = 4;
@@ -626,7 +631,7 @@ static void gst_rtp_pfap_pay_class_init(GstRtpPfapPayClass* klass) {
       g_param_spec_uint("max-delay", "Maximum delay",
                         "Longest a phoneme waits for its packet, in ms of stream time "
                         "(0 = one packet per phoneme)",
-                        0, G_MAXUINT, kDefaultMaxDelayMs,
+                        0, kMaxMaxDelayMs, kDefaultMaxDelayMs,
                         static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
                                                  GST_PARAM_MUTABLE_PLAYING)));
 
@@ -670,7 +675,7 @@ static void gst_rtp_pfap_pay_class_init(GstRtpPfapPayClass* klass) {
       g_param_spec_uint("complete-recovery-interval", "Complete recovery interval",
                         "Stream time between complete-recovery packets, in ms (0 = only at the "
                         "start of a stream and on request)",
-                        0, G_MAXUINT, kDefaultCompleteIntervalMs,
+                        0, kMaxCompleteIntervalMs, kDefaultCompleteIntervalMs,
                         static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
                                                  GST_PARAM_MUTABLE_PLAYING)));
 

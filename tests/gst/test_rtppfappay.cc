@@ -17,6 +17,7 @@
 #include "pfap/packetizer.h"
 #include "pfap/payload.h"
 #include "pfap/recovery.h"
+#include "glib_log.h"
 #include "pfap_buffers.h"
 
 namespace {
@@ -226,10 +227,31 @@ TEST(RtpPfapPay, MaxDelayPropertyIsDocumentedAndDefaultsTo100Ms) {
   const GParamSpecUInt* spec = G_PARAM_SPEC_UINT(pspec);
   EXPECT_EQ(spec->default_value, 100u);
   EXPECT_EQ(spec->minimum, 0u);
-  EXPECT_EQ(spec->maximum, G_MAXUINT);
+  EXPECT_EQ(spec->maximum, 60000u);
   guint max_delay = 0;
   g_object_get(element, "max-delay", &max_delay, nullptr);
   EXPECT_EQ(max_delay, 100u);
+  gst_object_unref(element);
+}
+
+// gst-launch reads max-delay=-5 as 4294967291: the range refuses it (GObject warns) and the
+// value stays.
+TEST(RtpPfapPay, NegativeOrHugeMsPropertiesAreRefusedByTheirRange) {
+  GstElement* element = gst_element_factory_make("rtppfappay", nullptr);
+  ASSERT_NE(element, nullptr);
+  for (const char* name : {"max-delay", "complete-recovery-interval"}) {
+    guint before = 0;
+    g_object_get(element, name, &before, nullptr);
+    {
+      pfap::testing::GlibLogCounter log;
+      gst_util_set_object_arg(G_OBJECT(element), name, "-5");
+      EXPECT_EQ(log.count(), 1) << name;
+      EXPECT_NE(log.first().find("out of range"), std::string::npos) << log.first();
+    }
+    guint after = 0;
+    g_object_get(element, name, &after, nullptr);
+    EXPECT_EQ(after, before) << name;
+  }
   gst_object_unref(element);
 }
 
@@ -344,7 +366,7 @@ class RtpPfapPayMtu : public ::testing::TestWithParam<guint> {};
 TEST_P(RtpPfapPayMtu, PacketsFitTheMtuAndKeepPhonemesInOrderWithTheirFaps) {
   const guint mtu = GetParam();
   Payloader pay;
-  g_object_set(pay.element(), "mtu", mtu, "max-delay", G_MAXUINT, nullptr);
+  g_object_set(pay.element(), "mtu", mtu, "max-delay", 60000u, nullptr);
   // Every other phoneme has a FAP: a phoneme and its FAP fit even the smallest MTU.
   std::vector<Input> inputs = sentence(0, 30, 20, true);
   for (size_t i = 0; i < inputs.size(); i += 2) {
