@@ -127,7 +127,10 @@ static GstStaticPadTemplate src_template = GST_STATIC_PAD_TEMPLATE(
                     "pixel-aspect-ratio = (fraction) 1/1"));
 
 G_DEFINE_TYPE(GstPfapFace, gst_pfap_face, GST_TYPE_AGGREGATOR)
-GST_ELEMENT_REGISTER_DEFINE(pfapface, "pfapface", GST_RANK_NONE, GST_TYPE_PFAP_FACE)
+// Codec/Decoder/Video with a rank: decodebin (playbin, uridecodebin) plugs it to show an
+// application/x-pfap stream, the only caps it takes. SECONDARY leaves PRIMARY to a renderer
+// an application prefers (docs/elements.md, "Playing a stream").
+GST_ELEMENT_REGISTER_DEFINE(pfapface, "pfapface", GST_RANK_SECONDARY, GST_TYPE_PFAP_FACE)
 
 // The neutral face and the first frame again (start, flush, new stream).
 static void reset(GstPfapFace* self) {
@@ -473,7 +476,7 @@ static void gst_pfap_face_class_init(GstPfapFaceClass* klass) {
   gst_element_class_add_static_pad_template_with_gtype(element_class, &src_template,
                                                        GST_TYPE_AGGREGATOR_PAD);
   gst_element_class_set_static_metadata(
-      element_class, "PFAP talking head", "Generator/Video",
+      element_class, "PFAP talking head", "Codec/Decoder/Video",
       "Draws a talking head moved by phoneme and facial animation parameter (PFAP) markup",
       "gst-pfap developers");
 

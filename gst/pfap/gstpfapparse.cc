@@ -23,7 +23,8 @@
  * error naming its line, its column (in bytes, from 1) and what is wrong; with
  * #GstPfapParse:skip-bad-lines it is a warning instead, and the lines after it are read as
  * usual. Input that arrives from sources without caps (filesrc, fdsrc) is taken as .pfap
- * text; caps, when given, must be text/x-raw,format=utf8 or text/plain.
+ * text; caps, when given, must be text/x-pfap (the typefinder's, for decodebin) or
+ * text/x-raw,format=utf8.
  *
  * Seeking is not supported: the text must be read from its start, as times and sentence
  * starts depend on the lines before. A flush starts the text anew: the next line is line 1,
@@ -46,6 +47,7 @@
 
 #include "pfap/model.h"
 #include "pfap/text.h"
+#include "gstpfaptypefind.h"
 #include "pfapbuffer.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapparse_debug);
@@ -82,15 +84,18 @@ struct _GstPfapParse {
 };
 
 // No caps from filesrc and fdsrc: the template only matters to sources that send caps.
+// Not text/plain: decodebin would plug the parser into every text file it meets; the
+// typefinder gives .pfap text its own type.
 static GstStaticPadTemplate sink_template =
     GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS,
-                            GST_STATIC_CAPS("text/x-raw, format = (string) utf8; text/plain"));
+                            GST_STATIC_CAPS(PFAP_TEXT_CAPS "; text/x-raw, format = (string) utf8"));
 
 static GstStaticPadTemplate src_template =
     GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
 
 G_DEFINE_TYPE(GstPfapParse, gst_pfap_parse, GST_TYPE_ELEMENT)
-GST_ELEMENT_REGISTER_DEFINE(pfapparse, "pfapparse", GST_RANK_NONE, GST_TYPE_PFAP_PARSE)
+// A rank, so that decodebin plugs it for text/x-pfap (gst-play-1.0 file.pfap).
+GST_ELEMENT_REGISTER_DEFINE(pfapparse, "pfapparse", GST_RANK_SECONDARY, GST_TYPE_PFAP_PARSE)
 
 // Back to the start of a stream (READY to PAUSED, FLUSH_STOP).
 static void reset(GstPfapParse* self) {

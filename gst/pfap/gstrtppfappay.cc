@@ -142,14 +142,16 @@ struct _GstRtpPfapPay {
 GType gst_rtp_pfap_recovery_depth_get_type() {
   static gsize type = 0;
   static constexpr GEnumValue values[] = {
-      {0, "No dynamic recovery", "0"},
-      {1, "Recover a loss of the previous packet", "1"},
-      {2, "Recover losses within the previous 2 packets", "2"},
-      {4, "Recover losses within the previous 4 packets", "4"},
-      {7, "Recover losses within the previous 7 packets", "7"},
-      {15, "Recover losses within the previous 15 packets", "15"},
-      {25, "Recover losses within the previous 25 packets", "25"},
-      {40, "Recover losses within the previous 40 packets", "40"},
+      // Nicks are words; gst-launch also takes the number (recovery-depth=4), as GStreamer
+      // reads an enum from its name, its nick or its value.
+      {0, "No dynamic recovery", "none"},
+      {1, "Recover a loss of the previous packet", "1-packet"},
+      {2, "Recover losses within the previous 2 packets", "2-packets"},
+      {4, "Recover losses within the previous 4 packets", "4-packets"},
+      {7, "Recover losses within the previous 7 packets", "7-packets"},
+      {15, "Recover losses within the previous 15 packets", "15-packets"},
+      {25, "Recover losses within the previous 25 packets", "25-packets"},
+      {40, "Recover losses within the previous 40 packets", "40-packets"},
       {0, nullptr, nullptr},
   };
   // A coverage added to the library without a value here, or a typo, fails to build.
@@ -171,14 +173,18 @@ GType gst_rtp_pfap_recovery_depth_get_type() {
 static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
     "sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
 
+// The second structure shows the optional alphabet field (SDP fmtp) with the alphabet
+// pfaptts and the examples use; the first, which fixation picks, any other alphabet or none.
+#define PFAP_RTP_CAPS                                                                  \
+  "application/x-rtp, media = (string) application, payload = (int) [ 96, 127 ], " \
+  "clock-rate = (int) [ 1, 2147483647 ], encoding-name = (string) PFAP"
 static GstStaticPadTemplate src_template = GST_STATIC_PAD_TEMPLATE(
     "src", GST_PAD_SRC, GST_PAD_ALWAYS,
-    GST_STATIC_CAPS("application/x-rtp, media = (string) application, "
-                    "payload = (int) [ 96, 127 ], clock-rate = (int) [ 1, 2147483647 ], "
-                    "encoding-name = (string) PFAP"));
+    GST_STATIC_CAPS(PFAP_RTP_CAPS "; " PFAP_RTP_CAPS ", alphabet = (string) x-pfap-arpabet"));
 
 G_DEFINE_TYPE(GstRtpPfapPay, gst_rtp_pfap_pay, GST_TYPE_RTP_BASE_PAYLOAD)
-GST_ELEMENT_REGISTER_DEFINE(rtppfappay, "rtppfappay", GST_RANK_NONE, GST_TYPE_RTP_PFAP_PAY)
+// SECONDARY, as gst-plugins-good's payloaders: what picks a payloader by caps finds it.
+GST_ELEMENT_REGISTER_DEFINE(rtppfappay, "rtppfappay", GST_RANK_SECONDARY, GST_TYPE_RTP_PFAP_PAY)
 
 // Forgets the pending packet, the stream position and what was sent: the next data packet
 // starts a new stream, after a complete packet (state changes, FLUSH). Under the stream

@@ -4,6 +4,7 @@
 
 #include "gstpfapparse.h"
 #include "gstpfaptextenc.h"
+#include "gstpfaptypefind.h"
 #include "gstrtppfapdepay.h"
 #include "gstrtppfappay.h"
 
@@ -13,6 +14,7 @@ static gboolean plugin_init(GstPlugin* plugin) {
   ok &= GST_ELEMENT_REGISTER(rtppfapdepay, plugin);
   ok &= GST_ELEMENT_REGISTER(pfapparse, plugin);
   ok &= GST_ELEMENT_REGISTER(pfaptextenc, plugin);
+  ok &= GST_TYPE_FIND_REGISTER(pfap, plugin);
   return ok;
 }
 

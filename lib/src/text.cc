@@ -189,6 +189,22 @@ TextResult TextReader::read_line(std::string_view line, TextEvent& out, bool& ha
 
 void TextReader::reset() { *this = TextReader(); }
 
+size_t count_text_events(std::string_view head, bool whole) {
+  TextReader reader;
+  TextEvent event;
+  size_t events = 0;
+  while (!head.empty()) {
+    const size_t end = head.find('\n');
+    if (end == std::string_view::npos && !whole) break;  // cut where the head ends
+    const std::string_view line = head.substr(0, end);
+    bool has_event = false;
+    if (!reader.read_line(line, event, has_event).ok()) return 0;
+    events += has_event ? 1 : 0;
+    head.remove_prefix(end == std::string_view::npos ? head.size() : end + 1);
+  }
+  return events;
+}
+
 void format_text_line(const TextEvent& text_event, std::string& out) {
   const MarkupEvent& event = text_event.event;
   append_integer(text_event.time_ms, out);

@@ -703,7 +703,7 @@ TEST(RtpPfapPay, RecoveryPropertiesAreDocumentedWithTheirDefaults) {
   gst_object_unref(element);
 }
 
-TEST(RtpPfapPay, RecoveryDepthValuesAreZeroAndTheCoveragesPpCanSignalNamedByTheirNumber) {
+TEST(RtpPfapPay, RecoveryDepthValuesAreZeroAndTheCoveragesPpCanSignalWithWordNicks) {
   GstElement* element = gst_element_factory_make("rtppfappay", nullptr);
   GParamSpec* pspec = g_object_class_find_property(G_OBJECT_GET_CLASS(element), "recovery-depth");
   GEnumClass* enum_class = G_PARAM_SPEC_ENUM(pspec)->enum_class;
@@ -711,7 +711,10 @@ TEST(RtpPfapPay, RecoveryDepthValuesAreZeroAndTheCoveragesPpCanSignalNamedByThei
   for (guint i = 0; i < enum_class->n_values; ++i) {
     const GEnumValue& v = enum_class->values[i];
     values.push_back(v.value);
-    EXPECT_EQ(std::string(v.value_nick), std::to_string(v.value));
+    EXPECT_EQ(std::string(v.value_nick),
+              v.value == 0   ? std::string("none")
+              : v.value == 1 ? std::string("1-packet")
+                             : std::to_string(v.value) + "-packets");
     EXPECT_STRNE(v.value_name, v.value_nick) << "a descriptive name";
   }
   std::vector<int> expected{0};
@@ -732,6 +735,12 @@ TEST(RtpPfapPay, RecoveryDepthIsSetFromItsNumberAsAStringAndRefusesOtherNumbers)
   gst_util_set_object_arg(G_OBJECT(element), "recovery-depth", "3");  // PP cannot say 3
   g_object_get(element, "recovery-depth", &depth, nullptr);
   EXPECT_EQ(depth, 4);
+  gst_util_set_object_arg(G_OBJECT(element), "recovery-depth", "7-packets");
+  g_object_get(element, "recovery-depth", &depth, nullptr);
+  EXPECT_EQ(depth, 7);
+  gst_util_set_object_arg(G_OBJECT(element), "recovery-depth", "none");
+  g_object_get(element, "recovery-depth", &depth, nullptr);
+  EXPECT_EQ(depth, 0);
   gst_object_unref(element);
 }
 

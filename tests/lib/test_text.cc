@@ -113,6 +113,22 @@ TEST(ReadLine, SkipsAByteOrderMarkOnlyAtTheStartOfTheFirstLine) {
   EXPECT_TRUE(reader.read_line(std::string(kBom) + "0 1 10 0 -", out, has_event).ok());
 }
 
+TEST(CountTextEvents, CountsTheEventsOfWholeLinesOnly) {
+  constexpr std::string_view kText = "# hello\n\n0 12 80 120 SW\n80 state complete\n100 1 2";
+  EXPECT_EQ(count_text_events(kText, false), 2u) << "the cut last line is not read";
+  EXPECT_EQ(count_text_events(kText, true), 0u) << "whole, its last line is missing fields";
+  EXPECT_EQ(count_text_events("\xEF\xBB\xBF" "0 12 80 120 SW\r\n20 1 2 3 -", true), 2u);
+}
+
+TEST(CountTextEvents, IsZeroForOtherTextAndForCommentsOnly) {
+  EXPECT_EQ(count_text_events("Hello world.\nHow are you?\n", true), 0u);
+  EXPECT_EQ(count_text_events("1\n00:00:01,000 --> 00:00:02,000\nHi\n", true), 0u);  // SubRip
+  EXPECT_EQ(count_text_events("v=0\no=- 0 0 IN IP4 127.0.0.1\n", true), 0u);         // SDP
+  EXPECT_EQ(count_text_events("# only a comment\n\n", true), 0u);
+  EXPECT_EQ(count_text_events("", true), 0u);
+  EXPECT_EQ(count_text_events("20 1 2 3 -\n10 1 2 3 -\n", true), 0u) << "time goes back";
+}
+
 TEST(ReadLine, PhonemeFieldsGoToTheirPlaces) {
   TextReader reader;
   TextEvent out;

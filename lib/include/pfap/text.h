@@ -66,6 +66,12 @@ class TextReader {
   bool first_line_ = true;  // where a byte order mark may be
 };
 
+// How many events `head`, the start of a stream, holds when it reads as .pfap text: every
+// whole line in it reads without error (the last line too, without its line end, when
+// `whole` says `head` is the whole stream); 0 when a line does not, or when there is no event
+// (only comments and blank lines say nothing). For typefinders, which see only a start.
+size_t count_text_events(std::string_view head, bool whole);
+
 // Appends the canonical line of `event` (no line end): integers separated by one space, f0
 // in Hz (2 × its code), flags in the order S W E or '-', bookmarks in the transformed form
 // "<FAP n a T C>" with n in 3..74, one after the other.
