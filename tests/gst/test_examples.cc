@@ -1231,29 +1231,26 @@ TEST(PlayStream, OtherTextIsNotTakenForPfap) {
   EXPECT_FALSE(player.has("pfapface"));
 }
 
-// ffmpeg -t 3 against the example: a client that reads for a fixed time ends, because both
-// streams end together (before, the PFAP stream ended alone and ffmpeg waited on).
-TEST(PlayStream, FfmpegReadingForAFixedTimeEnds) {
-  gchar* ffmpeg = g_find_program_in_path("ffmpeg");
-  ASSERT_NE(ffmpeg, nullptr) << "no ffmpeg: scripts/install-deps installs it";
-  RtspServer server(source_path("docs/examples/hello.pfap"));
-  ASSERT_EQ(server.url().rfind("rtsp://127.0.0.1:", 0), 0u) << "URL: " << server.url();
-  std::string url = server.url();
-  std::vector<std::string> args = {ffmpeg, "-nostdin", "-loglevel", "error", "-t", "3",
-                                   "-i", url, "-map", "0", "-c", "copy", "-f", "null", "-"};
-  g_free(ffmpeg);
+// Runs a program to its end, at most `timeout`: its exit status, or -1 when it had to be
+// killed (or did not exit normally).
+int run_bounded(std::vector<std::string> args, std::chrono::seconds timeout) {
   std::vector<gchar*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
   GPid pid = 0;
   GError* error = nullptr;
-  ASSERT_TRUE(g_spawn_async(nullptr, argv.data(), nullptr, G_SPAWN_DO_NOT_REAP_CHILD, nullptr,
-                            nullptr, &pid, &error))
-      << error->message;
-  const auto started = Clock::now();
+  if (!g_spawn_async(nullptr, argv.data(), nullptr,
+                     static_cast<GSpawnFlags>(G_SPAWN_DO_NOT_REAP_CHILD | G_SPAWN_SEARCH_PATH |
+                                              G_SPAWN_STDOUT_TO_DEV_NULL),
+                     nullptr, nullptr, &pid, &error)) {
+    ADD_FAILURE() << "cannot run " << args[0] << ": " << error->message;
+    g_error_free(error);
+    return -1;
+  }
+  const auto deadline = Clock::now() + timeout;
   int status = 0;
   pid_t done = 0;
-  while ((done = waitpid(pid, &status, WNOHANG)) == 0 && Clock::now() < started + 15s) {
+  while ((done = waitpid(pid, &status, WNOHANG)) == 0 && Clock::now() < deadline) {
     std::this_thread::sleep_for(20ms);
   }
   if (done == 0) {
@@ -1261,8 +1258,41 @@ TEST(PlayStream, FfmpegReadingForAFixedTimeEnds) {
     waitpid(pid, &status, 0);
   }
   g_spawn_close_pid(pid);
-  EXPECT_NE(done, 0) << "ffmpeg -t 3 did not end within 15 s";
-  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  return done != 0 && WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+bool installed(const char* program) {
+  gchar* path = g_find_program_in_path(program);
+  g_free(path);
+  return path != nullptr;
+}
+
+// ffmpeg -t 3 against the example: a client that reads for a fixed time ends, because both
+// streams end together (before, the PFAP stream ended alone and ffmpeg waited on).
+TEST(PlayStream, FfmpegReadingForAFixedTimeEnds) {
+  ASSERT_TRUE(installed("ffmpeg")) << "no ffmpeg: scripts/install-deps installs it";
+  RtspServer server(source_path("docs/examples/hello.pfap"));
+  ASSERT_EQ(server.url().rfind("rtsp://127.0.0.1:", 0), 0u) << "URL: " << server.url();
+  EXPECT_EQ(run_bounded({"ffmpeg", "-nostdin", "-loglevel", "error", "-t", "3", "-i",
+                         server.url(), "-map", "0", "-c", "copy", "-f", "null", "-"},
+                        15s),
+            0)
+      << "ffmpeg -t 3 ends by itself with status 0";
+  EXPECT_EQ(server.stop(), 0);
+}
+
+// The README's gst-play-1.0 lines, with fake sinks: each plays to its end and exits.
+TEST(PlayStream, GstPlayPlaysTheReadmeLines) {
+  ASSERT_TRUE(installed("gst-play-1.0")) << "no gst-play-1.0: scripts/install-deps installs it";
+  RtspServer server(source_path("docs/examples/hello.pfap"));
+  ASSERT_EQ(server.url().rfind("rtsp://127.0.0.1:", 0), 0u) << "URL: " << server.url();
+  for (const std::string& uri : {server.url(), source_path("docs/examples/hello.pfap")}) {
+    EXPECT_EQ(run_bounded({"gst-play-1.0", "--no-interactive", "--videosink=fakesink sync=true",
+                           "--audiosink=fakesink sync=true", uri},
+                          15s),
+              0)
+        << uri;
+  }
   EXPECT_EQ(server.stop(), 0);
 }
 
