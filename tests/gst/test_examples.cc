@@ -38,6 +38,7 @@
 #include <cstdlib>
 #include <functional>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <regex>
 #include <string>
@@ -632,6 +633,7 @@ TEST(DocumentedLines, EveryCommandIsTested) {
   size_t in_section = 0;
   bool in_block = false;
   for (const std::string& line : lines_of(doc.substr(start))) {
+    if (!in_block && line.rfind("## ", 0) == 0 && line != kSection) break;  // the next section
     if (line.rfind("```", 0) == 0) in_block = !in_block;
     if (in_block && (line.rfind("gst-launch-1.0", 0) == 0 || line.rfind("build/", 0) == 0)) {
       ++in_section;
@@ -1303,19 +1305,90 @@ TEST(PlayStream, FfmpegReadingForAFixedTimeEnds) {
   EXPECT_EQ(server.stop(), 0);
 }
 
-// The README's gst-play-1.0 lines, with fake sinks: each plays to its end and exits.
-TEST(PlayStream, GstPlayPlaysTheReadmeLines) {
-  ASSERT_TRUE(installed("gst-play-1.0")) << "no gst-play-1.0: scripts/install-deps installs it";
-  RtspServer server(source_path("docs/examples/hello.pfap"));
-  ASSERT_EQ(server.url().rfind("rtsp://127.0.0.1:", 0), 0u) << "URL: " << server.url();
-  for (const std::string& uri : {server.url(), source_path("docs/examples/hello.pfap")}) {
-    EXPECT_EQ(run_bounded({"gst-play-1.0", "--no-interactive", "--videosink=fakesink sync=true",
-                           "--audiosink=fakesink sync=true", uri},
-                          15s),
-              0)
-        << uri;
+// The commands of a "## " section's ```sh blocks in `file`: comment lines and trailing
+// comments dropped, a trailing '&' too.
+std::vector<std::string> section_commands(const std::string& file, const std::string& section) {
+  std::vector<std::string> commands;
+  bool in_section = false, in_block = false;
+  for (const std::string& line : lines_of(read_file(source_path(file)))) {
+    if (!in_block && line.rfind("## ", 0) == 0) in_section = line == section;
+    if (!in_section) continue;
+    if (line.rfind("```", 0) == 0) {
+      in_block = !in_block;
+      continue;
+    }
+    if (!in_block || line.rfind('#', 0) == 0) continue;
+    std::string c = line.substr(0, line.find(" #"));
+    while (!c.empty() && (c.back() == ' ' || c.back() == '&')) c.pop_back();
+    if (!c.empty()) commands.push_back(c);
   }
-  EXPECT_EQ(server.stop(), 0);
+  return commands;
+}
+
+// The "play a stream" commands of README.md and docs/elements.md, with fake sinks: the server
+// is started, and each player plays to its end and exits.
+TEST(PlayStream, DocumentedCommandsPlayToTheirEnd) {
+  ASSERT_TRUE(installed("gst-play-1.0")) << "no gst-play-1.0: scripts/install-deps installs it";
+  const std::vector<std::pair<std::string, std::string>> sections = {
+      {"README.md", "## Play a stream"}, {"docs/elements.md", "## Playing a stream"}};
+  for (const auto& [file, section] : sections) {
+    SCOPED_TRACE(file + ", " + section);
+    const std::vector<std::string> commands = section_commands(file, section);
+    ASSERT_GE(commands.size(), 3u);
+    std::unique_ptr<RtspServer> server;
+    int players = 0;
+    for (const std::string& command : commands) {
+      SCOPED_TRACE(command);
+      std::vector<std::string> words;
+      gchar** argv = g_strsplit(command.c_str(), " ", -1);
+      for (gchar** w = argv; *w != nullptr; ++w) {
+        if (**w != '\0') words.emplace_back(*w);
+      }
+      g_strfreev(argv);
+      if (words[0] == "export") continue;  // GST_PLUGIN_PATH: meson sets it
+      if (words[0] == "build/examples/pfap-rtsp-server") {
+        ASSERT_EQ(words.size(), 3u);
+        server = std::make_unique<RtspServer>(source_path(words[1]));
+        ASSERT_EQ(server->url().rfind("rtsp://127.0.0.1:", 0), 0u);
+        continue;
+      }
+      ASSERT_NE(server, nullptr) << "the server comes first";
+      ++players;
+      auto local = [&](std::string s) {
+        for (const char* from : {"rtsp://127.0.0.1:8554/pfap"}) {
+          for (size_t at = s.find(from); at != std::string::npos; at = s.find(from)) {
+            s.replace(at, std::string(from).size(), server->url());
+          }
+        }
+        if (s.rfind("docs/", 0) == 0) s = source_path(s);
+        return s;
+      };
+      if (words[0] == "gst-play-1.0") {
+        ASSERT_EQ(words.size(), 2u);
+        EXPECT_EQ(run_bounded({"gst-play-1.0", "--no-interactive",
+                               "--videosink=fakesink sync=true", "--audiosink=fakesink sync=true",
+                               local(words[1])},
+                              15s),
+                  0);
+      } else {
+        ASSERT_EQ(words[0], "gst-launch-1.0");
+        std::string launch = local(command.substr(std::string("gst-launch-1.0 ").size()));
+        for (const char* sink : {"autovideosink", "autoaudiosink"}) {
+          for (size_t at = launch.find(sink); at != std::string::npos; at = launch.find(sink)) {
+            launch.replace(at, std::string(sink).size(), "fakesink sync=true");
+          }
+        }
+        Pipeline player(launch);
+        ASSERT_TRUE(player.error().empty()) << player.error();
+        ASSERT_EQ(player.set_state(GST_STATE_PLAYING), "");
+        EXPECT_EQ(player.wait_eos(15s), "");
+      }
+    }
+    EXPECT_GE(players, 2);
+    if (server != nullptr) {
+      EXPECT_EQ(server->stop(), 0);
+    }
+  }
 }
 
 }  // namespace

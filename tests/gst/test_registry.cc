@@ -87,9 +87,17 @@ std::string element_block(GstElementFactory* factory) {
       << "\n  rank: " << rank_name(gst_plugin_feature_get_rank(GST_PLUGIN_FEATURE(factory)))
       << "\n  description: " << meta(GST_ELEMENT_METADATA_DESCRIPTION)
       << "\n  author: " << meta(GST_ELEMENT_METADATA_AUTHOR) << "\n";
-  // Templates in the registry's order (as the element added them).
+  // Templates sink first, then by name: the registry cache does not keep the order the
+  // element added them in.
+  std::vector<const GstStaticPadTemplate*> templates;
   for (const GList* l = gst_element_factory_get_static_pad_templates(factory); l; l = l->next) {
-    const auto* t = static_cast<GstStaticPadTemplate*>(l->data);
+    templates.push_back(static_cast<const GstStaticPadTemplate*>(l->data));
+  }
+  std::sort(templates.begin(), templates.end(), [](const auto* a, const auto* b) {
+    if (a->direction != b->direction) return a->direction == GST_PAD_SINK;
+    return std::string(a->name_template) < b->name_template;
+  });
+  for (const GstStaticPadTemplate* t : templates) {
     GstCaps* caps = gst_static_caps_get(const_cast<GstStaticCaps*>(&t->static_caps));
     out << "  pad " << t->name_template << ": "
         << (t->direction == GST_PAD_SRC ? "src" : "sink") << ", "
