@@ -17,8 +17,8 @@
 //    let tests/gst/test_examples.cc (PlayStream.*) measure lip sync in playbin.
 //  - identity sync=true paces the file's events in real time from PLAY on, as a live TTS
 //    source would produce them; the audio is live too, so both start at running time 0.
-//  - Both streams end together, when the file's last phoneme or transition ends: the audio
-//    is cut there and ends too (end_audio_with_markup). Each session then sends its RTCP
+//  - Both streams end together, when the file's last phoneme ends: the audio is cut there
+//    and ends too (EndAudioWithMarkup). Each session then sends its RTCP
 //    BYE, and a client sees the presentation end: rtspsrc and playbin post EOS, and a client
 //    that reads for a fixed time (ffmpeg -t 3) is not left waiting on a stream that ended
 //    while another went on.
@@ -54,9 +54,9 @@ constexpr const char* kLaunch =
     "filesrc name=file ! pfapparse alphabet=x-pfap-arpabet ! identity sync=true "
     "! rtppfappay name=pay1 pt=97 )";
 
-// Ends the audio where the markup ends, so that one media's streams end together. The
-// markup's end (running time: the file's segment starts at 0 and identity keeps it) is known
-// at its EOS; audio from there on is dropped and the audio source sent EOS.
+// Ends the audio where the markup's last phoneme ends, so that one media's streams end
+// together. That end (a running time: the file's segment starts at 0 and identity keeps it)
+// is known at the markup's EOS; audio from there on is dropped and the audio source sent EOS.
 class EndAudioWithMarkup {
  public:
   // Both probes share the object; the last one removed deletes it.
