@@ -7,15 +7,21 @@
 // standard output, and serves until SIGINT or SIGTERM (exit status 0). Each client gets its
 // own media, made from this launch description:
 //
-//   ( audiotestsrc is-live=true ! audioconvert ! audio/x-raw,rate=44100,channels=1
-//       ! rtpL16pay name=pay0 pt=96
+//   ( audiotestsrc name=audio is-live=true wave=ticks tick-interval=500000000
+//       ! audioconvert ! audio/x-raw,rate=44100,channels=1 ! rtpL16pay name=pay0 pt=96
 //     filesrc name=file ! pfapparse alphabet=x-pfap-arpabet ! identity sync=true
 //       ! rtppfappay name=pay1 pt=97 )
 //
-//  - audiotestsrc stands for the speech; a real server has its TTS audio here.
+//  - audiotestsrc stands for the speech; a real server has its TTS audio here. Its ticks,
+//    one every 500 ms from the start, let a listener hear where the phoneme times are, and
+//    let tests/gst/test_examples.cc (PlayStream.*) measure lip sync in playbin.
 //  - identity sync=true paces the file's events in real time from PLAY on, as a live TTS
 //    source would produce them; the audio is live too, so both start at running time 0.
-//    The file plays once; the audio goes on until the client leaves.
+//  - Both streams end together, when the file's last phoneme ends: the audio is cut there
+//    and ends too (EndAudioWithMarkup). Each session then sends its RTCP
+//    BYE, and a client sees the presentation end: rtspsrc and playbin post EOS, and a client
+//    that reads for a fixed time (ffmpeg -t 3) is not left waiting on a stream that ended
+//    while another went on.
 //  - pfapparse's alphabet names the phoneme alphabet in the caps (a .pfap file has symbol
 //    numbers only). rtppfappay copies it to its RTP caps, and
 //    gst-rtsp-server writes RTP caps fields to the SDP, so clients see
@@ -32,25 +38,124 @@
 #include <gst/gst.h>
 #include <gst/rtsp-server/rtsp-server.h>
 
+#include <algorithm>
+#include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <initializer_list>
+#include <memory>
 
 namespace {
 
 constexpr const char* kLaunch =
-    "( audiotestsrc is-live=true ! audioconvert ! audio/x-raw,rate=44100,channels=1 "
-    "! rtpL16pay name=pay0 pt=96 "
+    "( audiotestsrc name=audio is-live=true wave=ticks tick-interval=500000000 ! audioconvert "
+    "! audio/x-raw,rate=44100,channels=1 ! rtpL16pay name=pay0 pt=96 "
     "filesrc name=file ! pfapparse alphabet=x-pfap-arpabet ! identity sync=true "
     "! rtppfappay name=pay1 pt=97 )";
 
-// Sets the .pfap file on each new media's filesrc (no quoting of paths in kLaunch).
+// Ends the audio where the markup's last phoneme ends, so that one media's streams end
+// together. That end (a running time: the file's segment starts at 0 and identity keeps it)
+// is known at the markup's EOS; audio from there on is dropped and the audio source sent EOS.
+class EndAudioWithMarkup {
+ public:
+  // Both probes share the object; the last one removed deletes it.
+  static void attach(GstElement* audio_source, GstPad* markup_pad, GstPad* audio_pad) {
+    auto self = std::make_shared<EndAudioWithMarkup>(audio_source);
+    gst_pad_add_probe(markup_pad,
+                      static_cast<GstPadProbeType>(GST_PAD_PROBE_TYPE_BUFFER |
+                                                   GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM),
+                      on_markup, new Ref(self), release);
+    gst_pad_add_probe(audio_pad, GST_PAD_PROBE_TYPE_BUFFER, on_audio, new Ref(self), release);
+  }
+  explicit EndAudioWithMarkup(GstElement* audio_source)
+      : source_(GST_ELEMENT(gst_object_ref(audio_source))) {}
+  EndAudioWithMarkup(const EndAudioWithMarkup&) = delete;
+  EndAudioWithMarkup& operator=(const EndAudioWithMarkup&) = delete;
+  ~EndAudioWithMarkup() { gst_object_unref(source_); }
+
+ private:
+  using Ref = std::shared_ptr<EndAudioWithMarkup>;
+  static void release(gpointer ref) { delete static_cast<Ref*>(ref); }
+
+  static GstPadProbeReturn on_markup(GstPad*, GstPadProbeInfo* info, gpointer data) {
+    EndAudioWithMarkup* self = static_cast<Ref*>(data)->get();
+    if (info->type & GST_PAD_PROBE_TYPE_BUFFER) {
+      GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+      if (GST_BUFFER_PTS_IS_VALID(buffer)) {
+        const GstClockTime end = GST_BUFFER_PTS(buffer) + (GST_BUFFER_DURATION_IS_VALID(buffer)
+                                                               ? GST_BUFFER_DURATION(buffer)
+                                                               : 0);
+        self->markup_end_ = std::max(self->markup_end_.load(), end);
+      }
+    } else if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) == GST_EVENT_EOS) {
+      self->markup_ended_ = true;
+    }
+    return GST_PAD_PROBE_OK;
+  }
+
+  static GstPadProbeReturn on_audio(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
+    EndAudioWithMarkup* self = static_cast<Ref*>(data)->get();
+    if (!self->markup_ended_) return GST_PAD_PROBE_OK;
+    GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+    GstEvent* event = gst_pad_get_sticky_event(pad, GST_EVENT_SEGMENT, 0);
+    if (event == nullptr) return GST_PAD_PROBE_OK;
+    const GstSegment* segment = nullptr;
+    gst_event_parse_segment(event, &segment);
+    const GstClockTime start =
+        gst_segment_to_running_time(segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
+    gst_event_unref(event);
+    if (!GST_CLOCK_TIME_IS_VALID(start) || start < self->markup_end_) return GST_PAD_PROBE_OK;
+    if (!self->audio_ended_.exchange(true)) {
+      gst_element_send_event(self->source_, gst_event_new_eos());
+    }
+    return GST_PAD_PROBE_DROP;
+  }
+
+  GstElement* source_;
+  std::atomic<GstClockTime> markup_end_{0};
+  std::atomic<bool> markup_ended_{false};
+  std::atomic<bool> audio_ended_{false};
+};
+
+GstPad* sink_pad_of(GstElement* bin, const char* name) {
+  GstElement* element = gst_bin_get_by_name(GST_BIN(bin), name);
+  GstPad* pad = gst_element_get_static_pad(element, "sink");
+  gst_object_unref(element);
+  return pad;
+}
+
+// RTCP sender reports every ~100 ms instead of rtpbin's 5 s: a client puts audio and phonemes
+// on one timeline (lip sync) from the reports, and before the first one it has only arrival
+// times, which may put the face tens of ms off its speech. With reports from the start, the
+// face is within a video frame of the audio at once (PlayStream.* in test_examples.cc). The
+// cost is a few dozen bytes per stream each 100 ms.
+constexpr guint64 kRtcpIntervalNs = 100'000'000;
+
+void on_media_prepared(GstRTSPMedia* media, gpointer) {
+  for (guint i = 0; i < gst_rtsp_media_n_streams(media); ++i) {
+    GObject* session = gst_rtsp_stream_get_rtpsession(gst_rtsp_media_get_stream(media, i));
+    if (session == nullptr) continue;
+    g_object_set(session, "rtcp-min-interval", kRtcpIntervalNs, nullptr);
+    g_object_unref(session);
+  }
+}
+
+// Sets the .pfap file on each new media's filesrc (no quoting of paths in kLaunch) and ties
+// the end of its audio to the end of its markup.
 void on_media_configure(GstRTSPMediaFactory*, GstRTSPMedia* media, gpointer file) {
   GstElement* bin = gst_rtsp_media_get_element(media);
   GstElement* filesrc = gst_bin_get_by_name(GST_BIN(bin), "file");
   g_object_set(filesrc, "location", static_cast<const char*>(file), nullptr);
   gst_object_unref(filesrc);
+  GstElement* audio = gst_bin_get_by_name(GST_BIN(bin), "audio");
+  GstPad* markup_pad = sink_pad_of(bin, "pay1");
+  GstPad* audio_pad = sink_pad_of(bin, "pay0");
+  EndAudioWithMarkup::attach(audio, markup_pad, audio_pad);
+  g_signal_connect(media, "prepared", G_CALLBACK(on_media_prepared), nullptr);
+  gst_object_unref(audio_pad);
+  gst_object_unref(markup_pad);
+  gst_object_unref(audio);
   gst_object_unref(bin);
 }
 

@@ -78,6 +78,7 @@ struct Stream {
   uint64_t frame = 0;          // the next frame's number since the output segment's start
   int64_t covered_until = -1;  // running time up to which a GAP said no markup comes
   bool warned_mouth = false;   // the warning for phonemes without a mouth shape was posted
+  bool untimed_input = false;  // a segment not in TIME came: an error was posted
   pfap::MarkupEvent event;     // reused, so that steady streaming does not allocate
   pfap::EventTimeline timeline;  // the input events' running times
   uint64_t malformed = 0;        // input buffers dropped, for the warning's rate limit
@@ -130,7 +131,10 @@ static GstStaticPadTemplate src_template = GST_STATIC_PAD_TEMPLATE(
                     "pixel-aspect-ratio = (fraction) 1/1"));
 
 G_DEFINE_TYPE(GstPfapFace, gst_pfap_face, GST_TYPE_AGGREGATOR)
-GST_ELEMENT_REGISTER_DEFINE(pfapface, "pfapface", GST_RANK_NONE, GST_TYPE_PFAP_FACE)
+// Codec/Decoder/Video with a rank: decodebin (playbin, uridecodebin) plugs it to show an
+// application/x-pfap stream, the only caps it takes. SECONDARY leaves PRIMARY to a renderer
+// an application prefers (docs/elements.md, "Playing a stream").
+GST_ELEMENT_REGISTER_DEFINE(pfapface, "pfapface", GST_RANK_SECONDARY, GST_TYPE_PFAP_FACE)
 
 // The neutral face and the first frame again (start, flush, new stream).
 static void reset(GstPfapFace* self) {
@@ -140,6 +144,7 @@ static void reset(GstPfapFace* self) {
   s.frame = 0;
   s.covered_until = -1;
   s.warned_mouth = false;
+  s.untimed_input = false;
   GstAggregatorPad* srcpad = GST_AGGREGATOR_PAD(GST_AGGREGATOR_SRC_PAD(self));
   GST_OBJECT_LOCK(self);
   srcpad->segment.position = GST_CLOCK_TIME_NONE;
@@ -229,6 +234,7 @@ static GstFlowReturn push_frame(GstPfapFace* self, GstClockTime pts, GstClockTim
 static GstFlowReturn gst_pfap_face_aggregate(GstAggregator* agg, gboolean timeout) {
   GstPfapFace* self = GST_PFAP_FACE(agg);
   Stream& s = *self->stream;
+  if (s.untimed_input) return GST_FLOW_ERROR;
   if (!s.negotiated) return GST_FLOW_NOT_NEGOTIATED;
 
   for (;;) {
@@ -291,6 +297,22 @@ static gboolean gst_pfap_face_sink_event(GstAggregator* agg, GstAggregatorPad* p
     case GST_EVENT_STREAM_START:
       reset(self);
       break;
+    case GST_EVENT_SEGMENT: {
+      // Bytes (filesrc without pfapparse) have no times to draw at.
+      const GstSegment* segment;
+      gst_event_parse_segment(event, &segment);
+      if (segment->format != GST_FORMAT_TIME) {
+        self->stream->untimed_input = true;
+        GST_ELEMENT_ERROR(self, STREAM, WRONG_TYPE,
+                          ("The input is not a timed PFAP stream: read .pfap files through "
+                           "pfapparse (filesrc ! pfapparse ! pfapface)."),
+                          ("%s segment: x-pfap streams have TIME segments",
+                           gst_format_get_name(segment->format)));
+        gst_event_unref(event);
+        return FALSE;
+      }
+      break;
+    }
     default:
       break;
   }
@@ -455,7 +477,7 @@ static void gst_pfap_face_class_init(GstPfapFaceClass* klass) {
   gst_element_class_add_static_pad_template_with_gtype(element_class, &src_template,
                                                        GST_TYPE_AGGREGATOR_PAD);
   gst_element_class_set_static_metadata(
-      element_class, "PFAP talking head", "Generator/Video",
+      element_class, "PFAP talking head", "Codec/Decoder/Video",
       "Draws a talking head moved by phoneme and facial animation parameter (PFAP) markup",
       "gst-pfap developers");
 

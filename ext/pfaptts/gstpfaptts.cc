@@ -123,6 +123,8 @@ static GstStaticPadTemplate pfap_template = GST_STATIC_PAD_TEMPLATE(
     GST_STATIC_CAPS(PFAP_MARKUP_CAPS ", alphabet = (string) x-pfap-arpabet"));
 
 G_DEFINE_TYPE(GstPfapTts, gst_pfap_tts, GST_TYPE_ELEMENT)
+// Text in, speech out, as festival is classified; rank NONE so that decodebin never speaks a
+// text file it meets.
 GST_ELEMENT_REGISTER_DEFINE(pfaptts, "pfaptts", GST_RANK_NONE, GST_TYPE_PFAP_TTS)
 
 // Back to the start of the timeline: a new stream (READY to PAUSED), or after FLUSH_STOP the
@@ -582,7 +584,7 @@ static void gst_pfap_tts_class_init(GstPfapTtsClass* klass) {
   gst_element_class_add_static_pad_template(element_class, &audio_template);
   gst_element_class_add_static_pad_template(element_class, &pfap_template);
   gst_element_class_set_static_metadata(
-      element_class, "PFAP text-to-speech", "Source/Audio/Text",
+      element_class, "PFAP text-to-speech", "Codec/Decoder/Audio",
       "Speaks text with MPEG-4 bookmarks through espeak-ng: audio, and its phonemes with their "
       "facial animation parameters (PFAP) as application/x-pfap",
       "gst-pfap developers");

@@ -23,7 +23,8 @@
  * error naming its line, its column (in bytes, from 1) and what is wrong; with
  * #GstPfapParse:skip-bad-lines it is a warning instead, and the lines after it are read as
  * usual. Input that arrives from sources without caps (filesrc, fdsrc) is taken as .pfap
- * text; caps, when given, must be text/x-raw,format=utf8 or text/plain.
+ * text; caps, when given, must be text/x-pfap (the typefinder's, for decodebin) or
+ * text/x-raw,format=utf8.
  *
  * Seeking is not supported: the text must be read from its start, as times and sentence
  * starts depend on the lines before. A flush starts the text anew: the next line is line 1,
@@ -46,6 +47,7 @@
 
 #include "pfap/model.h"
 #include "pfap/text.h"
+#include "gstpfaptypefind.h"
 #include "markupbuffer.h"
 #include "sparse.h"
 
@@ -83,15 +85,18 @@ struct _GstPfapParse {
 };
 
 // No caps from filesrc and fdsrc: the template only matters to sources that send caps.
+// Not text/plain: decodebin would plug the parser into every text file it meets; the
+// typefinder gives .pfap text its own type.
 static GstStaticPadTemplate sink_template =
     GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS,
-                            GST_STATIC_CAPS("text/x-raw, format = (string) utf8; text/plain"));
+                            GST_STATIC_CAPS(PFAP_TEXT_CAPS "; text/x-raw, format = (string) utf8"));
 
 static GstStaticPadTemplate src_template =
     GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
 
 G_DEFINE_TYPE(GstPfapParse, gst_pfap_parse, GST_TYPE_ELEMENT)
-GST_ELEMENT_REGISTER_DEFINE(pfapparse, "pfapparse", GST_RANK_NONE, GST_TYPE_PFAP_PARSE)
+// A rank, so that decodebin plugs it for text/x-pfap (gst-play-1.0 file.pfap).
+GST_ELEMENT_REGISTER_DEFINE(pfapparse, "pfapparse", GST_RANK_SECONDARY, GST_TYPE_PFAP_PARSE)
 
 // Back to the start of a stream (READY to PAUSED, FLUSH_STOP).
 static void reset(GstPfapParse* self) {
@@ -133,6 +138,27 @@ static void send_events(GstPfapParse* self) {
   gst_pad_push_event(self->srcpad, gst_event_new_segment(&segment));
 }
 
+// Where the text comes from, for messages: ` of file "PATH"` when upstream reads a file
+// (filesrc answers the URI query), ` of "URI"` for another URI, else nothing (appsrc, fdsrc).
+static std::string source_name(GstPfapParse* self) {
+  std::string name;
+  GstQuery* query = gst_query_new_uri();
+  gchar* uri = nullptr;
+  if (gst_pad_peer_query(self->sinkpad, query)) gst_query_parse_uri(query, &uri);
+  gst_query_unref(query);
+  if (uri == nullptr) return name;
+  if (gchar* path = g_filename_from_uri(uri, nullptr, nullptr)) {
+    gchar* display = g_filename_display_name(path);
+    name = std::string(" of file \"") + display + "\"";
+    g_free(display);
+    g_free(path);
+  } else {
+    name = std::string(" of \"") + uri + "\"";
+  }
+  g_free(uri);
+  return name;
+}
+
 // A line that cannot be read: an error, or with skip-bad-lines a warning and reading goes on.
 // `column` is a byte offset in the line.
 static GstFlowReturn bad_line(GstPfapParse* self, size_t column, const std::string& what) {
@@ -140,17 +166,18 @@ static GstFlowReturn bad_line(GstPfapParse* self, size_t column, const std::stri
   const bool skip = self->skip_bad_lines;
   GST_OBJECT_UNLOCK(self);
   const uint64_t line = self->stream->line;
+  const std::string source = source_name(self);
   if (skip) {
     GST_ELEMENT_WARNING(self, STREAM, DECODE,
-                        ("Skipped .pfap line %" G_GUINT64_FORMAT ", column %zu: %s", line,
-                         column + 1, what.c_str()),
+                        ("Skipped .pfap line %" G_GUINT64_FORMAT ", column %zu%s: %s", line,
+                         column + 1, source.c_str(), what.c_str()),
                         (nullptr));
     return GST_FLOW_OK;
   }
-  GST_ELEMENT_ERROR(
-      self, STREAM, DECODE,
-      ("Bad .pfap line %" G_GUINT64_FORMAT ", column %zu: %s", line, column + 1, what.c_str()),
-      ("set skip-bad-lines to warn and go on"));
+  GST_ELEMENT_ERROR(self, STREAM, DECODE,
+                    ("Bad .pfap line %" G_GUINT64_FORMAT ", column %zu%s: %s", line, column + 1,
+                     source.c_str(), what.c_str()),
+                    ("set skip-bad-lines to warn and go on"));
   return GST_FLOW_ERROR;
 }
 

@@ -147,6 +147,8 @@ struct _GstRtpPfapDepay {
 enum { PROP_0, PROP_STATS, PROP_REQUEST_RECOVERY };
 
 constexpr gboolean kDefaultRequestRecovery = TRUE;
+// The lowest RTP clock rate taken: PFAP times are in ms, and real rates are 8000 Hz and up.
+constexpr gint kMinClockRate = 1000;
 
 static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
     "sink", GST_PAD_SINK, GST_PAD_ALWAYS,
@@ -173,11 +175,15 @@ static void reset(GstRtpPfapDepay* self) { self->stream->ssrc.reset(); }
 
 static gboolean gst_rtp_pfap_depay_set_caps(GstRTPBaseDepayload* depay, GstCaps* caps) {
   const GstStructure* s = gst_caps_get_structure(caps, 0);
-  gint clock_rate = 0;  // the template's range refuses any other value
-  if (!gst_structure_get_int(s, "clock-rate", &clock_rate)) {
+  gint clock_rate = 0;
+  // Below kMinClockRate is no sender's rate but a source's guess: udpsrc given caps without
+  // a clock-rate fixates the template's range to 1, and times would come out hours off. The
+  // template keeps the whole range so that such caps reach this message.
+  if (!gst_structure_get_int(s, "clock-rate", &clock_rate) || clock_rate < kMinClockRate) {
     GST_ELEMENT_ERROR(depay, CORE, NEGOTIATION,
-                      ("The RTP caps have no clock-rate (add clock-rate=44100, or the rate the "
-                       "sender signals)"),
+                      ("The RTP caps have no clock-rate, or one below %d Hz (add "
+                       "clock-rate=44100, or the rate the sender signals)",
+                       kMinClockRate),
                       ("caps: %" GST_PTR_FORMAT, static_cast<gpointer>(caps)));
     return FALSE;
   }

@@ -93,6 +93,11 @@ constexpr pfap::SenderConfig kDefaults{};
 constexpr guint kDefaultMaxDelayMs = kDefaults.max_delay_ns / pfap::kNsPerMs;
 constexpr guint kDefaultRecoveryDepth = kDefaults.recovery_depth;
 constexpr guint kDefaultCompleteIntervalMs = kDefaults.complete_interval_ns / pfap::kNsPerMs;
+// The property ranges: a minute's wait is far past any use (the element adds it to its
+// latency), an hour between complete states far past any recovery; a negative number given
+// to gst-launch reads as a huge one and is refused, not taken.
+constexpr guint kMaxMaxDelayMs = 60'000;
+constexpr guint kMaxCompleteIntervalMs = 3'600'000;
 
 enum { PROP_0, PROP_MAX_DELAY, PROP_RECOVERY_DEPTH, PROP_COMPLETE_RECOVERY_INTERVAL, PROP_STATS };
 
@@ -133,14 +138,16 @@ struct _GstRtpPfapPay {
 GType gst_rtp_pfap_recovery_depth_get_type() {
   static gsize type = 0;
   static constexpr GEnumValue values[] = {
-      {0, "No dynamic recovery", "0"},
-      {1, "Recover a loss of the previous packet", "1"},
-      {2, "Recover losses within the previous 2 packets", "2"},
-      {4, "Recover losses within the previous 4 packets", "4"},
-      {7, "Recover losses within the previous 7 packets", "7"},
-      {15, "Recover losses within the previous 15 packets", "15"},
-      {25, "Recover losses within the previous 25 packets", "25"},
-      {40, "Recover losses within the previous 40 packets", "40"},
+      // Nicks are words; gst-launch also takes the number (recovery-depth=4), as GStreamer
+      // reads an enum from its name, its nick or its value.
+      {0, "No dynamic recovery", "none"},
+      {1, "Recover a loss of the previous packet", "1-packet"},
+      {2, "Recover losses within the previous 2 packets", "2-packets"},
+      {4, "Recover losses within the previous 4 packets", "4-packets"},
+      {7, "Recover losses within the previous 7 packets", "7-packets"},
+      {15, "Recover losses within the previous 15 packets", "15-packets"},
+      {25, "Recover losses within the previous 25 packets", "25-packets"},
+      {40, "Recover losses within the previous 40 packets", "40-packets"},
       {0, nullptr, nullptr},
   };
   // A coverage added to the library without a value here, or a typo, fails to build.
@@ -162,14 +169,18 @@ GType gst_rtp_pfap_recovery_depth_get_type() {
 static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
     "sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
 
+// The second structure shows the optional alphabet field (SDP fmtp) with the alphabet
+// pfaptts and the examples use; the first, which fixation picks, any other alphabet or none.
+#define PFAP_RTP_CAPS                                                                  \
+  "application/x-rtp, media = (string) application, payload = (int) [ 96, 127 ], " \
+  "clock-rate = (int) [ 1, 2147483647 ], encoding-name = (string) PFAP"
 static GstStaticPadTemplate src_template = GST_STATIC_PAD_TEMPLATE(
     "src", GST_PAD_SRC, GST_PAD_ALWAYS,
-    GST_STATIC_CAPS("application/x-rtp, media = (string) application, "
-                    "payload = (int) [ 96, 127 ], clock-rate = (int) [ 1, 2147483647 ], "
-                    "encoding-name = (string) PFAP"));
+    GST_STATIC_CAPS(PFAP_RTP_CAPS "; " PFAP_RTP_CAPS ", alphabet = (string) x-pfap-arpabet"));
 
 G_DEFINE_TYPE(GstRtpPfapPay, gst_rtp_pfap_pay, GST_TYPE_RTP_BASE_PAYLOAD)
-GST_ELEMENT_REGISTER_DEFINE(rtppfappay, "rtppfappay", GST_RANK_NONE, GST_TYPE_RTP_PFAP_PAY)
+// SECONDARY, as gst-plugins-good's payloaders: what picks a payloader by caps finds it.
+GST_ELEMENT_REGISTER_DEFINE(rtppfappay, "rtppfappay", GST_RANK_SECONDARY, GST_TYPE_RTP_PFAP_PAY)
 
 template <typename Update>
 static void update_stats(GstRtpPfapPay* self, Update&& update) {
@@ -567,7 +578,7 @@ static void gst_rtp_pfap_pay_class_init(GstRtpPfapPayClass* klass) {
       g_param_spec_uint("max-delay", "Maximum delay",
                         "Longest a phoneme waits for its packet, in ms of stream time "
                         "(0 = one packet per phoneme)",
-                        0, G_MAXUINT, kDefaultMaxDelayMs,
+                        0, kMaxMaxDelayMs, kDefaultMaxDelayMs,
                         static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
                                                  GST_PARAM_MUTABLE_PLAYING)));
 
@@ -611,7 +622,7 @@ static void gst_rtp_pfap_pay_class_init(GstRtpPfapPayClass* klass) {
       g_param_spec_uint("complete-recovery-interval", "Complete recovery interval",
                         "Stream time between complete-recovery packets, in ms (0 = only at the "
                         "start of a stream and on request)",
-                        0, G_MAXUINT, kDefaultCompleteIntervalMs,
+                        0, kMaxCompleteIntervalMs, kDefaultCompleteIntervalMs,
                         static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
                                                  GST_PARAM_MUTABLE_PLAYING)));
 

@@ -9,7 +9,8 @@ G_BEGIN_DECLS
 G_DECLARE_FINAL_TYPE(GstRtpPfapPay, gst_rtp_pfap_pay, GST, RTP_PFAP_PAY, GstRTPBasePayload)
 
 // The values of GstRtpPfapPay:recovery-depth: 0 and the coverages the draft's PP field can
-// signal (1, 2, 4, 7, 15, 25, 40), each value its own number and nick.
+// signal (1, 2, 4, 7, 15, 25, 40), each value its own number; nicks none, 1-packet,
+// 2-packets, ... 40-packets.
 #define GST_TYPE_RTP_PFAP_RECOVERY_DEPTH (gst_rtp_pfap_recovery_depth_get_type())
 GType gst_rtp_pfap_recovery_depth_get_type(void);
 

@@ -6,6 +6,7 @@
 #include "gstpfapfapenc.h"
 #include "gstpfapparse.h"
 #include "gstpfaptextenc.h"
+#include "gstpfaptypefind.h"
 #include "gstrtppfapdepay.h"
 #include "gstrtppfappay.h"
 
@@ -17,6 +18,7 @@ static gboolean plugin_init(GstPlugin* plugin) {
   ok &= GST_ELEMENT_REGISTER(pfaptextenc, plugin);
   ok &= GST_ELEMENT_REGISTER(fapparse, plugin);
   ok &= GST_ELEMENT_REGISTER(pfapfapenc, plugin);
+  ok &= GST_TYPE_FIND_REGISTER(pfap, plugin);
   return ok;
 }
 

@@ -21,6 +21,7 @@ constexpr int64_t kMaxTimeMs = INT64_MAX / kNsPerMs - kMaxPhonemeDurationMs;
 static_assert(kMaxTimeMs < kSaturatedMagnitude);
 
 constexpr std::string_view kStateKeyword = "state";
+constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";  // U+FEFF in UTF-8
 constexpr std::string_view kRecovered = "recovered";
 constexpr std::string_view kComplete = "complete";
 // The flag letters in the order they must appear, and what each one sets.
@@ -156,7 +157,10 @@ TextResult TextReader::read_line(std::string_view line, TextEvent& out, bool& ha
   // No field contains '#', so a comment starts at the first one wherever it is.
   const std::string_view content = line.substr(0, line.find('#'));
 
-  size_t pos = 0;
+  // Editors on Windows start UTF-8 files with a byte order mark; it is no field. Skipping it
+  // in place keeps every column a byte offset in the line as given.
+  size_t pos = first_line_ && content.starts_with(kByteOrderMark) ? kByteOrderMark.size() : 0;
+  first_line_ = false;
   const Field time = next_field(content, pos);
   if (time.text.empty()) return {};  // blank or comment line
 
@@ -184,6 +188,22 @@ TextResult TextReader::read_line(std::string_view line, TextEvent& out, bool& ha
 }
 
 void TextReader::reset() { *this = TextReader(); }
+
+size_t count_text_events(std::string_view head, bool whole) {
+  TextReader reader;
+  TextEvent event;
+  size_t events = 0;
+  while (!head.empty()) {
+    const size_t end = head.find('\n');
+    if (end == std::string_view::npos && !whole) break;  // cut where the head ends
+    const std::string_view line = head.substr(0, end);
+    bool has_event = false;
+    if (!reader.read_line(line, event, has_event).ok()) return 0;
+    events += has_event ? 1 : 0;
+    head.remove_prefix(end == std::string_view::npos ? head.size() : end + 1);
+  }
+  return events;
+}
 
 void format_text_line(const TextEvent& text_event, std::string& out) {
   const MarkupEvent& event = text_event.event;

@@ -26,6 +26,7 @@
 #include "element_harness.h"
 #include "pfap/markup_event.h"
 #include "pfap/phoneme_table.h"
+#include "glib_log.h"
 #include "pfap_buffers.h"
 #include "pipeline.h"
 #include "release_fonts.h"
@@ -346,6 +347,29 @@ TEST(PfapFace, MalformedBufferIsDroppedWithAWarningAndFramesGoOn) {
   EXPECT_NE(face.picture(frames.back()), still("M", {}, 5));
   EXPECT_GT(mean_difference(face.picture(frames.back()), still("M", {}, 5), 55, 0, 105, 62), 0);
   unref_all(frames);
+}
+
+// The parser forgotten: filesrc gives bytes, with a BYTES segment and no times.
+TEST(PfapFace, BytesWithoutPfapparseAreAnErrorNamingTheParserWithoutCriticals) {
+  pfap::testing::GlibLogCounter log;
+  Pipeline p("filesrc location=\"" + source_path("docs/examples/hello.pfap") +
+             "\" ! pfapface ! fakesink name=sink");
+  ASSERT_TRUE(p.ok()) << p.error();
+  int frames = 0;
+  g_object_set(p.by_name("sink"), "signal-handoffs", TRUE, nullptr);
+  g_signal_connect(p.by_name("sink"), "handoff",
+                   G_CALLBACK(+[](GstElement*, GstBuffer*, GstPad*, gpointer n) {
+                     ++*static_cast<int*>(n);
+                   }),
+                   &frames);
+  ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+  const std::string error = p.wait_eos(std::chrono::seconds(10));
+  EXPECT_NE(error.find("error from pfapface"), std::string::npos) << error;
+  EXPECT_NE(error.find("pfapparse"), std::string::npos) << error;
+  EXPECT_NE(error.find("bytes segment"), std::string::npos) << error;
+  EXPECT_EQ(frames, 0);
+  ASSERT_EQ(p.set_state(GST_STATE_NULL), "");
+  EXPECT_EQ(log.count(), 0) << log.first();
 }
 
 TEST(PfapFace, EventEarlierThanTheLastIsAppliedAtItsTimeWithAWarning) {

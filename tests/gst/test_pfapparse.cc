@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <random>
 #include <string>
@@ -16,6 +17,7 @@
 #include "pfap/model.h"
 #include "pfap_buffers.h"
 #include "pipeline.h"
+#include "temp_dir.h"
 
 namespace {
 
@@ -480,6 +482,38 @@ TEST(PfapParsePipeline, FilesrcReadsAFileOfManyBlocks) {
     EXPECT_EQ(e.faps, (std::vector<Fap>{{3, i, 200, Curve::kLinear}})) << "line " << i;
     EXPECT_EQ((e.flags & PFAP_FLAG_SENTENCE_START) != 0, i % 10 == 0) << "line " << i;
   }
+}
+
+// Runs `filesrc location=PATH ! pfapparse ... ! fakesink` to its end: the first error's or
+// warning's message (with `skip`: skip-bad-lines=true), or "" at EOS.
+std::string run_file(const std::string& path, bool skip) {
+  pfap::testing::Pipeline p("filesrc location=\"" + path + "\" ! pfapparse skip-bad-lines=" +
+                            (skip ? "true" : "false") + " ! fakesink sync=false");
+  if (!p.ok()) return p.error();
+  if (std::string e = p.set_state(GST_STATE_PLAYING); !e.empty()) return e;
+  return p.wait_eos(std::chrono::seconds(10), /*warnings=*/true);
+}
+
+TEST(PfapParsePipeline, BadLineFromAFileNamesTheFile) {
+  pfap::testing::TempDir dir;
+  const std::string path = dir.file("broken.pfap");
+  const std::string text = "0 1 20 100 -\n40 2 5000 100 -\n";
+  ASSERT_TRUE(g_file_set_contents(path.c_str(), text.data(), static_cast<gssize>(text.size()),
+                                  nullptr));
+  const std::string error = run_file(path, false);
+  EXPECT_TRUE(contains(error, "line 2, column 6 of file \"" + path + "\": bad duration")) << error;
+  const std::string warning = run_file(path, true);
+  EXPECT_TRUE(contains(warning, "Skipped .pfap line 2, column 6 of file \"" + path + "\""))
+      << warning;
+}
+
+TEST(PfapParsePipeline, ByteOrderMarkAtTheStartOfAFileIsSkipped) {
+  pfap::testing::TempDir dir;
+  const std::string path = dir.file("bom.pfap");
+  const std::string text = "\xEF\xBB\xBF" "0 1 20 100 -\n20 2 20 100 E\n";
+  ASSERT_TRUE(g_file_set_contents(path.c_str(), text.data(), static_cast<gssize>(text.size()),
+                                  nullptr));
+  EXPECT_EQ(run_file(path, false), "");
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "glib_log.h"
 #include "lip_sync.h"
 #include "pfap/markup.h"
 #include "pfap_buffers.h"
@@ -407,6 +408,35 @@ TEST(PfapTts, PropertiesAreDocumented) {
   EXPECT_EQ(pitch, 50);
   EXPECT_EQ(volume, 100);
   g_free(voice);
+  gst_object_unref(tts);
+}
+
+// rate=1000 in gst-launch: GObject refuses it by the range gst-inspect shows (80 - 450),
+// with a warning naming the property, and the speech keeps its rate.
+TEST(PfapTts, OutOfRangeNumbersAreRefusedByTheirRanges) {
+  GstElement* tts = gst_element_factory_make("pfaptts", nullptr);
+  ASSERT_NE(tts, nullptr);
+  const struct {
+    const char* name;
+    gint minimum, maximum, default_value;
+    const char* bad;
+  } cases[] = {{"rate", 80, 450, 175, "1000"}, {"pitch", 0, 100, 50, "-1"},
+               {"volume", 0, 200, 100, "201"}};
+  for (const auto& c : cases) {
+    const GParamSpecInt* spec =
+        G_PARAM_SPEC_INT(g_object_class_find_property(G_OBJECT_GET_CLASS(tts), c.name));
+    EXPECT_EQ(spec->minimum, c.minimum) << c.name;
+    EXPECT_EQ(spec->maximum, c.maximum) << c.name;
+    {
+      pfap::testing::GlibLogCounter log;
+      gst_util_set_object_arg(G_OBJECT(tts), c.name, c.bad);
+      EXPECT_EQ(log.count(), 1) << c.name;
+      EXPECT_NE(log.first().find(c.name), std::string::npos) << log.first();
+    }
+    gint value = 0;
+    g_object_get(tts, c.name, &value, nullptr);
+    EXPECT_EQ(value, c.default_value) << c.name;
+  }
   gst_object_unref(tts);
 }
 

@@ -26,6 +26,7 @@
 #include <string>
 #include <thread>
 #include <utility>
+#include <tuple>
 #include <vector>
 
 #include "lip_sync.h"
@@ -472,12 +473,13 @@ TEST(GstInspect, Depayloader) {
 // in pfap, the espeak-ng speaker in pfaptts, the cairo head in pfapface.
 TEST(GstInspect, EachPluginListsItsElements) {
   ASSERT_TRUE(plugin_available(kElements));
-  const std::vector<std::pair<const char*, std::vector<const char*>>> plugins = {
-      {"pfap", {kPay, kDepay, "pfapparse", "pfaptextenc", "fapparse", "pfapfapenc"}},
-      {"pfaptts", {"pfaptts"}},
-      {"pfapface", {"pfapface"}},
+  // And its typefinders: .pfap text's in pfap.
+  const std::vector<std::tuple<const char*, std::vector<const char*>, int>> plugins = {
+      {"pfap", {kPay, kDepay, "pfapparse", "pfaptextenc", "fapparse", "pfapfapenc"}, 1},
+      {"pfaptts", {"pfaptts"}, 0},
+      {"pfapface", {"pfapface"}, 0},
   };
-  for (const auto& [plugin, elements] : plugins) {
+  for (const auto& [plugin, elements, typefinders] : plugins) {
     const Inspect r = gst_inspect(plugin, "--plugin");
     ASSERT_EQ(r.exit_status, 0) << r.err;
     SCOPED_TRACE(std::string("gst-inspect-1.0 ") + plugin + ":\n" + r.out);
@@ -494,8 +496,13 @@ TEST(GstInspect, EachPluginListsItsElements) {
       EXPECT_NE(std::find(lines.begin(), lines.end(), line), lines.end()) << "no line: " << line;
     }
     const std::string count = std::to_string(elements.size());
-    EXPECT_NE(r.out.find(count + " features:"), std::string::npos);
+    EXPECT_NE(r.out.find(std::to_string(elements.size() + typefinders) + " features:"),
+              std::string::npos);
     EXPECT_NE(r.out.find("+-- " + count + " elements"), std::string::npos);
+    if (typefinders > 0) {
+      EXPECT_NE(r.out.find("+-- " + std::to_string(typefinders) + " typefinders"),
+                std::string::npos);
+    }
   }
 }
 

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <map>
 #include <set>
 #include <string>
@@ -14,6 +15,7 @@
 #include "pfap/packetizer.h"
 #include "pfap/payload.h"
 #include "pfap_buffers.h"
+#include "pipeline.h"
 #include "rtp_packet.h"
 
 namespace pfap {
@@ -675,6 +677,40 @@ TEST(RtpPfapDepayCaps, CapsWithoutClockRateAreRefused) {
   const std::string error =
       refusal_of("application/x-rtp,media=application,encoding-name=PFAP,payload=96");
   EXPECT_TRUE(contains(error, "clock-rate")) << error;
+}
+
+TEST(RtpPfapDepayCaps, ImplausibleClockRatesAreRefusedAsMissingOnes) {
+  for (const char* rate : {"1", "999"}) {
+    const std::string error = refusal_of(
+        std::string("application/x-rtp,media=application,encoding-name=PFAP,payload=96,clock-rate=") +
+        rate);
+    EXPECT_TRUE(contains(error, "no clock-rate, or one below 1000 Hz")) << rate << ": " << error;
+  }
+}
+
+// What udpsrc does with caps that lack a clock-rate: it fixates against the template (to
+// clock-rate=1), and the depayloader must say so rather than run hours off.
+TEST(RtpPfapDepayCaps, UdpsrcWithoutClockRateIsAnErrorNamingIt) {
+  pfap::testing::Pipeline p(
+      "udpsrc address=127.0.0.1 port=0 caps=\"application/x-rtp,media=application,"
+      "encoding-name=PFAP\" name=src ! rtppfapdepay ! fakesink");
+  ASSERT_TRUE(p.ok()) << p.error();
+  ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+  const guint port = pfap::testing::bound_port(p.by_name("src"));
+  // One packet makes udpsrc negotiate.
+  GstElement* sender = gst_parse_launch("appsrc name=in ! udpsink host=127.0.0.1 name=out", nullptr);
+  ASSERT_NE(sender, nullptr);
+  GstElement* out = gst_bin_get_by_name(GST_BIN(sender), "out");
+  g_object_set(out, "port", static_cast<gint>(port), nullptr);
+  gst_object_unref(out);
+  GstElement* in = gst_bin_get_by_name(GST_BIN(sender), "in");
+  gst_element_set_state(sender, GST_STATE_PLAYING);
+  pfap::testing::push(in, rtp_packet(good_payload(), 1, 0));
+  const std::string error = p.wait_eos(std::chrono::seconds(5));
+  gst_element_set_state(sender, GST_STATE_NULL);
+  gst_object_unref(in);
+  gst_object_unref(sender);
+  EXPECT_TRUE(contains(error, "no clock-rate, or one below 1000 Hz")) << error;
 }
 
 // The PTS comes from upstream, where rtpjitterbuffer makes it from the RTP timestamp at the

@@ -18,6 +18,7 @@
 #include "pfap/packetizer.h"
 #include "pfap/payload.h"
 #include "pfap/recovery.h"
+#include "glib_log.h"
 #include "pfap_buffers.h"
 
 namespace {
@@ -202,10 +203,31 @@ TEST(RtpPfapPay, MaxDelayPropertyIsDocumentedAndDefaultsTo100Ms) {
   const GParamSpecUInt* spec = G_PARAM_SPEC_UINT(pspec);
   EXPECT_EQ(spec->default_value, 100u);
   EXPECT_EQ(spec->minimum, 0u);
-  EXPECT_EQ(spec->maximum, G_MAXUINT);
+  EXPECT_EQ(spec->maximum, 60000u);
   guint max_delay = 0;
   g_object_get(element, "max-delay", &max_delay, nullptr);
   EXPECT_EQ(max_delay, 100u);
+  gst_object_unref(element);
+}
+
+// gst-launch reads max-delay=-5 as 4294967291: the range refuses it (GObject warns) and the
+// value stays.
+TEST(RtpPfapPay, NegativeOrHugeMsPropertiesAreRefusedByTheirRange) {
+  GstElement* element = gst_element_factory_make("rtppfappay", nullptr);
+  ASSERT_NE(element, nullptr);
+  for (const char* name : {"max-delay", "complete-recovery-interval"}) {
+    guint before = 0;
+    g_object_get(element, name, &before, nullptr);
+    {
+      pfap::testing::GlibLogCounter log;
+      gst_util_set_object_arg(G_OBJECT(element), name, "-5");
+      EXPECT_EQ(log.count(), 1) << name;
+      EXPECT_NE(log.first().find("out of range"), std::string::npos) << log.first();
+    }
+    guint after = 0;
+    g_object_get(element, name, &after, nullptr);
+    EXPECT_EQ(after, before) << name;
+  }
   gst_object_unref(element);
 }
 
@@ -320,7 +342,7 @@ class RtpPfapPayMtu : public ::testing::TestWithParam<guint> {};
 TEST_P(RtpPfapPayMtu, PacketsFitTheMtuAndKeepPhonemesInOrderWithTheirFaps) {
   const guint mtu = GetParam();
   Payloader pay;
-  g_object_set(pay.element(), "mtu", mtu, "max-delay", G_MAXUINT, nullptr);
+  g_object_set(pay.element(), "mtu", mtu, "max-delay", 60000u, nullptr);
   // Every other phoneme has a FAP: a phoneme and its FAP fit even the smallest MTU.
   std::vector<Input> inputs = sentence(0, 30, 20, true);
   for (size_t i = 0; i < inputs.size(); i += 2) {
@@ -697,7 +719,7 @@ TEST(RtpPfapPay, RecoveryPropertiesAreDocumentedWithTheirDefaults) {
   gst_object_unref(element);
 }
 
-TEST(RtpPfapPay, RecoveryDepthValuesAreZeroAndTheCoveragesPpCanSignalNamedByTheirNumber) {
+TEST(RtpPfapPay, RecoveryDepthValuesAreZeroAndTheCoveragesPpCanSignalWithWordNicks) {
   GstElement* element = gst_element_factory_make("rtppfappay", nullptr);
   GParamSpec* pspec = g_object_class_find_property(G_OBJECT_GET_CLASS(element), "recovery-depth");
   GEnumClass* enum_class = G_PARAM_SPEC_ENUM(pspec)->enum_class;
@@ -705,7 +727,10 @@ TEST(RtpPfapPay, RecoveryDepthValuesAreZeroAndTheCoveragesPpCanSignalNamedByThei
   for (guint i = 0; i < enum_class->n_values; ++i) {
     const GEnumValue& v = enum_class->values[i];
     values.push_back(v.value);
-    EXPECT_EQ(std::string(v.value_nick), std::to_string(v.value));
+    EXPECT_EQ(std::string(v.value_nick),
+              v.value == 0   ? std::string("none")
+              : v.value == 1 ? std::string("1-packet")
+                             : std::to_string(v.value) + "-packets");
     EXPECT_STRNE(v.value_name, v.value_nick) << "a descriptive name";
   }
   std::vector<int> expected{0};
@@ -726,6 +751,12 @@ TEST(RtpPfapPay, RecoveryDepthIsSetFromItsNumberAsAStringAndRefusesOtherNumbers)
   gst_util_set_object_arg(G_OBJECT(element), "recovery-depth", "3");  // PP cannot say 3
   g_object_get(element, "recovery-depth", &depth, nullptr);
   EXPECT_EQ(depth, 4);
+  gst_util_set_object_arg(G_OBJECT(element), "recovery-depth", "7-packets");
+  g_object_get(element, "recovery-depth", &depth, nullptr);
+  EXPECT_EQ(depth, 7);
+  gst_util_set_object_arg(G_OBJECT(element), "recovery-depth", "none");
+  g_object_get(element, "recovery-depth", &depth, nullptr);
+  EXPECT_EQ(depth, 0);
   gst_object_unref(element);
 }
 

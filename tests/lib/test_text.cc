@@ -84,6 +84,51 @@ void expect_errors(std::initializer_list<ErrorCase> cases) {
   }
 }
 
+TEST(ReadLine, SkipsAByteOrderMarkOnlyAtTheStartOfTheFirstLine) {
+  constexpr std::string_view kBom = "\xEF\xBB\xBF";
+  TextReader reader;
+  TextEvent out;
+  bool has_event = false;
+  ASSERT_TRUE(reader.read_line(std::string(kBom) + "120 17 85 200 SW", out, has_event).ok());
+  ASSERT_TRUE(has_event);
+  EXPECT_EQ(out.time_ms, 120);
+  EXPECT_EQ(out.event.phoneme.symbol, 17);
+
+  // Later lines: a byte order mark is a bad time, at column 0 of the line as given.
+  const TextResult later = reader.read_line(std::string(kBom) + "200 17 85 200 -", out, has_event);
+  EXPECT_EQ(later.status, TextStatus::kBadTime);
+  EXPECT_EQ(later.column, 0u);
+
+  // A comment line first takes the mark too; errors after it count its bytes.
+  TextReader commented;
+  ASSERT_TRUE(commented.read_line(std::string(kBom) + "# a session", out, has_event).ok());
+  EXPECT_FALSE(has_event);
+  TextReader bad;
+  const TextResult result = bad.read_line(std::string(kBom) + "12 x 85 200 -", out, has_event);
+  EXPECT_EQ(result.status, TextStatus::kBadSymbol);
+  EXPECT_EQ(result.column, kBom.size() + 3);
+
+  // After reset() the next line is a first line again.
+  reader.reset();
+  EXPECT_TRUE(reader.read_line(std::string(kBom) + "0 1 10 0 -", out, has_event).ok());
+}
+
+TEST(CountTextEvents, CountsTheEventsOfWholeLinesOnly) {
+  constexpr std::string_view kText = "# hello\n\n0 12 80 120 SW\n80 state complete\n100 1 2";
+  EXPECT_EQ(count_text_events(kText, false), 2u) << "the cut last line is not read";
+  EXPECT_EQ(count_text_events(kText, true), 0u) << "whole, its last line is missing fields";
+  EXPECT_EQ(count_text_events("\xEF\xBB\xBF" "0 12 80 120 SW\r\n20 1 2 3 -", true), 2u);
+}
+
+TEST(CountTextEvents, IsZeroForOtherTextAndForCommentsOnly) {
+  EXPECT_EQ(count_text_events("Hello world.\nHow are you?\n", true), 0u);
+  EXPECT_EQ(count_text_events("1\n00:00:01,000 --> 00:00:02,000\nHi\n", true), 0u);  // SubRip
+  EXPECT_EQ(count_text_events("v=0\no=- 0 0 IN IP4 127.0.0.1\n", true), 0u);         // SDP
+  EXPECT_EQ(count_text_events("# only a comment\n\n", true), 0u);
+  EXPECT_EQ(count_text_events("", true), 0u);
+  EXPECT_EQ(count_text_events("20 1 2 3 -\n10 1 2 3 -\n", true), 0u) << "time goes back";
+}
+
 TEST(ReadLine, PhonemeFieldsGoToTheirPlaces) {
   TextReader reader;
   TextEvent out;

@@ -54,6 +54,8 @@ class TextReader {
  public:
   // Parses one line, without its line end. Blank and comment lines give kOk with `has_event`
   // false. On error nothing is kept from the line (it may be skipped and reading go on).
+  // A UTF-8 byte order mark at the start of the stream's first line is skipped (columns
+  // still count its 3 bytes).
   TextResult read_line(std::string_view line, TextEvent& out, bool& has_event);
   // Back to the start of a stream.
   void reset();
@@ -61,7 +63,14 @@ class TextReader {
  private:
   int64_t last_time_ms_ = 0;
   bool next_starts_sentence_ = true;
+  bool first_line_ = true;  // where a byte order mark may be
 };
+
+// How many events `head`, the start of a stream, holds when it reads as .pfap text: every
+// whole line in it reads without error (the last line too, without its line end, when
+// `whole` says `head` is the whole stream); 0 when a line does not, or when there is no event
+// (only comments and blank lines say nothing). For typefinders, which see only a start.
+size_t count_text_events(std::string_view head, bool whole);
 
 // Appends the canonical line of `event` (no line end): integers separated by one space, f0
 // in Hz (2 × its code), flags in the order S W E or '-', bookmarks in the transformed form

@@ -1,0 +1,13 @@
+#pragma once
+
+#include <gst/gst.h>
+
+G_BEGIN_DECLS
+
+// The media type of .pfap text (docs/text-format.md), found by the typefinder "pfap" and read
+// by pfapparse.
+#define PFAP_TEXT_CAPS "text/x-pfap"
+
+GST_TYPE_FIND_REGISTER_DECLARE(pfap);
+
+G_END_DECLS
