@@ -10,8 +10,8 @@
 namespace pfap::tts {
 
 // No piece is longer than this, in code points (a sentence longer than that is cut at white
-// space). It bounds what one espeak-ng call takes: about 30 s of speech for words, 3 minutes
-// for a text spelled letter by letter (docs/tts.md, "Long texts").
+// space). It bounds what one espeak-ng call takes: about 20 s of speech for English words,
+// 2.5 minutes for CJK characters spelled out one by one (docs/tts.md, "Long texts").
 constexpr size_t kMaxPieceCodePoints = 400;
 
 // Where the piece that starts at `from` in `text` ends (exclusive; > from unless `from` is the
