@@ -235,7 +235,9 @@ static uint64_t rest_until_frame(GstPfapFace* self, const GstSegment& segment, i
                                  int64_t until) {
   Stream& s = *self->stream;
   const int64_t rest_from = std::max(s.animator.end_ns(), s.animator.last_ns());
-  if (s.frame == 0 || at < rest_from + kMaxRestNs || until <= at) return 0;
+  // Both are running times, 0 or more: the difference cannot overflow, a sum near the end of
+  // time (292 years) could.
+  if (s.frame == 0 || at - rest_from < kMaxRestNs || until <= at) return 0;
   const GstClockTime position = gst_segment_position_from_running_time(
       &segment, GST_FORMAT_TIME, static_cast<GstClockTime>(until));
   if (!GST_CLOCK_TIME_IS_VALID(position) || position < segment.start) return 0;
