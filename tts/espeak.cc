@@ -17,6 +17,7 @@ int espeak_rate = 0;  // espeak_Initialize's answer; <= 0 when it failed
 struct Call {
   Synthesis* out = nullptr;
   size_t sentences = 0;  // sentence events so far
+  const std::atomic<bool>* cancel = nullptr;
 };
 Call current;
 
@@ -47,7 +48,8 @@ int on_synth(short* wav, int n_samples, espeak_EVENT* events) {
     }
   }
   if (wav != nullptr && n_samples > 0) s.samples.insert(s.samples.end(), wav, wav + n_samples);
-  return 0;
+  // Non-zero stops the synthesis.
+  return current.cancel != nullptr && current.cancel->load() ? 1 : 0;
 }
 
 // A word's phonemes run to the next word's, without the pauses that end a clause.
@@ -96,7 +98,7 @@ bool check_voice(const VoiceSettings& settings, unsigned& sample_rate, std::stri
 }
 
 bool synthesize(std::string_view text, const VoiceSettings& settings, Synthesis& out,
-                std::string& error) {
+                std::string& error, const std::atomic<bool>* cancel) {
   std::lock_guard lock(espeak_mutex);
   if (!start(error) || !set_voice(settings, error)) return false;
   out = Synthesis{};
@@ -112,7 +114,7 @@ bool synthesize(std::string_view text, const VoiceSettings& settings, Synthesis&
     out.transcription += phonemes;
   }
 
-  current = {&out, 0};
+  current = {&out, 0, cancel};
   const espeak_ERROR result = espeak_Synth(input.c_str(), input.size() + 1, 0, POS_CHARACTER, 0,
                                            espeakCHARS_UTF8, nullptr, nullptr);
   current = {};

@@ -3,6 +3,7 @@
 // global), so every call runs under one mutex, synchronously, and sets all of them.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -45,8 +46,9 @@ struct Synthesis {
 bool check_voice(const VoiceSettings& settings, unsigned& sample_rate, std::string& error);
 
 // Speaks plain UTF-8 `text` (no SSML). False with `error` set when espeak-ng cannot start or
-// has no such voice.
+// has no such voice. When `*cancel` becomes true, espeak-ng stops at its next block of audio
+// (a few ms of work) and `out` holds what was spoken so far.
 bool synthesize(std::string_view text, const VoiceSettings& settings, Synthesis& out,
-                std::string& error);
+                std::string& error, const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace pfap::tts

@@ -22,7 +22,7 @@ struct Estimate {
 }  // namespace
 
 std::vector<double> segment_f0(std::span<const int16_t> samples, unsigned rate,
-                               std::span<const size_t> bounds) {
+                               std::span<const size_t> bounds, const std::atomic<bool>* cancel) {
   std::vector<Estimate> voiced;
   {
     std::unique_ptr<aubio_pitch_t, decltype(&del_aubio_pitch)> pitch(
@@ -32,6 +32,7 @@ std::vector<double> segment_f0(std::span<const int16_t> samples, unsigned rate,
     aubio_pitch_set_unit(pitch.get(), "Hz");
     aubio_pitch_set_silence(pitch.get(), kSilenceDb);
     for (size_t hop_start = 0; hop_start < samples.size(); hop_start += kHop) {
+      if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) break;
       for (uint_t k = 0; k < kHop; ++k) {
         const size_t j = hop_start + k;
         in->data[k] = j < samples.size() ? static_cast<smpl_t>(samples[j]) / 32768 : 0;

@@ -53,10 +53,11 @@ void add_phoneme(const MarkupEvent& event, size_t start, size_t end, unsigned ra
 }
 
 bool speak(const Utterance& utterance, const VoiceSettings& settings, Speech& out,
-           std::string& error) {
+           std::string& error, const std::atomic<bool>* cancel) {
   Synthesis syn;
-  if (!synthesize(utterance.text_utf8(), settings, syn, error)) return false;
+  if (!synthesize(utterance.text_utf8(), settings, syn, error, cancel)) return false;
   out = Speech{};
+  if (cancel != nullptr && *cancel) return true;
   out.sample_rate = syn.sample_rate;
   const size_t total = syn.samples.size();
 
@@ -99,7 +100,8 @@ bool speak(const Utterance& utterance, const VoiceSettings& settings, Speech& ou
   std::vector<size_t> bounds;
   for (const Segment& s : segments) bounds.push_back(s.start);
   bounds.push_back(segments.back().end);
-  const std::vector<double> f0 = segment_f0(syn.samples, syn.sample_rate, bounds);
+  const std::vector<double> f0 = segment_f0(syn.samples, syn.sample_rate, bounds, cancel);
+  if (cancel != nullptr && *cancel) return true;
 
   const PhonemeAlphabet& arpabet = *find_alphabet(kArpabetAlphabet);
   std::vector<MarkupEvent> events(segments.size());

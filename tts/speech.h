@@ -52,7 +52,9 @@ void add_phoneme(const MarkupEvent& event, size_t start, size_t end, unsigned ra
 //  - duration_ms: the phoneme's start and end rounded to whole ms from the utterance's start,
 //    subtracted, so that the durations add up to the audio's length and a receiver that adds
 //    them up stays within 0.5 ms of every start. Longer than 4095 ms: split.
+// With `cancel`: when `*cancel` becomes true, returns within a few ms (espeak-ng and the f0
+// stop), `out` then incomplete, for the caller to drop.
 bool speak(const Utterance& utterance, const VoiceSettings& settings, Speech& out,
-           std::string& error);
+           std::string& error, const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace pfap::tts

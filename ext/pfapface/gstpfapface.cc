@@ -27,9 +27,11 @@
  * holds the FAP state. It is a #GstAggregator: with a live source it produces each frame on
  * time (at its running time plus the latency) whether or not markup came; otherwise it draws
  * a frame as soon as a later event, a GAP event or EOS shows that nothing before that frame
- * can still come, so a file renders as fast as the machine draws. The stream ends with the
- * frame in which its last phoneme, transition or gap ends. A malformed buffer is dropped with
- * a warning and the frames go on.
+ * can still come, so a file renders as fast as the machine draws. A face at rest (no phoneme,
+ * no transition) for 10 s draws no more frames until its next markup: a GAP event covers that
+ * time instead, so a far-off event costs one event, not a frame per frame period. The stream
+ * ends with the frame in which its last phoneme, transition or gap ends. A malformed buffer is
+ * dropped with a warning and the frames go on.
  *
  * ## Example pipelines
  * |[
@@ -68,6 +70,10 @@ constexpr int kDefaultFpsN = 25;
 constexpr int kDefaultFpsD = 1;
 constexpr face::Style kDefaultStyle = face::Style::kCartoon;
 constexpr gboolean kDefaultDebugOverlay = FALSE;
+// A face at rest for this long draws no more frames until its next markup: one GAP event
+// covers the rest (docs/face.md, "Long silences"), so that a far-off event costs one event,
+// not a frame per frame period.
+constexpr int64_t kMaxRestNs = 10 * GST_SECOND;
 
 // What the streaming thread keeps between frames. GObject runs no C++ constructors, so it
 // lives behind a pointer made in init and deleted in finalize.
@@ -227,6 +233,42 @@ static GstFlowReturn push_frame(GstPfapFace* self, GstClockTime pts, GstClockTim
   return gst_aggregator_finish_buffer(agg, out);
 }
 
+// Whether frames from `at` on would all show the face at rest for more than kMaxRestNs before
+// `until` (the running time of the next markup, or the end of a GAP): then the frames up to
+// `until` are left out and one GAP event covers them. Returns the number of the frame that
+// holds `until`, or 0 when frames are to be drawn.
+static uint64_t rest_until_frame(GstPfapFace* self, const GstSegment& segment, int64_t at,
+                                 int64_t until) {
+  Stream& s = *self->stream;
+  const int64_t rest_from = std::max(s.animator.end_ns(), s.animator.last_ns());
+  // Both are running times, 0 or more: the difference cannot overflow, a sum near the end of
+  // time (292 years) could.
+  if (s.frame == 0 || at - rest_from < kMaxRestNs || until <= at) return 0;
+  const GstClockTime position = gst_segment_position_from_running_time(
+      &segment, GST_FORMAT_TIME, static_cast<GstClockTime>(until));
+  if (!GST_CLOCK_TIME_IS_VALID(position) || position < segment.start) return 0;
+  const GstVideoInfo& info = s.info;
+  const uint64_t frame =
+      gst_util_uint64_scale(position - segment.start, static_cast<guint64>(info.fps_n),
+                            GST_SECOND * static_cast<guint64>(info.fps_d));
+  return frame > s.frame ? frame : 0;
+}
+
+// Leaves out the frames from s.frame to `frame` (excluded) with a GAP event over their time.
+static void skip_to_frame(GstPfapFace* self, const GstSegment& segment, uint64_t frame) {
+  Stream& s = *self->stream;
+  const GstClockTime from = frame_time(self, segment, s.frame);
+  const GstClockTime to = frame_time(self, segment, frame);
+  GST_DEBUG_OBJECT(self, "face at rest: a gap from %" GST_TIME_FORMAT " to %" GST_TIME_FORMAT,
+                   GST_TIME_ARGS(from), GST_TIME_ARGS(to));
+  s.frame = frame;
+  GST_OBJECT_LOCK(self);
+  GST_AGGREGATOR_PAD(GST_AGGREGATOR_SRC_PAD(self))->segment.position = to;
+  GST_OBJECT_UNLOCK(self);
+  // A frame went out before (s.frame > 0), so the stream's start, caps and segment have too.
+  gst_pad_push_event(GST_AGGREGATOR_SRC_PAD(self), gst_event_new_gap(from, to - from));
+}
+
 // Draws every frame whose markup is known: all of it has come when a later buffer is
 // queued, a GAP covers the frame's time, or the input ended. The base class calls this only
 // while input is queued or has ended, so one call draws all the frames a GAP covers. A
@@ -248,10 +290,12 @@ static GstFlowReturn gst_pfap_face_aggregate(GstAggregator* agg, gboolean timeou
 
     // Apply everything up to this frame's time.
     bool later_input = false;
+    int64_t next_input = -1;
     while (GstBuffer* buffer = gst_aggregator_pad_peek_buffer(self->sinkpad)) {
       const int64_t start = input_running_time(self, GST_BUFFER_PTS(buffer));
       if (start > at) {
         later_input = true;
+        next_input = start;
         gst_buffer_unref(buffer);
         break;
       }
@@ -271,6 +315,15 @@ static GstFlowReturn gst_pfap_face_aggregate(GstAggregator* agg, gboolean timeou
     const bool known = later_input || s.covered_until > at || (ended && at < s.animator.end_ns());
     if (!known && (ended || !timeout)) {
       return ended ? GST_FLOW_EOS : GST_AGGREGATOR_FLOW_NEED_DATA;
+    }
+
+    if (known) {
+      const uint64_t rest_end = rest_until_frame(self, segment, at,
+                                                 later_input ? next_input : s.covered_until);
+      if (rest_end > 0) {
+        skip_to_frame(self, segment, rest_end);
+        continue;
+      }
     }
 
     const GstFlowReturn ret = push_frame(self, pts, next, at);

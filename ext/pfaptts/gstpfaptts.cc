@@ -20,7 +20,12 @@
  * follows the audio before it at once. The `pfap` stream is sparse.
  *
  * A bad bookmark is an error naming its character (counted from 1 in the utterance); with
- * #GstPfapTts:skip-bad-bookmarks it is a warning, and the bookmark is left out.
+ * #GstPfapTts:skip-bad-bookmarks it is a warning (at the 1st, 2nd, 4th, ... only, counted in
+ * #GstPfapTts:bad-bookmarks), and the bookmark is left out.
+ *
+ * An utterance is spoken a piece (about a sentence) at a time: a long text starts speaking
+ * after its first sentence, the speech held is one piece's whatever the text's length, and a
+ * flush or a state change stops it within one piece (docs/tts.md, "Long texts").
  *
  * Both source pads are pushed from one thread: put a queue on each branch, as after a demuxer.
  *
@@ -38,12 +43,15 @@
 #include <gst/base/gstflowcombiner.h>
 
 #include <algorithm>
+#include <atomic>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "pfap/markup.h"
 #include "markupbuffer.h"
+#include "pieces.h"
+#include "ratelimit.h"
 #include "speech.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfaptts_debug);
@@ -67,6 +75,7 @@ enum {
   PROP_PITCH,
   PROP_VOLUME,
   PROP_SKIP_BAD_BOOKMARKS,
+  PROP_BAD_BOOKMARKS,
 };
 
 // The output timeline: a position is `base` plus `samples` at `rate`, so that a change of rate
@@ -81,6 +90,9 @@ struct Stream {
   bool pfap_discont = true;
   GstSegment input_segment;               // the sink pad's, for utterance running times
   std::set<std::string> warned_phonemes;  // inexact mnemonics already warned about
+  // Set from other threads (flush-start, PAUSED to READY) to stop a synthesis at once;
+  // cleared by reset().
+  std::atomic<bool> cancel{false};
 
   // The time of sample number `n` of the current count.
   GstClockTime time_at(uint64_t n) const {
@@ -105,6 +117,7 @@ struct _GstPfapTts {
   gint pitch;
   gint volume;
   gboolean skip_bad_bookmarks;
+  guint64 bad_bookmarks;  // left out since READY to PAUSED
 
   Stream* stream;  // the streaming thread's
 };
@@ -142,6 +155,7 @@ static void reset(GstPfapTts* self, bool new_stream) {
   s.pfap_discont = true;
   gst_segment_init(&s.input_segment, GST_FORMAT_TIME);
   s.warned_phonemes.clear();
+  s.cancel = false;
   gst_flow_combiner_reset(self->flow_combiner);
 }
 
@@ -258,51 +272,25 @@ static void warn_inexact(GstPfapTts* self, const pfap::tts::Speech& speech,
   }
 }
 
-// Speaks one utterance starting at running time `at` (GST_CLOCK_TIME_NONE: right after the
-// audio before it) and pushes it on both pads, phonemes interleaved with their audio.
-static GstFlowReturn speak(GstPfapTts* self, std::string_view input, GstClockTime at) {
-  const gchar* bad_utf8 = nullptr;
-  if (!g_utf8_validate(input.data(), static_cast<gssize>(input.size()), &bad_utf8)) {
-    GST_ELEMENT_ERROR(
-        self, STREAM, DECODE,
-        ("The text is not UTF-8 at byte %zu", static_cast<size_t>(bad_utf8 - input.data()) + 1),
-        (nullptr));
-    return GST_FLOW_ERROR;
-  }
-  std::vector<pfap::tts::BadBookmark> bad;
-  const pfap::tts::Utterance utterance = pfap::tts::parse_utterance(input, bad);
-  GST_OBJECT_LOCK(self);
-  const bool skip = self->skip_bad_bookmarks;
-  GST_OBJECT_UNLOCK(self);
-  for (const pfap::tts::BadBookmark& b : bad) {
-    if (!skip) {
-      GST_ELEMENT_ERROR(
-          self, STREAM, FORMAT,
-          ("Bad bookmark at character %zu: %s", b.character + 1, pfap::to_string(b.status)),
-          ("set skip-bad-bookmarks to warn and leave it out"));
-      return GST_FLOW_ERROR;
-    }
-    GST_ELEMENT_WARNING(self, STREAM, FORMAT,
-                        ("Left out a bad bookmark at character %zu: %s", b.character + 1,
-                         pfap::to_string(b.status)),
-                        (nullptr));
-  }
-
-  const pfap::tts::VoiceSettings settings = voice_settings(self);
+// Speaks one piece of an utterance starting at running time `at` (GST_CLOCK_TIME_NONE: right
+// after the audio before it) and pushes it on both pads, phonemes interleaved with their audio.
+static GstFlowReturn speak_piece(GstPfapTts* self, const pfap::tts::Utterance& piece,
+                                 const pfap::tts::VoiceSettings& settings, GstClockTime at) {
+  Stream& s = *self->stream;
   pfap::tts::Speech speech;
   std::string error;
-  if (!pfap::tts::speak(utterance, settings, speech, error)) {
+  if (!pfap::tts::speak(piece, settings, speech, error, &s.cancel)) {
     GST_ELEMENT_ERROR(self, LIBRARY, FAILED, ("%s", error.c_str()), (nullptr));
     return GST_FLOW_ERROR;
   }
+  if (s.cancel) return GST_FLOW_FLUSHING;
   warn_inexact(self, speech, settings.voice);
 
-  Stream& s = *self->stream;
   send_events(self, speech.sample_rate);
   GstFlowReturn ret = GST_FLOW_OK;
   if (GST_CLOCK_TIME_IS_VALID(at)) ret = push_silence(self, at);
   const uint64_t first = s.samples;
-  GST_DEBUG_OBJECT(self, "utterance of %zu phonemes, %zu samples at %" GST_TIME_FORMAT,
+  GST_DEBUG_OBJECT(self, "piece of %zu phonemes, %zu samples at %" GST_TIME_FORMAT,
                    speech.phonemes.size(), speech.samples.size(), GST_TIME_ARGS(s.position()));
   for (const pfap::tts::SpokenPhoneme& p : speech.phonemes) {
     if (ret != GST_FLOW_OK) break;
@@ -321,6 +309,66 @@ static GstFlowReturn speak(GstPfapTts* self, std::string_view input, GstClockTim
     ret = combine(self, self->pfappad, gst_pad_push(self->pfappad, buffer));
     if (ret == GST_FLOW_OK) ret = push_audio(self, speech.samples.data() + p.start, p.n_samples);
   }
+  return ret;
+}
+
+// A bad bookmark: an error, or with skip-bad-bookmarks a warning at the 1st, 2nd, 4th, ...
+// (one text can hold thousands) and the bookmark left out. False when it is an error.
+static bool handle_bad_bookmark(GstPfapTts* self, const pfap::tts::BadBookmark& b) {
+  GST_OBJECT_LOCK(self);
+  const bool skip = self->skip_bad_bookmarks;
+  const guint64 count = skip ? ++self->bad_bookmarks : self->bad_bookmarks;
+  GST_OBJECT_UNLOCK(self);
+  if (!skip) {
+    GST_ELEMENT_ERROR(
+        self, STREAM, FORMAT,
+        ("Bad bookmark at character %zu: %s", b.character + 1, pfap::to_string(b.status)),
+        ("set skip-bad-bookmarks to warn and leave it out"));
+    return false;
+  }
+  GST_DEBUG_OBJECT(self, "left out a bad bookmark at character %zu: %s", b.character + 1,
+                   pfap::to_string(b.status));
+  if (pfap_warn_at(count)) {
+    GST_ELEMENT_WARNING(self, STREAM, FORMAT,
+                        ("Left out a bad bookmark at character %zu: %s", b.character + 1,
+                         pfap::to_string(b.status)),
+                        ("%" G_GUINT64_FORMAT
+                         " bad bookmarks left out so far (warned at the 1st, 2nd, 4th, 8th, ...; "
+                         "the bad-bookmarks property counts them)",
+                         count));
+  }
+  return true;
+}
+
+// Speaks one utterance starting at running time `at` (GST_CLOCK_TIME_NONE: right after the
+// audio before it), a piece (about a sentence) at a time: the first is heard after its own
+// synthesis, the speech held is one piece's, and a flush or a state change stops it at the
+// next push (docs/tts.md, "Long texts").
+static GstFlowReturn speak(GstPfapTts* self, std::string_view input, GstClockTime at) {
+  const gchar* bad_utf8 = nullptr;
+  if (!g_utf8_validate(input.data(), static_cast<gssize>(input.size()), &bad_utf8)) {
+    GST_ELEMENT_ERROR(
+        self, STREAM, DECODE,
+        ("The text is not UTF-8 at byte %zu", static_cast<size_t>(bad_utf8 - input.data()) + 1),
+        (nullptr));
+    return GST_FLOW_ERROR;
+  }
+  std::vector<pfap::tts::BadBookmark> bad;
+  const pfap::tts::Utterance utterance = pfap::tts::parse_utterance(input, bad);
+  for (const pfap::tts::BadBookmark& b : bad) {
+    if (!handle_bad_bookmark(self, b)) return GST_FLOW_ERROR;
+  }
+
+  const pfap::tts::VoiceSettings settings = voice_settings(self);
+  GstFlowReturn ret = GST_FLOW_OK;
+  size_t from = 0;
+  size_t next_bookmark = 0;
+  do {
+    const size_t end = pfap::tts::piece_end(utterance.text, from);
+    ret = speak_piece(self, pfap::tts::piece(utterance, from, end, next_bookmark), settings, at);
+    at = GST_CLOCK_TIME_NONE;
+    from = end;
+  } while (ret == GST_FLOW_OK && from < utterance.text.size());
   return ret;
 }
 
@@ -381,6 +429,9 @@ static gboolean gst_pfap_tts_sink_event(GstPad* pad, GstObject* parent, GstEvent
     case GST_EVENT_EOS:
       gst_event_unref(event);
       return push_eos(self);
+    case GST_EVENT_FLUSH_START:
+      s.cancel = true;
+      break;
     case GST_EVENT_FLUSH_STOP:
       reset(self, false);
       break;
@@ -423,8 +474,13 @@ static gboolean gst_pfap_tts_audio_activate_mode(GstPad* pad, GstObject*, GstPad
 static GstStateChangeReturn gst_pfap_tts_change_state(GstElement* element,
                                                       GstStateChange transition) {
   GstPfapTts* self = GST_PFAP_TTS(element);
+  // The streaming thread may be inside a synthesis: stop it before the pads wait for it.
+  if (transition == GST_STATE_CHANGE_PAUSED_TO_READY) self->stream->cancel = true;
   if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) {
     reset(self, true);
+    GST_OBJECT_LOCK(self);
+    self->bad_bookmarks = 0;
+    GST_OBJECT_UNLOCK(self);
     unsigned rate = 0;
     std::string error;
     if (!pfap::tts::check_voice(voice_settings(self), rate, error)) {
@@ -503,6 +559,9 @@ static void gst_pfap_tts_get_property(GObject* object, guint prop_id, GValue* va
     case PROP_SKIP_BAD_BOOKMARKS:
       g_value_set_boolean(value, self->skip_bad_bookmarks);
       break;
+    case PROP_BAD_BOOKMARKS:
+      g_value_set_uint64(value, self->bad_bookmarks);
+      break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
       break;
@@ -579,6 +638,17 @@ static void gst_pfap_tts_class_init(GstPfapTtsClass* klass) {
       g_param_spec_boolean("skip-bad-bookmarks", "Skip bad bookmarks",
                            "Warn about a bad bookmark and leave it out, instead of an error", FALSE,
                            kPlaying));
+  /**
+   * GstPfapTts:bad-bookmarks:
+   *
+   * The bad bookmarks left out (#GstPfapTts:skip-bad-bookmarks) since the element last went
+   * from READY to PAUSED. Their warnings come at the 1st, 2nd, 4th, 8th, ... only.
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_BAD_BOOKMARKS,
+      g_param_spec_uint64("bad-bookmarks", "Bad bookmarks",
+                          "Bad bookmarks left out since READY to PAUSED", 0, G_MAXUINT64, 0,
+                          static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
 
   gst_element_class_add_static_pad_template(element_class, &sink_template);
   gst_element_class_add_static_pad_template(element_class, &audio_template);
@@ -615,5 +685,6 @@ static void gst_pfap_tts_init(GstPfapTts* self) {
   self->pitch = kDefaultPitch;
   self->volume = kDefaultVolume;
   self->skip_bad_bookmarks = FALSE;
+  self->bad_bookmarks = 0;
   self->stream = new Stream{};
 }

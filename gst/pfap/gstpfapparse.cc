@@ -21,10 +21,10 @@
  * A bad line (a field that does not parse, time going back, bad bookmarks, invalid UTF-8,
  * more than 65536 bytes, or a time past about 292 years) is an
  * error naming its line, its column (in bytes, from 1) and what is wrong; with
- * #GstPfapParse:skip-bad-lines it is a warning instead, and the lines after it are read as
- * usual. Input that arrives from sources without caps (filesrc, fdsrc) is taken as .pfap
- * text; caps, when given, must be text/x-pfap (the typefinder's, for decodebin) or
- * text/x-raw,format=utf8.
+ * #GstPfapParse:skip-bad-lines it is a warning instead (at the 1st, 2nd, 4th, ... bad line,
+ * all counted in #GstPfapParse:bad-lines), and the lines after it are read as usual. Input
+ * that arrives from sources without caps (filesrc, fdsrc) is taken as .pfap text; caps, when
+ * given, must be text/x-pfap (the typefinder's, for decodebin) or text/x-raw,format=utf8.
  *
  * Seeking is not supported: the text must be read from its start, as times and sentence
  * starts depend on the lines before. A flush starts the text anew: the next line is line 1,
@@ -49,6 +49,7 @@
 #include "pfap/text.h"
 #include "gstpfaptypefind.h"
 #include "markupbuffer.h"
+#include "ratelimit.h"
 #include "sparse.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapparse_debug);
@@ -60,7 +61,7 @@ namespace {
 // stream without line ends takes, and the FAPs of one event to what x-pfap holds.
 constexpr size_t kMaxLineBytes = 64 * 1024;
 
-enum { PROP_0, PROP_SKIP_BAD_LINES, PROP_ALPHABET };
+enum { PROP_0, PROP_SKIP_BAD_LINES, PROP_ALPHABET, PROP_BAD_LINES };
 
 // What the streaming thread keeps between buffers. GObject runs no C++ constructors, so it
 // lives behind a pointer made in init and deleted in finalize.
@@ -80,6 +81,7 @@ struct _GstPfapParse {
   GstPad* sinkpad;
   GstPad* srcpad;
   gboolean skip_bad_lines;  // under the object lock
+  guint64 bad_lines;        // under the object lock: skipped since READY to PAUSED
   gchar* alphabet;          // under the object lock; NULL when unset
   Stream* stream;
 };
@@ -164,14 +166,23 @@ static std::string source_name(GstPfapParse* self) {
 static GstFlowReturn bad_line(GstPfapParse* self, size_t column, const std::string& what) {
   GST_OBJECT_LOCK(self);
   const bool skip = self->skip_bad_lines;
+  const guint64 count = skip ? ++self->bad_lines : self->bad_lines;
   GST_OBJECT_UNLOCK(self);
   const uint64_t line = self->stream->line;
   const std::string source = source_name(self);
   if (skip) {
-    GST_ELEMENT_WARNING(self, STREAM, DECODE,
-                        ("Skipped .pfap line %" G_GUINT64_FORMAT ", column %zu%s: %s", line,
-                         column + 1, source.c_str(), what.c_str()),
-                        (nullptr));
+    GST_DEBUG_OBJECT(self, "skipped line %" G_GUINT64_FORMAT ", column %zu%s: %s", line,
+                     column + 1, source.c_str(), what.c_str());
+    // Random bytes are a bad line every few hundred bytes: warn at the 1st, 2nd, 4th, ...
+    if (pfap_warn_at(count)) {
+      GST_ELEMENT_WARNING(self, STREAM, DECODE,
+                          ("Skipped .pfap line %" G_GUINT64_FORMAT ", column %zu%s: %s", line,
+                           column + 1, source.c_str(), what.c_str()),
+                          ("%" G_GUINT64_FORMAT
+                           " bad lines skipped so far (warned at the 1st, 2nd, 4th, 8th, ...; "
+                           "the bad-lines property counts them)",
+                           count));
+    }
     return GST_FLOW_OK;
   }
   GST_ELEMENT_ERROR(self, STREAM, DECODE,
@@ -325,7 +336,13 @@ static gboolean gst_pfap_parse_src_query(GstPad* pad, GstObject* parent, GstQuer
 
 static GstStateChangeReturn gst_pfap_parse_change_state(GstElement* element,
                                                         GstStateChange transition) {
-  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) reset(GST_PFAP_PARSE(element));
+  GstPfapParse* self = GST_PFAP_PARSE(element);
+  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) {
+    reset(self);
+    GST_OBJECT_LOCK(self);
+    self->bad_lines = 0;
+    GST_OBJECT_UNLOCK(self);
+  }
   return GST_ELEMENT_CLASS(gst_pfap_parse_parent_class)->change_state(element, transition);
 }
 
@@ -364,6 +381,11 @@ static void gst_pfap_parse_get_property(GObject* object, guint prop_id, GValue* 
       g_value_set_string(value, self->alphabet);
       GST_OBJECT_UNLOCK(self);
       break;
+    case PROP_BAD_LINES:
+      GST_OBJECT_LOCK(self);
+      g_value_set_uint64(value, self->bad_lines);
+      GST_OBJECT_UNLOCK(self);
+      break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
       break;
@@ -390,7 +412,8 @@ static void gst_pfap_parse_class_init(GstPfapParseClass* klass) {
    * GstPfapParse:skip-bad-lines:
    *
    * What a bad line does: FALSE (the default) posts an error and stops the stream; TRUE
-   * posts a warning naming the line and what is wrong with it, drops the line and reads on.
+   * posts a warning naming the line and what is wrong with it (at the 1st, 2nd, 4th, 8th,
+   * ... bad line only), drops the line and reads on.
    */
   g_object_class_install_property(
       gobject_class, PROP_SKIP_BAD_LINES,
@@ -414,6 +437,18 @@ static void gst_pfap_parse_class_init(GstPfapParseClass* klass) {
                           nullptr,
                           static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
                                                    GST_PARAM_MUTABLE_READY)));
+
+  /**
+   * GstPfapParse:bad-lines:
+   *
+   * The bad lines skipped (#GstPfapParse:skip-bad-lines) since the element last went from
+   * READY to PAUSED.
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_BAD_LINES,
+      g_param_spec_uint64("bad-lines", "Bad lines", "Bad lines skipped since READY to PAUSED", 0,
+                          G_MAXUINT64, 0,
+                          static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
 
   gst_element_class_add_static_pad_template(element_class, &sink_template);
   gst_element_class_add_static_pad_template(element_class, &src_template);
@@ -439,6 +474,7 @@ static void gst_pfap_parse_init(GstPfapParse* self) {
   gst_element_add_pad(GST_ELEMENT(self), self->srcpad);
 
   self->skip_bad_lines = FALSE;
+  self->bad_lines = 0;
   self->alphabet = nullptr;
   self->stream = new Stream{};
 }

@@ -251,6 +251,66 @@ TEST(PfapFaceTiming, GapEventReleasesFramesThroughIt) {
   unref_all(frames);
 }
 
+// The outside tester's two-line file: "0 1 60 120 W", then "9223372032759 1 60 120 E", 292
+// years later. The face at rest draws 10 s of frames, then one GAP event up to the frame of
+// the next event, not a frame every 40 ms for centuries (docs/face.md, "Long silences").
+TEST(PfapFaceTiming, FarFutureEventCostsOneGapNotCenturiesOfFrames) {
+  Face face;
+  const GstClockTime far = 9223372032759 * kMs;
+  face.push(phoneme("W", 0, 120));
+  face.push(phoneme("EH", far, 120));
+  face.eos();
+  std::vector<GstBuffer*> frames;
+  std::vector<GstEvent*> gaps;
+  bool eos = false;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (!eos && frames.size() < 1000 && std::chrono::steady_clock::now() < deadline) {
+    if (GstBuffer* b = gst_harness_try_pull(face.harness())) {
+      frames.push_back(b);
+      continue;
+    }
+    while (GstEvent* e = gst_harness_try_pull_event(face.harness())) {
+      if (GST_EVENT_TYPE(e) == GST_EVENT_GAP) {
+        gaps.push_back(e);
+        continue;
+      }
+      eos = eos || GST_EVENT_TYPE(e) == GST_EVENT_EOS;
+      gst_event_unref(e);
+    }
+    if (!eos) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_TRUE(eos) << frames.size() << " frames";
+  // 0 .. 10.08 s: the phoneme and 10 s at rest; then 9223372032720 .. 9223372032840 ms.
+  ASSERT_EQ(frames.size(), 257u);
+  EXPECT_EQ(GST_BUFFER_PTS(frames[252]), 10080 * kMs);
+  EXPECT_EQ(GST_BUFFER_PTS(frames[253]), 9223372032720 * kMs);
+  EXPECT_EQ(GST_BUFFER_PTS(frames.back()), 9223372032840 * kMs);
+  ASSERT_EQ(gaps.size(), 1u);
+  GstClockTime gap_pts = 0, gap_duration = 0;
+  gst_event_parse_gap(gaps[0], &gap_pts, &gap_duration);
+  EXPECT_EQ(gap_pts, 10120 * kMs);
+  EXPECT_EQ(gap_pts + gap_duration, GST_BUFFER_PTS(frames[253]));
+  // The frame after the gap is the face at rest, as the one before it.
+  EXPECT_EQ(face.picture(frames[252]), face.picture(frames[253]));
+  unref_all(frames);
+  for (GstEvent* e : gaps) gst_event_unref(e);
+}
+
+// A GAP from upstream (a TTS's silence) of an hour: the same, 10 s of frames, then a gap.
+TEST(PfapFaceTiming, LongGapEventIsPassedOnAfterTenSecondsAtRest) {
+  Face face;
+  face.push(phoneme("HH", 0, 100));
+  face.push_gap(100 * kMs, 3600 * GST_SECOND);
+  face.push(phoneme("AY", 3600 * GST_SECOND + 100 * kMs, 100));
+  face.eos();
+  std::vector<GstBuffer*> frames = face.frames_until_eos();
+  // 0 .. 10.08 s, then the frame holding 3600.1 s and those of "AY".
+  ASSERT_LT(frames.size(), 270u);
+  EXPECT_EQ(GST_BUFFER_PTS(frames[252]), 10080 * kMs);
+  EXPECT_EQ(GST_BUFFER_PTS(frames[253]), 3600080 * kMs);
+  unref_all(frames);
+}
+
 TEST(PfapFaceTiming, EmptyStreamEndsWithoutFrames) {
   Face face;
   face.eos();

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <iostream>
 #include <mutex>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "glib_log.h"
+#include "heap.h"
 #include "lip_sync.h"
 #include "pfap/markup.h"
 #include "pfap_buffers.h"
@@ -299,6 +301,121 @@ TEST(PfapTts, BadBookmarkSkippedWithAWarning) {
   EXPECT_EQ(faps, 1);
 }
 
+// 10,000 bad bookmarks in one text: warnings at the 1st, 2nd, 4th, ... 8192nd (14), every one
+// counted in bad-bookmarks, the text spoken.
+TEST(PfapTts, BadBookmarkWarningsAreRateLimited) {
+  Tts t;
+  g_object_set(t.element(), "skip-bad-bookmarks", TRUE, nullptr);
+  std::string text;
+  for (int i = 0; i < 10000; ++i) text += "<FAP 3 1 0 7>";
+  text += " Hello.";
+  EXPECT_EQ(t.say(text), GST_FLOW_OK);
+  const std::vector<std::string> warnings = t.warnings();
+  EXPECT_EQ(warnings.size(), 14u);
+  guint64 bad = 0;
+  g_object_get(t.element(), "bad-bookmarks", &bad, nullptr);
+  EXPECT_EQ(bad, 10000u);
+  EXPECT_FALSE(t.phonemes().empty());
+}
+
+// The outside tester's 1 MiB text in one buffer (docs/tts.md, "Long texts"): spoken a sentence
+// at a time, so the first audio comes after the first sentence's synthesis (the whole text
+// would take minutes), the heap holds one sentence's speech, and going to NULL mid-text
+// returns at once.
+TEST(PfapTts, LongTextSpeaksSentenceBySentenceAndStopsAtOnce) {
+  std::string text;
+  while (text.size() < (1u << 20)) text += "The quick brown fox jumps over the lazy dog. ";
+  text.resize(1u << 20);
+  pfap::testing::Pipeline p(
+      "appsrc name=src format=time ! text/x-raw,format=utf8 ! pfaptts name=t "
+      "t.audio ! queue ! fakesink name=audio sync=false t.pfap ! queue ! fakesink sync=false");
+  ASSERT_TRUE(p.ok()) << p.error();
+
+  struct Watch {
+    std::mutex mutex;
+    std::condition_variable cond;
+    std::chrono::steady_clock::time_point first_audio{};
+    uint64_t samples = 0;
+    size_t peak_heap = 0;
+  } watch;
+  GstPad* audio = gst_element_get_static_pad(p.by_name("t"), "audio");
+  gst_pad_add_probe(
+      audio, GST_PAD_PROBE_TYPE_BUFFER,
+      [](GstPad*, GstPadProbeInfo* info, gpointer data) {
+        auto* w = static_cast<Watch*>(data);
+        std::lock_guard lock(w->mutex);
+        if (w->samples == 0) w->first_audio = std::chrono::steady_clock::now();
+        w->samples += gst_buffer_get_size(GST_PAD_PROBE_INFO_BUFFER(info)) / 2;
+        w->peak_heap = std::max(w->peak_heap, pfap::testing::heap_bytes());
+        w->cond.notify_all();
+        return GST_PAD_PROBE_OK;
+      },
+      &watch, nullptr);
+  gst_object_unref(audio);
+
+  ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+  const size_t heap_before = pfap::testing::heap_bytes();
+  const auto pushed = std::chrono::steady_clock::now();
+  ASSERT_EQ(pfap::testing::push(p.by_name("src"), gst_buffer_new_memdup(text.data(), text.size())),
+            GST_FLOW_OK);
+  {
+    std::unique_lock lock(watch.mutex);
+    ASSERT_TRUE(watch.cond.wait_for(lock, std::chrono::seconds(5), [&] { return watch.samples > 0; }))
+        << "no audio 5 s after a 1 MiB text";
+    const auto first_ms =
+        std::chrono::duration_cast<std::chrono::milliseconds>(watch.first_audio - pushed).count();
+    EXPECT_LT(first_ms, 1000) << "the first audio came " << first_ms << " ms after the text";
+    // Some sentences later: 20 s of speech.
+    ASSERT_TRUE(watch.cond.wait_for(lock, std::chrono::seconds(20),
+                                    [&] { return watch.samples > 20u * kRate; }));
+  }
+  const auto stop = std::chrono::steady_clock::now();
+  EXPECT_EQ(gst_element_set_state(p.get(), GST_STATE_NULL), GST_STATE_CHANGE_SUCCESS);
+  const auto stop_ms = std::chrono::duration_cast<std::chrono::milliseconds>(
+                           std::chrono::steady_clock::now() - stop)
+                           .count();
+  EXPECT_LT(stop_ms, 1000) << "to NULL mid-text took " << stop_ms << " ms";
+  std::lock_guard lock(watch.mutex);
+  // The text (1 MiB, and 4 MiB as code points) and a sentence's speech; the whole text's speech
+  // would be 2.5 GB.
+  EXPECT_LT(watch.peak_heap - std::min(watch.peak_heap, heap_before), 32u << 20)
+      << "heap grew while speaking " << watch.samples / kRate << " s of a long text";
+}
+
+// The slowest piece to synthesize: 400 CJK characters (the longest piece) at the slowest rate
+// are minutes of speech, seconds of synthesis and f0. A flush, and going to NULL, in the middle
+// of it stop espeak-ng and the f0 at once.
+TEST(PfapTts, FlushAndStateChangeStopASynthesisInTheMiddle) {
+  std::string text;
+  for (int i = 0; i < 1200; ++i) text += "\u6F22";
+  pfap::testing::Pipeline p(
+      "appsrc name=src format=time ! text/x-raw,format=utf8 ! pfaptts name=t rate=80 "
+      "t.audio ! queue ! fakesink sync=false t.pfap ! queue ! fakesink sync=false");
+  ASSERT_TRUE(p.ok()) << p.error();
+  ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+  auto ms_since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() -
+                                                                 t)
+        .count();
+  };
+  GstElement* src = p.by_name("src");
+  GstPad* sink = gst_element_get_static_pad(p.by_name("t"), "sink");
+  ASSERT_EQ(pfap::testing::push(src, gst_buffer_new_memdup(text.data(), text.size())), GST_FLOW_OK);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  // flush-stop waits for the streaming thread to leave the element.
+  auto start = std::chrono::steady_clock::now();
+  EXPECT_TRUE(gst_pad_send_event(sink, gst_event_new_flush_start()));
+  EXPECT_TRUE(gst_pad_send_event(sink, gst_event_new_flush_stop(FALSE)));
+  EXPECT_LT(ms_since(start), 1000) << "a flush mid-synthesis took " << ms_since(start) << " ms";
+  gst_object_unref(sink);
+
+  ASSERT_EQ(pfap::testing::push(src, gst_buffer_new_memdup(text.data(), text.size())), GST_FLOW_OK);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  start = std::chrono::steady_clock::now();
+  EXPECT_EQ(gst_element_set_state(p.get(), GST_STATE_NULL), GST_STATE_CHANGE_SUCCESS);
+  EXPECT_LT(ms_since(start), 1000) << "to NULL mid-synthesis took " << ms_since(start) << " ms";
+}
+
 TEST(PfapTts, UtterancePtsGivesSilenceAndGap) {
   Tts t;
   ASSERT_EQ(t.say("First.", 0), GST_FLOW_OK);
@@ -398,8 +515,8 @@ TEST(PfapTts, PropertiesAreDocumented) {
   }
   g_free(specs);
   std::sort(own.begin(), own.end());
-  EXPECT_EQ(own, (std::vector<std::string>{"pitch", "rate", "skip-bad-bookmarks", "text", "voice",
-                                           "volume"}));
+  EXPECT_EQ(own, (std::vector<std::string>{"bad-bookmarks", "pitch", "rate", "skip-bad-bookmarks",
+                                           "text", "voice", "volume"}));
   gchar* voice = nullptr;
   gint rate = 0, pitch = 0, volume = 0;
   g_object_get(tts, "voice", &voice, "rate", &rate, "pitch", &pitch, "volume", &volume, nullptr);
