@@ -2,6 +2,8 @@
 // markup. Needs only GStreamer core, base and rtp.
 #include <gst/gst.h>
 
+#include "gstpfapmarksenc.h"
+#include "gstpfapmarksparse.h"
 #include "gstpfapparse.h"
 #include "gstpfaptextenc.h"
 #include "gstrtppfapdepay.h"
@@ -13,6 +15,8 @@ static gboolean plugin_init(GstPlugin* plugin) {
   ok &= GST_ELEMENT_REGISTER(rtppfapdepay, plugin);
   ok &= GST_ELEMENT_REGISTER(pfapparse, plugin);
   ok &= GST_ELEMENT_REGISTER(pfaptextenc, plugin);
+  ok &= GST_ELEMENT_REGISTER(pfapmarksenc, plugin);
+  ok &= GST_ELEMENT_REGISTER(pfapmarksparse, plugin);
   return ok;
 }
 

@@ -471,7 +471,7 @@ TEST(GstInspect, Depayloader) {
 TEST(GstInspect, EachPluginListsItsElements) {
   ASSERT_TRUE(plugin_available(kElements));
   const std::vector<std::pair<const char*, std::vector<const char*>>> plugins = {
-      {"pfap", {kPay, kDepay, "pfapparse", "pfaptextenc"}},
+      {"pfap", {kPay, kDepay, "pfapparse", "pfaptextenc", "pfapmarksenc", "pfapmarksparse"}},
       {"pfaptts", {"pfaptts"}},
       {"pfapface", {"pfapface"}},
   };
