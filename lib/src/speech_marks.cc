@@ -13,6 +13,7 @@ namespace {
 using Spoken = MarksWriter::Spoken;
 
 constexpr int64_t kNsPerTick = 100;  // Azure's unit
+constexpr int64_t kNsPerSecond = 1'000'000'000;
 constexpr int64_t kTicksPerMs = kNsPerMs / kNsPerTick;
 // Times must end in ns that fit an int64 (about 292 years), as .pfap text times.
 constexpr int64_t kMaxTimeMs = INT64_MAX / kNsPerMs - kMaxPhonemeDurationMs;
@@ -295,7 +296,7 @@ void write_marks(MarksFormat format, const std::vector<Spoken>& phonemes, std::s
 }
 
 MarksWriter::MarksWriter(MarksFormat format, int frames_per_second)
-    : format_(format), frame_ns_num_(1'000'000'000), fps_(std::max(1, frames_per_second)) {}
+    : format_(format), fps_(std::max(1, frames_per_second)) {}
 
 void MarksWriter::reset() {
   utterance_.clear();
@@ -315,6 +316,16 @@ bool MarksWriter::flush_utterance(const Sink& sink) {
   return sink(text_);
 }
 
+// Frame k is at k / fps s, computed without overflow for any time an int64 of ns holds.
+int64_t MarksWriter::frame_time(int64_t k) const {
+  return k / fps_ * kNsPerSecond + k % fps_ * kNsPerSecond / fps_;
+}
+
+int64_t MarksWriter::first_frame_from(int64_t ns) const {
+  const int64_t k = ns / kNsPerSecond * fps_ + ns % kNsPerSecond * fps_ / kNsPerSecond;
+  return frame_time(k) < ns ? k + 1 : k;
+}
+
 bool MarksWriter::frames_until(int64_t end_ns, const Sink& sink) {
   text_.clear();
   if (format_ == MarksFormat::kArkitCsv && !wrote_header_) {
@@ -331,7 +342,13 @@ bool MarksWriter::frames_until(int64_t end_ns, const Sink& sink) {
   int batch = 0;
   FapAmplitudes faps{};
   for (;;) {
-    const int64_t t = next_frame_ * frame_ns_num_ / fps_;
+    int64_t t = frame_time(next_frame_);
+    // Once everything has settled, frames repeat the same face: a rest longer than
+    // kMaxRestNs is written for that long, then the frames go on at the next event.
+    if (t >= end_ns_ + kMaxRestNs && end_ns > t) {
+      next_frame_ = first_frame_from(end_ns);
+      t = frame_time(next_frame_);
+    }
     if (t >= end_ns) break;
     for (int i = kMinFapIndex; i <= kMaxFapIndex; ++i) faps[i] = state_.amplitude(i, t);
     const Viseme viseme =
@@ -349,6 +366,8 @@ bool MarksWriter::frames_until(int64_t end_ns, const Sink& sink) {
 }
 
 bool MarksWriter::add(const MarkupEvent& event, int64_t time_ns, const Sink& sink) {
+  // Far past any stream (146 years), and room for the durations added to it.
+  time_ns = std::clamp<int64_t>(time_ns, 0, INT64_MAX / 2);
   Spoken spoken{};
   if (event.kind == PFAP_EVENT_PHONEME) {
     const std::optional<VisemeSet> visemes =
@@ -448,7 +467,10 @@ void MarksReader::emit_pending(int64_t end_ms, std::vector<TextEvent>& out) {
   if (!has_pending_) return;
   has_pending_ = false;
   std::vector<Phoneme> pieces;
-  const int64_t duration = std::max<int64_t>(0, end_ms - pending_.time_ms);
+  // Longer than the wire's 4095 ms is split; past kMaxVisemeMs the rest is left a gap (the
+  // next event's PTS says when it comes), so that a time far ahead costs no more.
+  const int64_t duration =
+      std::clamp<int64_t>(end_ms - pending_.time_ms, 0, MarksReader::kMaxVisemeMs);
   split_long_phoneme(pending_.event.phoneme, static_cast<uint32_t>(std::min<int64_t>(
                                                  duration, UINT32_MAX)),
                      pieces);

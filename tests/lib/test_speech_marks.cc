@@ -228,6 +228,29 @@ TEST(SpeechMarks, LongVisemesAreSplitAsTheWireNeeds) {
   EXPECT_EQ(events[3].time_ms, 9500);
 }
 
+TEST(SpeechMarks, AVisemeFarAheadCostsNoMoreThanItsCap) {
+  const std::vector<TextEvent> events =
+      read_lines(MarksInput::kRhubarb, "0.0\tX\n9000000000.0\tA\n");
+  ASSERT_EQ(events.size(), 17u);  // X cut at 16 pieces of 4095 ms, then A far ahead
+  EXPECT_EQ(events[15].time_ms, 15 * 4095);
+  EXPECT_EQ(events[16].time_ms, 9'000'000'000'000);
+}
+
+TEST(SpeechMarks, ArkitFramesOfALongRestAreLeftOut) {
+  const std::string csv = write(MarksFormat::kArkitCsv,
+                                {event(0, phoneme(1, 100), true), event(60'000, phoneme(1, 100))},
+                                10);
+  std::istringstream lines(csv);
+  std::string line;
+  std::vector<std::string> rows;
+  while (std::getline(lines, line)) rows.push_back(line);
+  // Header; 0 up to 10 s after the phoneme's end at 0.1 s (101 frames), then 60 and 60.1 s.
+  ASSERT_EQ(rows.size(), 1u + 101 + 2);
+  EXPECT_TRUE(rows[101].starts_with("10000.000,"));
+  EXPECT_TRUE(rows[102].starts_with("60000.000,"));
+  EXPECT_TRUE(rows[103].starts_with("60100.000,"));
+}
+
 TEST(SpeechMarks, BadLinesSayWhatAndWhere) {
   const struct {
     MarksInput input;

@@ -42,6 +42,9 @@ class MarksWriter {
 
   static constexpr size_t kMaxUtterancePhonemes = 4096;
   static constexpr size_t kMaxDocumentPhonemes = 1'000'000;  // Rhubarb JSON
+  // ARKit frames of a rest (every phoneme and transition over) longer than this are left
+  // out: the frames after it keep their times, so a reader sees the jump.
+  static constexpr int64_t kMaxRestNs = 10'000'000'000;
   // A phoneme whose viseme is unknown (no alphabet, or a symbol not in it) is written as
   // this half-open mouth, the nearest to pfapface's generic mouth.
   static constexpr VisemeSet kUnknownVisemes{Viseme::kE, OculusViseme::kE, 4, 14, 3};
@@ -76,9 +79,10 @@ class MarksWriter {
  private:
   bool flush_utterance(const Sink& sink);
   bool frames_until(int64_t end_ns, const Sink& sink);
+  int64_t frame_time(int64_t k) const;
+  int64_t first_frame_from(int64_t ns) const;
 
   MarksFormat format_;
-  int64_t frame_ns_num_;  // a frame lasts 1e9 / frames_per_second ns: frame k at k * 1e9 / fps
   int fps_;
   const PhonemeAlphabet* alphabet_ = nullptr;
   std::vector<Spoken> utterance_;
@@ -133,6 +137,8 @@ class MarksReader {
  public:
   // A last viseme with no end given lasts this long.
   static constexpr int64_t kLastVisemeMs = 150;
+  // A viseme lasting longer (a long silence) is cut here: the time after it is a gap.
+  static constexpr int64_t kMaxVisemeMs = 16 * kMaxPhonemeDurationMs;
   static constexpr size_t kMaxDocumentBytes = 16 * 1024 * 1024;  // Rhubarb JSON
 
   explicit MarksReader(MarksInput input) : input_(input) {}
