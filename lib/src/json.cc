@@ -44,6 +44,7 @@ class Parser {
 
   bool value(Value& out, int depth) {
     if (depth > kMaxDepth) return fail("nested deeper than 16");
+    if (++values_ > kMaxValues) return fail("more than 400000 values");
     out.offset = pos_;
     if (pos_ >= text_.size()) return fail("the text ends where a value should be");
     switch (text_[pos_]) {
@@ -287,6 +288,7 @@ class Parser {
 
   std::string_view text_;
   size_t pos_ = 0;
+  size_t values_ = 0;
   Error error_;
 };
 

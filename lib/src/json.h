@@ -13,6 +13,8 @@
 namespace pfap::json {
 
 inline constexpr int kMaxDepth = 16;
+// Bounds the memory of a document's tree (about 100 bytes a value): 100,000 Rhubarb cues.
+inline constexpr size_t kMaxValues = 400'000;
 
 struct Value {
   enum class Type : uint8_t { kNull, kBool, kNumber, kString, kArray, kObject };
@@ -33,7 +35,7 @@ struct Error {
 };
 
 // Parses one JSON value filling all of `text` (white space around it allowed). Strings must
-// be valid UTF-8; nesting deeper than kMaxDepth is refused.
+// be valid UTF-8; nesting deeper than kMaxDepth, or more than kMaxValues values, is refused.
 bool parse(std::string_view text, Value& out, Error& error);
 
 // A JSON number as an integer count of 10^-decimals units: "1.25" with decimals 3 is 1250.

@@ -320,6 +320,13 @@ TEST(SpeechMarks, RhubarbJsonDocument) {
   EXPECT_EQ(bad.read_document(R"({"cues":[]})", out).status, MarksStatus::kMissingField);
   std::string deep(40, '[');
   EXPECT_EQ(bad.read_document(deep, out).status, MarksStatus::kBadJson);
+  // A tree's memory is bounded: at most 400,000 values in a document.
+  std::string wide = "{\"mouthCues\":[0";
+  for (int i = 0; i < 400'000; ++i) wide += ",0";
+  wide += "]}";
+  const MarksResult too_many = bad.read_document(wide, out);
+  EXPECT_EQ(too_many.status, MarksStatus::kBadJson);
+  EXPECT_STREQ(too_many.what, "more than 400000 values");
 }
 
 TEST(SpeechMarks, ArkitFramesAtTheFrameRate) {
