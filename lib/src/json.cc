@@ -83,13 +83,13 @@ class Parser {
     for (;;) {
       skip_space();
       if (pos_ >= text_.size() || text_[pos_] != '"') return fail("expected a member name");
-      std::pair<std::string, Value> member;
-      if (!string(member.first)) return false;
+      Member member;
+      if (!string(member.name)) return false;
       skip_space();
       if (pos_ >= text_.size() || text_[pos_] != ':') return fail("expected ':'");
       ++pos_;
       skip_space();
-      if (!value(member.second, depth + 1)) return false;
+      if (!value(member.value, depth + 1)) return false;
       out.members.push_back(std::move(member));
       skip_space();
       if (pos_ < text_.size() && text_[pos_] == ',') {
@@ -295,8 +295,8 @@ class Parser {
 }  // namespace
 
 const Value* Value::get(std::string_view key) const {
-  for (const auto& [name, value] : members) {
-    if (name == key) return &value;
+  for (const Member& member : members) {
+    if (member.name == key) return &member.value;
   }
   return nullptr;
 }

@@ -7,7 +7,6 @@
 #include <optional>
 #include <string>
 #include <string_view>
-#include <utility>
 #include <vector>
 
 namespace pfap::json {
@@ -16,6 +15,8 @@ inline constexpr int kMaxDepth = 16;
 // Bounds the memory of a document's tree (about 100 bytes a value): 100,000 Rhubarb cues.
 inline constexpr size_t kMaxValues = 400'000;
 
+struct Member;
+
 struct Value {
   enum class Type : uint8_t { kNull, kBool, kNumber, kString, kArray, kObject };
   Type type = Type::kNull;
@@ -23,10 +24,15 @@ struct Value {
   std::string text;      // a string's value (UTF-8), or a number as written
   size_t offset = 0;     // where the value starts in the document, in bytes
   std::vector<Value> items;                           // an array's
-  std::vector<std::pair<std::string, Value>> members;  // an object's, in document order
+  std::vector<Member> members;  // an object's, in document order
 
   // The member `key` of an object (the first, if repeated); nullptr if none.
   const Value* get(std::string_view key) const;
+};
+
+struct Member {
+  std::string name;
+  Value value;
 };
 
 struct Error {

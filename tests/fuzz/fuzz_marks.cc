@@ -39,7 +39,7 @@ void write_all(const std::vector<pfap::TextEvent>& events, const pfap::PhonemeAl
       if (format != pfap::MarksFormat::kArkitJson && format != pfap::MarksFormat::kArkitCsv) {
         out += text;
       }
-      return frames_bytes < (1u << 24);
+      return frames_bytes < (1u << 16);
     };
     bool ok = true;
     for (const pfap::TextEvent& e : events) {
