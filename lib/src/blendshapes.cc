@@ -32,13 +32,9 @@ constexpr double kTongueFull = 512;      // 45 thrust_tongue_tip (MW)
 constexpr double kNoseFull = 200;        // 61..63 (ENS)
 constexpr double kAngleUnit = 1e-5;      // rad, FAPs 48..50
 
-// A viseme's mouth as the FAP displacements pfapface adds for it (face/src/animator.cc,
-// viseme_shape; tests/face checks the two agree): jaw (3), upper mid lip down (4), lower mid
-// lip up (5), corners out (6, 7), corners up (12, 13), lips pushed (16, 17).
-struct Mouth {
-  double open_jaw, lower_t_midlip, raise_b_midlip, stretch_corner, raise_corner, push_lip;
-};
-constexpr std::array<Mouth, 15> kVisemeMouths{{
+// Each viseme's mouth, as face/src/animator.cc's viseme_shape (tests/face checks the two
+// agree): {open_jaw, lower_t_midlip, raise_b_midlip, stretch_corner, raise_corner, push_lip}.
+constexpr std::array<VisemeMouth, 15> kVisemeMouths{{
     {0, 0, 0, 0, 0, 0},          // none
     {0, 30, 30, 0, 0, 40},       // p b m
     {70, -40, 110, 0, 0, 0},     // f v
@@ -124,11 +120,26 @@ double neg(double x) { return std::max(0.0, -x); }
 
 const std::array<std::string_view, kBlendshapeCount>& blendshape_names() { return kNames; }
 
+VisemeMouth VisemeMouth::blend(const VisemeMouth& to, double u) const {
+  auto mix = [u](double a, double b) { return a + (b - a) * u; };
+  return {mix(open_jaw, to.open_jaw),           mix(lower_t_midlip, to.lower_t_midlip),
+          mix(raise_b_midlip, to.raise_b_midlip), mix(stretch_corner, to.stretch_corner),
+          mix(raise_corner, to.raise_corner),   mix(push_lip, to.push_lip)};
+}
+
+VisemeMouth viseme_mouth(Viseme viseme) {
+  return kVisemeMouths.at(static_cast<size_t>(viseme));
+}
+
 BlendshapeWeights blendshape_weights(const FapAmplitudes& faps, Viseme viseme) {
-  // The viseme's mouth added to the FAPs as pfapface adds it (Animator::faps): the points
-  // beside the middle of each lip move 0.7 as much.
+  return blendshape_weights(faps, viseme_mouth(viseme), viseme);
+}
+
+BlendshapeWeights blendshape_weights(const FapAmplitudes& faps, const VisemeMouth& m,
+                                     Viseme viseme) {
+  // The mouth added to the FAPs as pfapface adds it (Animator::faps): the points beside the
+  // middle of each lip move 0.7 as much.
   FapAmplitudes f = faps;
-  const Mouth& m = kVisemeMouths.at(static_cast<size_t>(viseme));
   f[3] += m.open_jaw;
   f[4] += m.lower_t_midlip;
   f[8] += 0.7 * m.lower_t_midlip;

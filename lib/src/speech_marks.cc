@@ -5,7 +5,6 @@
 #include <charconv>
 
 #include "json.h"
-#include "pfap/blendshapes.h"
 
 namespace pfap {
 namespace {
@@ -306,6 +305,7 @@ void MarksWriter::reset() {
   next_frame_ = 0;
   end_ns_ = 0;
   current_ = {};
+  mouth_from_ = {};
 }
 
 bool MarksWriter::flush_utterance(const Sink& sink) {
@@ -314,6 +314,27 @@ bool MarksWriter::flush_utterance(const Sink& sink) {
   write_marks(format_, utterance_, text_);
   utterance_.clear();
   return sink(text_);
+}
+
+// The mouth as pfapface's animator moves it (face/src/animator.cc, Animator::mouth): from
+// where it was when the phoneme started to the phoneme's viseme, eased (zero slope at both
+// ends) over at most kMouthEaseNs and half the phoneme; after its end, closing over
+// kMouthEaseNs.
+VisemeMouth MarksWriter::mouth(int64_t time_ns) const {
+  const auto ease = [](double u) {
+    u = std::clamp(u, 0.0, 1.0);
+    return u * u * (3 - 2 * u);
+  };
+  const Spoken& s = current_;
+  const VisemeMouth to = viseme_mouth(s.visemes.mpeg4);
+  const auto during = [&](int64_t t) {
+    const int64_t span = std::min(kMouthEaseNs, (s.end_ns - s.start_ns) / 2);
+    const double u = span > 0 ? ease(static_cast<double>(t - s.start_ns) / span) : 1.0;
+    return mouth_from_.blend(to, u);
+  };
+  if (time_ns < s.end_ns) return during(std::max(time_ns, s.start_ns));
+  return during(s.end_ns).blend(
+      VisemeMouth{}, ease(static_cast<double>(time_ns - s.end_ns) / kMouthEaseNs));
 }
 
 // Frame k is at k / fps s, computed without overflow for any time an int64 of ns holds.
@@ -353,8 +374,8 @@ bool MarksWriter::frames_until(int64_t end_ns, const Sink& sink) {
     for (int i = kMinFapIndex; i <= kMaxFapIndex; ++i) faps[i] = state_.amplitude(i, t);
     const Viseme viseme =
         t >= current_.start_ns && t < current_.end_ns ? current_.visemes.mpeg4 : Viseme::kNone;
-    write_frame(format_, static_cast<double>(t) / kNsPerMs, blendshape_weights(faps, viseme),
-                head_pose(faps), text_);
+    write_frame(format_, static_cast<double>(t) / kNsPerMs,
+                blendshape_weights(faps, mouth(t), viseme), head_pose(faps), text_);
     ++next_frame_;
     if (++batch == kBatch) {
       if (!sink(text_)) return false;
@@ -391,8 +412,9 @@ bool MarksWriter::add(const MarkupEvent& event, int64_t time_ns, const Sink& sin
       end_ns_ = std::max(end_ns_, time_ns + int64_t{fap.transition_ms} * kNsPerMs);
     }
     if (event.kind == PFAP_EVENT_PHONEME) {
+      mouth_from_ = mouth(time_ns);
       current_ = spoken;
-      end_ns_ = std::max(end_ns_, spoken.end_ns);
+      end_ns_ = std::max(end_ns_, spoken.end_ns + kMouthEaseNs);  // and the mouth closed
     }
     return true;
   }

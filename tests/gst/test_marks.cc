@@ -158,7 +158,7 @@ TEST_F(MarksEnc, ArkitFramesAtTheFrameRateEndAfterTheLastTransition) {
   std::string line;
   std::vector<std::string> rows;
   while (std::getline(lines, line)) rows.push_back(line);
-  ASSERT_EQ(rows.size(), 4u) << csv;  // header, 0, 50, 100 ms
+  ASSERT_EQ(rows.size(), 5u) << csv;  // header, 0, 50, 100, 150 ms (the mouth closes by 180)
   EXPECT_TRUE(rows[0].starts_with("time_ms,eyeBlinkLeft,"));
   EXPECT_TRUE(rows[1].starts_with("0.000,0.0000,"));
   EXPECT_TRUE(rows[2].starts_with("50.000,0.5000,"));

@@ -244,11 +244,12 @@ TEST(SpeechMarks, ArkitFramesOfALongRestAreLeftOut) {
   std::string line;
   std::vector<std::string> rows;
   while (std::getline(lines, line)) rows.push_back(line);
-  // Header; 0 up to 10 s after the phoneme's end at 0.1 s (101 frames), then 60 and 60.1 s.
-  ASSERT_EQ(rows.size(), 1u + 101 + 2);
-  EXPECT_TRUE(rows[101].starts_with("10000.000,"));
-  EXPECT_TRUE(rows[102].starts_with("60000.000,"));
-  EXPECT_TRUE(rows[103].starts_with("60100.000,"));
+  // Header; 0 up to 10 s after the mouth has closed at 0.18 s (102 frames), then 60 to
+  // 60.18 s.
+  ASSERT_EQ(rows.size(), 1u + 102 + 2);
+  EXPECT_TRUE(rows[102].starts_with("10100.000,"));
+  EXPECT_TRUE(rows[103].starts_with("60000.000,"));
+  EXPECT_TRUE(rows[104].starts_with("60100.000,"));
 }
 
 TEST(SpeechMarks, BadLinesSayWhatAndWhere) {
@@ -330,10 +331,11 @@ TEST(SpeechMarks, RhubarbJsonDocument) {
 }
 
 TEST(SpeechMarks, ArkitFramesAtTheFrameRate) {
-  // FAP 3 to 512 over 100 ms from 0, linear; a 200 ms phoneme AA.
+  // FAP 3 to 256 over 100 ms from 0, linear; a 200 ms phoneme AA, whose mouth (jaw 430) eases
+  // in over 80 ms as pfapface's does.
   TextEvent e = event(0, phoneme(1, 200, true), true);
-  e.event.faps = {Fap{3, 512, 100, Curve::kLinear}};
-  const std::string csv = write(MarksFormat::kArkitCsv, {e}, 10);
+  e.event.faps = {Fap{3, 256, 100, Curve::kLinear}};
+  const std::string csv = write(MarksFormat::kArkitCsv, {e}, 20);
   std::istringstream lines(csv);
   std::string header, line;
   std::getline(lines, header);
@@ -341,8 +343,9 @@ TEST(SpeechMarks, ArkitFramesAtTheFrameRate) {
   EXPECT_TRUE(header.ends_with(",tongueOut,headPitch,headYaw,headRoll"));
   std::vector<std::string> rows;
   while (std::getline(lines, line)) rows.push_back(line);
-  ASSERT_EQ(rows.size(), 3u);  // frames at 0, 100, 200 ms: the last one after the phoneme
-  // jawOpen is column 1 + 17; at 100 ms FAP 3 is 512 plus the viseme's 430: clamped to 1.
+  // Frames at 0, 50, ..., 250 ms: through the mouth closed 80 ms after the phoneme's end.
+  ASSERT_EQ(rows.size(), 6u);
+  // jawOpen is column 1 + 17.
   auto column = [](const std::string& row, int n) {
     std::istringstream fields(row);
     std::string field;
@@ -350,13 +353,17 @@ TEST(SpeechMarks, ArkitFramesAtTheFrameRate) {
     return field;
   };
   EXPECT_EQ(column(rows[0], 0), "0.000");
-  EXPECT_EQ(column(rows[0], 18), "0.8398");  // the viseme only: 430 / 512
-  EXPECT_EQ(column(rows[1], 0), "100.000");
-  EXPECT_EQ(column(rows[1], 18), "1.0000");
-  EXPECT_EQ(column(rows[2], 18), "1.0000");  // FAP 3 holds 512 after the phoneme
-  const std::string json = write(MarksFormat::kArkitJson, {e}, 10);
+  EXPECT_EQ(column(rows[0], 18), "0.0000");  // the mouth starts closed
+  EXPECT_EQ(column(rows[1], 0), "50.000");
+  // FAP 3 at 128, the mouth at ease(50 / 80) = 0.68359375 of 430: (128 + 293.95) / 512.
+  EXPECT_EQ(column(rows[1], 18), "0.8241");
+  EXPECT_EQ(column(rows[2], 18), "1.0000");  // 256 + 430, clamped
+  EXPECT_EQ(column(rows[4], 0), "200.000");
+  const std::string json = write(MarksFormat::kArkitJson, {e}, 20);
   EXPECT_TRUE(json.starts_with("{\"time\":0.000,\"blendshapes\":{\"eyeBlinkLeft\":0.0000,"));
-  EXPECT_NE(json.find("\"jawOpen\":0.8398"), std::string::npos);
+  const size_t at_100 = json.find("{\"time\":100.000,");
+  ASSERT_NE(at_100, std::string::npos);
+  EXPECT_EQ(json.find("\"jawOpen\":1.0000", at_100) < json.find('\n', at_100), true);
   EXPECT_NE(json.find("\"head\":{\"pitch\":0.00000,\"yaw\":0.00000,\"roll\":0.00000}}\n"),
             std::string::npos);
 }

@@ -83,10 +83,32 @@ struct HeadPose {
   double roll = 0;
 };
 
-// The weights for `faps` (amplitudes in FAP units, as FapState gives them) while `viseme`
-// sounds (kNone in pauses): each FAP moves the blendshapes of its feature in proportion to
-// its amplitude, the viseme adds its mouth shape, the expressions 69..74 (intensity 0..63)
-// add their combinations, and each sum is clamped to 0..1.
+// A mouth as the FAP displacements pfapface's animator adds for a viseme (face::MouthShape,
+// which tests/face checks this agrees with): jaw (FAP 3), upper mid lip down (4; 8, 9 by 0.7),
+// lower mid lip up (5; 10, 11 by 0.7), corners out (6, 7, 53, 54), corners up (12, 13, 59,
+// 60), lips pushed (16, 17).
+struct VisemeMouth {
+  double open_jaw = 0;
+  double lower_t_midlip = 0;
+  double raise_b_midlip = 0;
+  double stretch_corner = 0;
+  double raise_corner = 0;
+  double push_lip = 0;
+
+  VisemeMouth blend(const VisemeMouth& to, double u) const;  // u = 0 this, 1 `to`
+  bool operator==(const VisemeMouth&) const = default;
+};
+
+// The mouth of `viseme` (kNone: closed, neutral).
+VisemeMouth viseme_mouth(Viseme viseme);
+
+// The weights for `faps` (amplitudes in FAP units, as FapState gives them) with `mouth` on
+// them, while `viseme` sounds (kNone in pauses; it adds what FAPs cannot say, th's tongue):
+// each FAP moves the blendshapes of its feature in proportion to its amplitude, the
+// expressions 69..74 (intensity 0..63) add their combinations, and each sum is clamped to 0..1.
+BlendshapeWeights blendshape_weights(const FapAmplitudes& faps, const VisemeMouth& mouth,
+                                     Viseme viseme);
+// The same with the viseme's own mouth.
 BlendshapeWeights blendshape_weights(const FapAmplitudes& faps, Viseme viseme);
 
 HeadPose head_pose(const FapAmplitudes& faps);

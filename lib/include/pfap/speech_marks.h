@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "pfap/blendshapes.h"
 #include "pfap/fap_state.h"
 #include "pfap/markup_event.h"
 #include "pfap/phoneme_table.h"
@@ -42,8 +43,11 @@ class MarksWriter {
 
   static constexpr size_t kMaxUtterancePhonemes = 4096;
   static constexpr size_t kMaxDocumentPhonemes = 1'000'000;  // Rhubarb JSON
-  // ARKit frames of a rest (every phoneme and transition over) longer than this are left
-  // out: the frames after it keep their times, so a reader sees the jump.
+  // How long the mouth of the frames takes from one viseme to the next (at most half the
+  // phoneme), and to close after the last: pfapface's animator's kMouthEaseNs.
+  static constexpr int64_t kMouthEaseNs = 80'000'000;
+  // ARKit frames of a rest (every phoneme, transition and closing mouth over) longer than
+  // this are left out: the frames after it keep their times, so a reader sees the jump.
   static constexpr int64_t kMaxRestNs = 10'000'000'000;
   // A phoneme whose viseme is unknown (no alphabet, or a symbol not in it) is written as
   // this half-open mouth, the nearest to pfapface's generic mouth.
@@ -80,6 +84,7 @@ class MarksWriter {
   bool flush_utterance(const Sink& sink);
   bool frames_until(int64_t end_ns, const Sink& sink);
   int64_t frame_time(int64_t k) const;
+  VisemeMouth mouth(int64_t time_ns) const;
   int64_t first_frame_from(int64_t ns) const;
 
   MarksFormat format_;
@@ -94,6 +99,7 @@ class MarksWriter {
   int64_t next_frame_ = 0;  // index of the next frame to write
   int64_t end_ns_ = 0;      // when the last phoneme and transition are over
   Spoken current_{};        // the last phoneme, whose viseme the frames show while it lasts
+  VisemeMouth mouth_from_;  // the mouth when it started, from which it eases to its viseme's
   std::string text_;
 };
 
