@@ -40,6 +40,7 @@
 #include <string>
 
 #include "markupbuffer.h"
+#include "runningtime.h"
 #include "pfap/model.h"
 #include "pfap/text.h"
 #include "pfap/timeline.h"
@@ -62,19 +63,6 @@ struct Stream {
   pfap::TextEvent text;
   std::string line;
 };
-
-// The running time of `pts`, negative before the segment start; none without a PTS.
-std::optional<int64_t> running_time(const GstSegment& segment, GstClockTime pts) {
-  guint64 time = 0;
-  switch (gst_segment_to_running_time_full(&segment, GST_FORMAT_TIME, pts, &time)) {
-    case 1:
-      return static_cast<int64_t>(time);
-    case -1:
-      return -static_cast<int64_t>(time);
-    default:
-      return std::nullopt;
-  }
-}
 
 }  // namespace
 
@@ -115,7 +103,7 @@ static int64_t line_time_ms(GstPfapTextEnc* self, GstClockTime pts) {
   Stream& s = *self->stream;
   // A first event without a PTS is where the segment begins, whose running time is base.
   int64_t time =
-      s.timeline.start(running_time(s.segment, pts), static_cast<int64_t>(s.segment.base));
+      s.timeline.start(pfap_running_time(s.segment, pts), static_cast<int64_t>(s.segment.base));
   if (!s.origin_ns) s.origin_ns = time;
   if (s.timeline.earlier(time)) {
     const guint64 count = s.timeline.earlier_count();

@@ -4,6 +4,8 @@
 
 #include "gstfapparse.h"
 #include "gstpfapfapenc.h"
+#include "gstpfapmarksenc.h"
+#include "gstpfapmarksparse.h"
 #include "gstpfapparse.h"
 #include "gstpfaptextenc.h"
 #include "gstpfaptypefind.h"
@@ -19,6 +21,8 @@ static gboolean plugin_init(GstPlugin* plugin) {
   ok &= GST_ELEMENT_REGISTER(fapparse, plugin);
   ok &= GST_ELEMENT_REGISTER(pfapfapenc, plugin);
   ok &= GST_TYPE_FIND_REGISTER(pfap, plugin);
+  ok &= GST_ELEMENT_REGISTER(pfapmarksenc, plugin);
+  ok &= GST_ELEMENT_REGISTER(pfapmarksparse, plugin);
   return ok;
 }
 

@@ -20,8 +20,40 @@ constexpr std::array<PhonemeInfo, 40> kArpabet{{
     {"V", V::kFV},       {"W", V::kU},   {"Y", V::kI},   {"Z", V::kSZ},  {"ZH", V::kCh},
 }};
 
-constexpr std::array<PhonemeAlphabet, 1> kAlphabets{{
+// The viseme alphabets: each viseme with the MPEG-4 viseme of the phonemes it stands for
+// (docs/visemes.md has the sources and where this is a judgment).
+constexpr std::array<PhonemeInfo, 17> kPollyVisemes{{
+    {"sil", V::kNone}, {"p", V::kPBM}, {"t", V::kTD}, {"S", V::kCh}, {"T", V::kTH},
+    {"f", V::kFV},     {"k", V::kKG},  {"i", V::kI},  {"r", V::kR},  {"s", V::kSZ},
+    {"u", V::kU},      {"@", V::kA},   {"a", V::kA},  {"e", V::kE},  {"E", V::kE},
+    {"o", V::kQ},      {"O", V::kQ},
+}};
+
+constexpr std::array<PhonemeInfo, 22> kAzureVisemes{{
+    {"0", V::kNone}, {"1", V::kA},   {"2", V::kA},   {"3", V::kQ},   {"4", V::kE},
+    {"5", V::kR},    {"6", V::kI},   {"7", V::kU},   {"8", V::kQ},   {"9", V::kA},
+    {"10", V::kQ},   {"11", V::kA},  {"12", V::kKG}, {"13", V::kR},  {"14", V::kNL},
+    {"15", V::kSZ},  {"16", V::kCh}, {"17", V::kTH}, {"18", V::kFV}, {"19", V::kTD},
+    {"20", V::kKG},  {"21", V::kPBM},
+}};
+
+constexpr std::array<PhonemeInfo, 9> kRhubarbShapes{{
+    {"X", V::kNone},
+    {"A", V::kPBM},
+    {"B", V::kSZ},
+    {"C", V::kE},
+    {"D", V::kA},
+    {"E", V::kQ},
+    {"F", V::kU},
+    {"G", V::kFV},
+    {"H", V::kNL},
+}};
+
+constexpr std::array<PhonemeAlphabet, 4> kAlphabets{{
     {kArpabetAlphabet, kArpabet},
+    {kPollyVisemeAlphabet, kPollyVisemes},
+    {kAzureVisemeAlphabet, kAzureVisemes},
+    {kRhubarbShapeAlphabet, kRhubarbShapes},
 }};
 
 }  // namespace

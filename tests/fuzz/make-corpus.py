@@ -129,7 +129,8 @@ def rtp_input(packets):
 
 
 def main():
-    for harness in ("fuzz_payload", "fuzz_bookmark", "fuzz_text", "fuzz_depay", "fuzz_fap_file"):
+    for harness in ("fuzz_payload", "fuzz_bookmark", "fuzz_text", "fuzz_depay", "fuzz_fap_file",
+                    "fuzz_marks"):
         shutil.rmtree(FUZZ / "corpus" / harness, ignore_errors=True)
 
     samples = sample_payloads()
@@ -175,6 +176,21 @@ def main():
 
     for name, data in FAP_FILES.items():
         write("fuzz_fap_file", name, data)
+    # fuzz_marks: a format byte (0 Polly, 1 Rhubarb lines, 2 Rhubarb JSON, 3 Azure), then the
+    # example files of docs/examples/marks/.
+    marks = ROOT / "docs" / "examples" / "marks"
+    for mode, name in ((0, "hello.polly.jsonl"), (1, "hello.rhubarb.tsv"),
+                       (2, "hello.rhubarb.json"), (3, "hello.azure.jsonl")):
+        write("fuzz_marks", name, bytes([mode]) + (marks / name).read_bytes())
+    write("fuzz_marks", "azure-spellings", b"\x03" + b"""{"AudioOffset":500000,"VisemeId":0}
+{"audio_offset":1004999,"viseme_id":21}
+{"audioOffset":1e7,"visemeId":2}
+""")
+    write("fuzz_marks", "polly-escapes", b"\x00" + b"""{"time":0,"type":"sentence","value":"a\\u00e9\\ud83d\\ude00"}
+{"time":1,"type":"word","value":"x"}
+{"time":1,"type":"viseme","value":"p"}
+{"time":99999999999999999,"type":"viseme","value":"sil"}
+""")
 
 
 if __name__ == "__main__":

@@ -475,7 +475,8 @@ TEST(GstInspect, EachPluginListsItsElements) {
   ASSERT_TRUE(plugin_available(kElements));
   // And its typefinders: .pfap text's in pfap.
   const std::vector<std::tuple<const char*, std::vector<const char*>, int>> plugins = {
-      {"pfap", {kPay, kDepay, "pfapparse", "pfaptextenc", "fapparse", "pfapfapenc"}, 1},
+      {"pfap", {kPay, kDepay, "pfapparse", "pfaptextenc", "fapparse", "pfapfapenc",
+        "pfapmarksenc", "pfapmarksparse"}, 1},
       {"pfaptts", {"pfaptts"}, 0},
       {"pfapface", {"pfapface"}, 0},
   };

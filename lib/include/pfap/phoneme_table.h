@@ -44,6 +44,16 @@ struct PhonemeAlphabet {
 // Dictionary in alphabetical order, AA = 1 ... ZH = 39 (docs/examples/README.md).
 inline constexpr std::string_view kArpabetAlphabet = "x-pfap-arpabet";
 
+// Alphabets whose symbols are the visemes of another vocabulary, for streams that came from
+// a service or tool that gives visemes, not phonemes (docs/visemes.md): each symbol stands
+// for the phonemes its viseme shows.
+// Amazon Polly's viseme names: 0 sil, then p t S T f k i r s u @ a e E o O (1..16).
+inline constexpr std::string_view kPollyVisemeAlphabet = "x-pfap-polly-viseme";
+// Azure Speech / SAPI viseme IDs: the symbol is the ID, 0 (silence) .. 21 (p b m).
+inline constexpr std::string_view kAzureVisemeAlphabet = "x-pfap-azure-viseme";
+// Rhubarb Lip Sync mouth shapes: 0 X (rest), then A..H (1..8).
+inline constexpr std::string_view kRhubarbShapeAlphabet = "x-pfap-rhubarb-shape";
+
 // The alphabet called `name`, or nullptr if it is not one this library knows.
 const PhonemeAlphabet* find_alphabet(std::string_view name);
 

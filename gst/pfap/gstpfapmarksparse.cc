@@ -1,0 +1,420 @@
+// The example pipelines stay on one line, to be copied.
+// clang-format off
+/**
+ * SECTION:element-pfapmarksparse
+ * @title: pfapmarksparse
+ * @see_also: pfapmarksenc, pfapparse, rtppfappay
+ *
+ * Reads the visemes of a TTS service or lip-sync tool and outputs them as application/x-pfap
+ * phoneme events, so that a stream from a service we do not run becomes PFAP
+ * (docs/visemes.md). #GstPfapMarksParse:format says what comes in:
+ *
+ * - `polly`: Amazon Polly speech marks (JSON lines); word and sentence marks become the
+ *   word-begin, sentence-start and end-of-text flags, ssml marks are skipped;
+ * - `rhubarb`: Rhubarb Lip Sync output, TSV lines or (when the input starts with '{') its JSON
+ *   document, read whole at EOS;
+ * - `azure`: Azure Speech viseme events as JSON lines of `audioOffset` (100 ns ticks) and
+ *   `visemeId` (also the C# and Python spellings AudioOffset/VisemeId, audio_offset/viseme_id).
+ *
+ * Each viseme becomes a phoneme of an alphabet that says what it is, set as the `alphabet`
+ * field of the output caps: x-pfap-polly-viseme, x-pfap-rhubarb-shape or x-pfap-azure-viseme
+ * (pfapface and pfapmarksenc know them; rtppfappay carries the name to the SDP). A viseme
+ * lasts until the next one; the last one (with no end given) lasts 150 ms. A PTS is the
+ * viseme's time from the start of the input. The output is a TIME segment from 0.
+ *
+ * A bad line (not JSON, a missing field, an unknown viseme, time going back, more than 64 KiB)
+ * is an error naming its line, its column (bytes, from 1) and what is wrong; with
+ * #GstPfapMarksParse:skip-bad-lines it is a warning (rate-limited: the 1st, 2nd, 4th, ...) and
+ * reading goes on.
+ *
+ * ## Example pipeline
+ * |[
+ * gst-launch-1.0 filesrc location=docs/examples/marks/hello.polly.jsonl ! pfapmarksparse format=polly ! rtppfappay ! udpsink host=127.0.0.1 port=5004
+ * ]| Sends the visemes of Polly speech marks as a PFAP RTP stream.
+ */
+// clang-format on
+#include "gstpfapmarksparse.h"
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "pfap/speech_marks.h"
+#include "markupbuffer.h"
+#include "ratelimit.h"
+#include "sparse.h"
+
+GST_DEBUG_CATEGORY_STATIC(pfapmarksparse_debug);
+#define GST_CAT_DEFAULT pfapmarksparse_debug
+
+namespace {
+
+constexpr size_t kMaxLineBytes = 64 * 1024;
+
+enum { PROP_0, PROP_FORMAT, PROP_SKIP_BAD_LINES };
+
+constexpr pfap::MarksInput kDefaultFormat = pfap::MarksInput::kPolly;
+
+struct Stream {
+  explicit Stream(pfap::MarksInput input) : reader(input) {}
+
+  pfap::MarksReader reader;
+  std::string tail;             // a line whose end has not come yet, or a whole JSON document
+  uint64_t line = 1;            // the line being read, from 1
+  bool skipping = false;        // dropping the rest of an over-long line
+  bool started = false;         // the first non-blank byte has been seen
+  bool document = false;        // Rhubarb JSON: the input is kept whole until EOS
+  bool need_events = true;
+  bool discont = true;
+  uint64_t bad_lines = 0;
+  std::vector<pfap::TextEvent> events;
+};
+
+}  // namespace
+
+struct _GstPfapMarksParse {
+  GstElement parent;
+  GstPad* sinkpad;
+  GstPad* srcpad;
+  pfap::MarksInput format;  // under the object lock
+  gboolean skip_bad_lines;  // under the object lock
+  Stream* stream;
+};
+
+static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
+    "sink", GST_PAD_SINK, GST_PAD_ALWAYS,
+    GST_STATIC_CAPS("text/x-raw, format = (string) utf8; text/plain; application/json"));
+
+static GstStaticPadTemplate src_template =
+    GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
+
+G_DEFINE_TYPE(GstPfapMarksParse, gst_pfap_marks_parse, GST_TYPE_ELEMENT)
+GST_ELEMENT_REGISTER_DEFINE(pfapmarksparse, "pfapmarksparse", GST_RANK_NONE,
+                            GST_TYPE_PFAP_MARKS_PARSE)
+
+#define GST_TYPE_PFAP_MARKS_INPUT (gst_pfap_marks_input_get_type())
+static GType gst_pfap_marks_input_get_type() {
+  static GType type = 0;
+  static const GEnumValue values[] = {
+      {int(pfap::MarksInput::kPolly), "Amazon Polly speech marks (JSON lines)", "polly"},
+      {int(pfap::MarksInput::kRhubarb), "Rhubarb Lip Sync TSV or JSON", "rhubarb"},
+      {int(pfap::MarksInput::kAzure), "Azure viseme events (JSON lines, 100 ns ticks)", "azure"},
+      {0, nullptr, nullptr},
+  };
+  if (g_once_init_enter(&type)) {
+    g_once_init_leave(&type, g_enum_register_static("GstPfapMarksInput", values));
+  }
+  return type;
+}
+
+// A new stream from the properties (READY to PAUSED, FLUSH_STOP).
+static void reset(GstPfapMarksParse* self) {
+  GST_OBJECT_LOCK(self);
+  const pfap::MarksInput format = self->format;
+  GST_OBJECT_UNLOCK(self);
+  delete self->stream;
+  self->stream = new Stream(format);
+}
+
+static void send_events(GstPfapMarksParse* self) {
+  Stream& s = *self->stream;
+  if (!s.need_events) return;
+  s.need_events = false;
+  if (GstEvent* start = gst_pad_get_sticky_event(self->srcpad, GST_EVENT_STREAM_START, 0)) {
+    gst_event_unref(start);
+  } else {
+    gchar* id = gst_pad_create_stream_id(self->srcpad, GST_ELEMENT(self), nullptr);
+    gst_pad_push_event(self->srcpad, pfap_make_sparse(gst_event_new_stream_start(id)));
+    g_free(id);
+  }
+  GstCaps* caps = gst_caps_make_writable(gst_static_pad_template_get_caps(&src_template));
+  const std::string alphabet(s.reader.alphabet());
+  gst_caps_set_simple(caps, "alphabet", G_TYPE_STRING, alphabet.c_str(), nullptr);
+  gst_pad_push_event(self->srcpad, gst_event_new_caps(caps));
+  gst_caps_unref(caps);
+  GstSegment segment;
+  gst_segment_init(&segment, GST_FORMAT_TIME);
+  gst_pad_push_event(self->srcpad, gst_event_new_segment(&segment));
+}
+
+static GstFlowReturn push_events(GstPfapMarksParse* self) {
+  Stream& s = *self->stream;
+  GstFlowReturn ret = GST_FLOW_OK;
+  for (const pfap::TextEvent& event : s.events) {
+    if (ret != GST_FLOW_OK) break;
+    GstBuffer* buffer = pfap_buffer_new(event.event);
+    if (buffer == nullptr) {
+      // The reader gives values within range: a bug.
+      GST_ELEMENT_ERROR(self, STREAM, FAILED, (nullptr), ("an event x-pfap cannot hold"));
+      ret = GST_FLOW_ERROR;
+      break;
+    }
+    GST_BUFFER_PTS(buffer) = event.time_ms * GST_MSECOND;
+    GST_BUFFER_DURATION(buffer) = event.event.phoneme.duration_ms * GST_MSECOND;
+    if (s.discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
+    s.discont = false;
+    send_events(self);
+    ret = gst_pad_push(self->srcpad, buffer);
+  }
+  s.events.clear();
+  return ret;
+}
+
+// An error, or with skip-bad-lines a rate-limited warning and reading goes on.
+static GstFlowReturn bad_input(GstPfapMarksParse* self, size_t column, const std::string& what) {
+  GST_OBJECT_LOCK(self);
+  const bool skip = self->skip_bad_lines;
+  GST_OBJECT_UNLOCK(self);
+  Stream& s = *self->stream;
+  const char* kind = s.document ? "Rhubarb JSON document" : "line";
+  const uint64_t line = s.document ? 1 : s.line;
+  if (skip) {
+    if (pfap_warn_at(++s.bad_lines)) {
+      GST_ELEMENT_WARNING(self, STREAM, DECODE,
+                          ("Skipped %s %" G_GUINT64_FORMAT ", column %zu: %s (%" G_GUINT64_FORMAT
+                           " bad so far)",
+                           kind, line, column + 1, what.c_str(), s.bad_lines),
+                          (nullptr));
+    }
+    return GST_FLOW_OK;
+  }
+  GST_ELEMENT_ERROR(self, STREAM, DECODE,
+                    ("Bad %s %" G_GUINT64_FORMAT ", column %zu: %s", kind, line, column + 1,
+                     what.c_str()),
+                    ("set skip-bad-lines to warn and go on"));
+  return GST_FLOW_ERROR;
+}
+
+static std::string describe(const pfap::MarksResult& result) {
+  std::string what = pfap::to_string(result.status);
+  if (result.status == pfap::MarksStatus::kBadJson) what.append(": ").append(result.what);
+  return what;
+}
+
+static GstFlowReturn read_line(GstPfapMarksParse* self, std::string_view line) {
+  Stream& s = *self->stream;
+  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  const pfap::MarksResult result = s.reader.read_line(line, s.events);
+  if (!result.ok()) return bad_input(self, result.column, describe(result));
+  return push_events(self);
+}
+
+static GstFlowReturn read_chunk(GstPfapMarksParse* self, std::string_view data) {
+  Stream& s = *self->stream;
+  if (!s.started) {
+    const size_t first = data.find_first_not_of(" \t\r\n");
+    if (first == std::string_view::npos) return GST_FLOW_OK;
+    s.started = true;
+    s.document = data[first] == '{' && s.reader.alphabet() == pfap::kRhubarbShapeAlphabet;
+  }
+  if (s.document) {
+    if (s.tail.size() + data.size() > pfap::MarksReader::kMaxDocumentBytes) {
+      return bad_input(self, pfap::MarksReader::kMaxDocumentBytes, "larger than 16 MiB");
+    }
+    s.tail.append(data);
+    return GST_FLOW_OK;
+  }
+  while (!data.empty()) {
+    const size_t end = data.find('\n');
+    const std::string_view piece = data.substr(0, end);
+    GstFlowReturn ret = GST_FLOW_OK;
+    if (s.skipping) {
+      // Reported when it grew too long.
+    } else if (s.tail.size() + piece.size() > kMaxLineBytes) {
+      s.tail.clear();
+      s.skipping = true;
+      ret = bad_input(self, kMaxLineBytes, "longer than 65536 bytes");
+    } else if (end == std::string_view::npos) {
+      s.tail.append(piece);
+    } else if (s.tail.empty()) {
+      ret = read_line(self, piece);
+    } else {
+      s.tail.append(piece);
+      ret = read_line(self, s.tail);
+      s.tail.clear();
+    }
+    if (ret != GST_FLOW_OK || end == std::string_view::npos) return ret;
+    ++s.line;
+    s.skipping = false;
+    data.remove_prefix(end + 1);
+  }
+  return GST_FLOW_OK;
+}
+
+// At EOS: the last line, or the whole Rhubarb document, then the last viseme.
+static GstFlowReturn finish(GstPfapMarksParse* self) {
+  Stream& s = *self->stream;
+  GstFlowReturn ret = GST_FLOW_OK;
+  if (s.document) {
+    const pfap::MarksResult result = s.reader.read_document(s.tail, s.events);
+    ret = push_events(self);
+    if (!result.ok() && ret == GST_FLOW_OK) ret = bad_input(self, result.column, describe(result));
+  } else {
+    if (!s.skipping && !s.tail.empty()) ret = read_line(self, s.tail);
+    if (ret == GST_FLOW_OK) {
+      s.reader.finish(s.events);
+      ret = push_events(self);
+    }
+  }
+  s.tail.clear();
+  return ret;
+}
+
+static GstFlowReturn gst_pfap_marks_parse_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
+  GstPfapMarksParse* self = GST_PFAP_MARKS_PARSE(parent);
+  GstMapInfo map;
+  if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) {
+    gst_buffer_unref(buffer);
+    GST_ELEMENT_ERROR(self, RESOURCE, READ, (nullptr), ("cannot map the input buffer"));
+    return GST_FLOW_ERROR;
+  }
+  const GstFlowReturn ret = read_chunk(self, {reinterpret_cast<const char*>(map.data), map.size});
+  gst_buffer_unmap(buffer, &map);
+  gst_buffer_unref(buffer);
+  return ret;
+}
+
+static gboolean gst_pfap_marks_parse_sink_event(GstPad* pad, GstObject* parent, GstEvent* event) {
+  GstPfapMarksParse* self = GST_PFAP_MARKS_PARSE(parent);
+  switch (GST_EVENT_TYPE(event)) {
+    case GST_EVENT_STREAM_START:
+      return gst_pad_push_event(self->srcpad, pfap_make_sparse(event));
+    case GST_EVENT_CAPS:
+    case GST_EVENT_SEGMENT:
+    case GST_EVENT_GAP:
+      gst_event_unref(event);
+      return TRUE;
+    case GST_EVENT_EOS:
+      if (finish(self) == GST_FLOW_ERROR) {
+        gst_event_unref(event);
+        return FALSE;
+      }
+      send_events(self);
+      break;
+    case GST_EVENT_FLUSH_STOP:
+      reset(self);
+      break;
+    default:
+      break;
+  }
+  return gst_pad_event_default(pad, parent, event);
+}
+
+static gboolean gst_pfap_marks_parse_src_event(GstPad* pad, GstObject* parent, GstEvent* event) {
+  // Durations and flags depend on the marks before: reading starts at the start.
+  if (GST_EVENT_TYPE(event) == GST_EVENT_SEEK) {
+    gst_event_unref(event);
+    return FALSE;
+  }
+  return gst_pad_event_default(pad, parent, event);
+}
+
+static GstStateChangeReturn gst_pfap_marks_parse_change_state(GstElement* element,
+                                                              GstStateChange transition) {
+  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) reset(GST_PFAP_MARKS_PARSE(element));
+  return GST_ELEMENT_CLASS(gst_pfap_marks_parse_parent_class)->change_state(element, transition);
+}
+
+static void gst_pfap_marks_parse_set_property(GObject* object, guint prop_id,
+                                              const GValue* value, GParamSpec* pspec) {
+  GstPfapMarksParse* self = GST_PFAP_MARKS_PARSE(object);
+  GST_OBJECT_LOCK(self);
+  switch (prop_id) {
+    case PROP_FORMAT:
+      self->format = static_cast<pfap::MarksInput>(g_value_get_enum(value));
+      break;
+    case PROP_SKIP_BAD_LINES:
+      self->skip_bad_lines = g_value_get_boolean(value);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
+  GST_OBJECT_UNLOCK(self);
+}
+
+static void gst_pfap_marks_parse_get_property(GObject* object, guint prop_id, GValue* value,
+                                              GParamSpec* pspec) {
+  GstPfapMarksParse* self = GST_PFAP_MARKS_PARSE(object);
+  GST_OBJECT_LOCK(self);
+  switch (prop_id) {
+    case PROP_FORMAT:
+      g_value_set_enum(value, static_cast<int>(self->format));
+      break;
+    case PROP_SKIP_BAD_LINES:
+      g_value_set_boolean(value, self->skip_bad_lines);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
+  GST_OBJECT_UNLOCK(self);
+}
+
+static void gst_pfap_marks_parse_finalize(GObject* object) {
+  delete GST_PFAP_MARKS_PARSE(object)->stream;
+  G_OBJECT_CLASS(gst_pfap_marks_parse_parent_class)->finalize(object);
+}
+
+static void gst_pfap_marks_parse_class_init(GstPfapMarksParseClass* klass) {
+  GObjectClass* gobject_class = G_OBJECT_CLASS(klass);
+  GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
+
+  GST_DEBUG_CATEGORY_INIT(pfapmarksparse_debug, "pfapmarksparse", 0, "PFAP speech-mark reader");
+
+  gobject_class->set_property = gst_pfap_marks_parse_set_property;
+  gobject_class->get_property = gst_pfap_marks_parse_get_property;
+  gobject_class->finalize = gst_pfap_marks_parse_finalize;
+
+  /**
+   * GstPfapMarksParse:format:
+   *
+   * What the input is; it sets the output's alphabet. Read when going to PAUSED.
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_FORMAT,
+      g_param_spec_enum("format", "Format", "The speech-mark format of the input",
+                        GST_TYPE_PFAP_MARKS_INPUT, static_cast<int>(kDefaultFormat),
+                        static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                 GST_PARAM_MUTABLE_READY)));
+  /**
+   * GstPfapMarksParse:skip-bad-lines:
+   *
+   * FALSE (the default): a bad line is an error that stops the stream; TRUE: a warning, the
+   * line is dropped and reading goes on.
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_SKIP_BAD_LINES,
+      g_param_spec_boolean("skip-bad-lines", "Skip bad lines",
+                           "Warn about a bad line and go on, instead of an error", FALSE,
+                           static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                    GST_PARAM_MUTABLE_PLAYING)));
+
+  gst_element_class_add_static_pad_template(element_class, &sink_template);
+  gst_element_class_add_static_pad_template(element_class, &src_template);
+  gst_element_class_set_static_metadata(
+      element_class, "PFAP speech-mark parser", "Codec/Parser/Text",
+      "Reads Polly speech marks, Rhubarb mouth cues or Azure viseme events as "
+      "application/x-pfap viseme events",
+      "gst-pfap developers");
+
+  element_class->change_state = gst_pfap_marks_parse_change_state;
+  gst_type_mark_as_plugin_api(GST_TYPE_PFAP_MARKS_INPUT, static_cast<GstPluginAPIFlags>(0));
+}
+
+static void gst_pfap_marks_parse_init(GstPfapMarksParse* self) {
+  self->format = kDefaultFormat;
+  self->skip_bad_lines = FALSE;
+  self->stream = nullptr;
+  self->sinkpad = gst_pad_new_from_static_template(&sink_template, "sink");
+  gst_pad_set_chain_function(self->sinkpad, gst_pfap_marks_parse_chain);
+  gst_pad_set_event_function(self->sinkpad, gst_pfap_marks_parse_sink_event);
+  gst_element_add_pad(GST_ELEMENT(self), self->sinkpad);
+
+  self->srcpad = gst_pad_new_from_static_template(&src_template, "src");
+  gst_pad_use_fixed_caps(self->srcpad);
+  gst_pad_set_event_function(self->srcpad, gst_pfap_marks_parse_src_event);
+  gst_element_add_pad(GST_ELEMENT(self), self->srcpad);
+  reset(self);
+}

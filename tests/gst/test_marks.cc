@@ -1,0 +1,342 @@
+// pfapmarksenc and pfapmarksparse: element behaviour with GstHarness, and the commands of
+// docs/elements.md, "Speech marks", run as written against the files in docs/examples/.
+#include <gst/check/gstharness.h>
+#include <gtest/gtest.h>
+
+#include <array>
+#include <chrono>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "../common/temp_dir.h"
+#include "pfap/markup.h"
+#include "pfap/markup_event.h"
+#include "pfap_buffers.h"
+#include "pipeline.h"
+
+namespace {
+
+using namespace std::chrono_literals;
+using pfap::Phoneme;
+using pfap::testing::Pipeline;
+using pfap::testing::TempDir;
+
+constexpr GstClockTime kMs = GST_MSECOND;
+constexpr std::array<const char*, 5> kElements{"pfapmarksenc", "pfapmarksparse", "pfapparse",
+                                               "rtppfappay", "pfapface"};
+
+std::string read_file(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  std::ostringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+std::string source_path(const std::string& relative) {
+  return std::string(PFAP_SOURCE_DIR) + "/" + relative;
+}
+
+// The text of every buffer the harness holds, in order.
+std::string pull_text(GstHarness* h) {
+  std::string text;
+  while (GstBuffer* b = gst_harness_try_pull(h)) {
+    GstMapInfo map;
+    gst_buffer_map(b, &map, GST_MAP_READ);
+    text.append(reinterpret_cast<const char*>(map.data), map.size);
+    gst_buffer_unmap(b, &map);
+    gst_buffer_unref(b);
+  }
+  return text;
+}
+
+// The messages of the bus's warnings (or errors), taken off it.
+std::vector<std::string> messages(GstBus* bus, GstMessageType type) {
+  std::vector<std::string> out;
+  while (GstMessage* m = gst_bus_pop_filtered(bus, type)) {
+    GError* error = nullptr;
+    if (type == GST_MESSAGE_ERROR) {
+      gst_message_parse_error(m, &error, nullptr);
+    } else {
+      gst_message_parse_warning(m, &error, nullptr);
+    }
+    out.push_back(error->message);
+    g_error_free(error);
+    gst_message_unref(m);
+  }
+  return out;
+}
+
+class HarnessTest : public ::testing::Test {
+ protected:
+  void make(const char* description) {
+    h_ = gst_harness_new_parse(description);
+    gst_element_set_bus(h_->element, bus_);
+  }
+  ~HarnessTest() override {
+    if (h_ != nullptr) gst_harness_teardown(h_);
+    gst_bus_set_flushing(bus_, TRUE);
+    gst_object_unref(bus_);
+  }
+  GstHarness* h_ = nullptr;
+  GstBus* bus_ = gst_bus_new();
+};
+
+using MarksEnc = HarnessTest;
+
+Phoneme phoneme(uint8_t symbol, uint16_t duration_ms, bool word_begin = false,
+                bool end_of_text = false) {
+  Phoneme p{symbol, duration_ms, 60};
+  p.word_begin = word_begin;
+  p.end_of_text = end_of_text;
+  return p;
+}
+
+TEST_F(MarksEnc, WritesPollyMarksPerUtterance) {
+  make("pfapmarksenc format=polly");
+  gst_harness_set_src_caps_str(h_, PFAP_MARKUP_CAPS ",alphabet=x-pfap-arpabet");
+  // "HH AH" + "M" (end of text), then a second sentence starting 1 s in: "P" with no end.
+  const GstClockTime base = 5000 * kMs;  // times are counted from the first event
+  gst_harness_push(h_, pfap::testing::phoneme_buffer(phoneme(16, 60, true), {}, base, true));
+  gst_harness_push(h_, pfap::testing::phoneme_buffer(phoneme(3, 90), {}, base + 60 * kMs, false));
+  EXPECT_EQ(pull_text(h_), "");  // the utterance is not over
+  gst_harness_push(
+      h_, pfap::testing::phoneme_buffer(phoneme(22, 80, true, true), {}, base + 150 * kMs, false));
+  EXPECT_EQ(pull_text(h_),
+            "{\"time\":0,\"type\":\"sentence\",\"value\":\"HH-AH M\"}\n"
+            "{\"time\":0,\"type\":\"word\",\"value\":\"HH-AH\"}\n"
+            "{\"time\":0,\"type\":\"viseme\",\"value\":\"k\"}\n"
+            "{\"time\":60,\"type\":\"viseme\",\"value\":\"@\"}\n"
+            "{\"time\":150,\"type\":\"word\",\"value\":\"M\"}\n"
+            "{\"time\":150,\"type\":\"viseme\",\"value\":\"p\"}\n"
+            "{\"time\":230,\"type\":\"viseme\",\"value\":\"sil\"}\n");
+  gst_harness_push(h_, pfap::testing::phoneme_buffer(phoneme(27, 70, true), {}, base + kMs * 1000,
+                                                     true));
+  gst_harness_push_event(h_, gst_event_new_eos());
+  EXPECT_EQ(pull_text(h_),
+            "{\"time\":1000,\"type\":\"sentence\",\"value\":\"P\"}\n"
+            "{\"time\":1000,\"type\":\"word\",\"value\":\"P\"}\n"
+            "{\"time\":1000,\"type\":\"viseme\",\"value\":\"p\"}\n"
+            "{\"time\":1070,\"type\":\"viseme\",\"value\":\"sil\"}\n");
+  EXPECT_TRUE(messages(bus_, GST_MESSAGE_WARNING).empty());
+}
+
+TEST_F(MarksEnc, UnknownAlphabetAndMalformedBuffersWarnAndGoOn) {
+  make("pfapmarksenc format=azure");
+  gst_harness_set_src_caps_str(h_, PFAP_MARKUP_CAPS ",alphabet=x-sampa");
+  for (int i = 0; i < 5; ++i) {
+    gst_harness_push(h_, pfap::testing::phoneme_buffer(phoneme(7, 100), {}, i * 100 * kMs, i == 0));
+  }
+  GstBuffer* bad = gst_buffer_new_allocate(nullptr, 3, nullptr);
+  gst_buffer_memset(bad, 0, 0xff, 3);
+  gst_harness_push(h_, bad);
+  gst_harness_push(h_, pfap::testing::phoneme_buffer(phoneme(7, 100, false, true), {}, 500 * kMs,
+                                                     false));
+  const std::string text = pull_text(h_);
+  // All six, each as the half-open mouth (Azure 4), then silence where speech ends.
+  EXPECT_EQ(text.rfind("{\"audioOffset\":0,\"visemeId\":4}\n", 0), 0u) << text;
+  EXPECT_NE(text.find("{\"audioOffset\":5000000,\"visemeId\":4}\n"
+                      "{\"audioOffset\":6000000,\"visemeId\":0}\n"),
+            std::string::npos)
+      << text;
+  const std::vector<std::string> warnings = messages(bus_, GST_MESSAGE_WARNING);
+  // Rate-limited: the unknown phonemes at the 1st, 2nd, 4th of 6 buffers, one malformed.
+  ASSERT_EQ(warnings.size(), 4u);
+  EXPECT_NE(warnings[0].find("no known viseme"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[3].find("malformed"), std::string::npos) << warnings[3];
+}
+
+TEST_F(MarksEnc, ArkitFramesAtTheFrameRateEndAfterTheLastTransition) {
+  make("pfapmarksenc format=arkit-csv frame-rate=20");
+  gst_harness_set_src_caps_str(h_, PFAP_MARKUP_CAPS ",alphabet=x-pfap-arpabet");
+  // A blink (FAP 19 to 1024 over 100 ms) with a 100 ms phoneme; frames every 50 ms.
+  gst_harness_push(h_, pfap::testing::phoneme_buffer(phoneme(22, 100), {{19, 1024, 100}}, 0, true));
+  gst_harness_push_event(h_, gst_event_new_eos());
+  const std::string csv = pull_text(h_);
+  std::istringstream lines(csv);
+  std::string line;
+  std::vector<std::string> rows;
+  while (std::getline(lines, line)) rows.push_back(line);
+  ASSERT_EQ(rows.size(), 5u) << csv;  // header, 0, 50, 100, 150 ms (the mouth closes by 180)
+  EXPECT_TRUE(rows[0].starts_with("time_ms,eyeBlinkLeft,"));
+  EXPECT_TRUE(rows[1].starts_with("0.000,0.0000,"));
+  EXPECT_TRUE(rows[2].starts_with("50.000,0.5000,"));
+  EXPECT_TRUE(rows[3].starts_with("100.000,1.0000,"));
+  // Each row: time, 52 weights, 3 angles.
+  EXPECT_EQ(std::count(rows[2].begin(), rows[2].end(), ','), 55);
+}
+
+using MarksParse = HarnessTest;
+
+// Every buffer the harness holds, as events.
+std::vector<pfap::testing::Event> pull_events(GstHarness* h) {
+  std::vector<pfap::testing::Event> events;
+  while (GstBuffer* b = gst_harness_try_pull(h)) {
+    events.push_back(pfap::testing::read_event(b));
+    gst_buffer_unref(b);
+  }
+  return events;
+}
+
+TEST_F(MarksParse, PollyMarksByteByByte) {
+  make("pfapmarksparse format=polly");
+  const std::string text =
+      "{\"time\":0,\"type\":\"sentence\",\"value\":\"Hi.\"}\n"
+      "{\"time\":6,\"type\":\"word\",\"value\":\"Hi\"}\n"
+      "{\"time\":6,\"type\":\"viseme\",\"value\":\"k\"}\r\n"
+      "{\"time\":73,\"type\":\"viseme\",\"value\":\"a\"}\n"
+      "{\"time\":300,\"type\":\"viseme\",\"value\":\"sil\"}";  // no line end at the last
+  for (char c : text) {
+    GstBuffer* b = gst_buffer_new_memdup(&c, 1);
+    ASSERT_EQ(gst_harness_push(h_, b), GST_FLOW_OK);
+  }
+  gst_harness_push_event(h_, gst_event_new_eos());
+  GstCaps* caps = gst_pad_get_current_caps(h_->sinkpad);
+  ASSERT_NE(caps, nullptr);
+  EXPECT_STREQ(gst_structure_get_string(gst_caps_get_structure(caps, 0), "alphabet"),
+               "x-pfap-polly-viseme");
+  gst_caps_unref(caps);
+  const std::vector<pfap::testing::Event> events = pull_events(h_);
+  ASSERT_EQ(events.size(), 3u);
+  EXPECT_EQ(events[0].pts, 6 * kMs);
+  EXPECT_EQ(events[0].duration, 67 * kMs);
+  EXPECT_EQ(events[0].phoneme.symbol, 6);  // k
+  EXPECT_TRUE(events[0].phoneme.word_begin);
+  EXPECT_TRUE(events[0].flags & PFAP_FLAG_SENTENCE_START);
+  EXPECT_TRUE(events[0].discont);
+  EXPECT_EQ(events[1].pts, 73 * kMs);
+  EXPECT_EQ(events[1].phoneme.symbol, 12);  // a
+  EXPECT_EQ(events[2].pts, 300 * kMs);
+  EXPECT_EQ(events[2].duration, 150 * kMs);  // the last viseme, with no end given
+  EXPECT_TRUE(events[2].phoneme.end_of_text);
+}
+
+TEST_F(MarksParse, BadLineIsAnErrorNamingLineAndColumn) {
+  make("pfapmarksparse format=azure");
+  const std::string text =
+      "{\"audioOffset\":0,\"visemeId\":0}\n"
+      "{\"audioOffset\":500000,\"visemeId\":99}\n";
+  EXPECT_EQ(gst_harness_push(h_, gst_buffer_new_memdup(text.data(), text.size())),
+            GST_FLOW_ERROR);
+  const std::vector<std::string> errors = messages(bus_, GST_MESSAGE_ERROR);
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_EQ(errors[0], "Bad line 2, column 34: not a viseme of this format");
+}
+
+TEST_F(MarksParse, SkipBadLinesWarnsRateLimitedAndGoesOn) {
+  make("pfapmarksparse format=rhubarb skip-bad-lines=true");
+  std::string text = "0.00\tX\n";
+  for (int i = 0; i < 5; ++i) text += "0.10\tZ\n";  // five bad shapes
+  text += "0.10\tA\n0.30\tX\n";
+  EXPECT_EQ(gst_harness_push(h_, gst_buffer_new_memdup(text.data(), text.size())), GST_FLOW_OK);
+  gst_harness_push_event(h_, gst_event_new_eos());
+  const std::vector<pfap::testing::Event> events = pull_events(h_);
+  ASSERT_EQ(events.size(), 3u);
+  EXPECT_EQ(events[1].pts, 100 * kMs);
+  EXPECT_EQ(events[1].duration, 200 * kMs);
+  EXPECT_EQ(events[1].phoneme.symbol, 1);  // A
+  const std::vector<std::string> warnings = messages(bus_, GST_MESSAGE_WARNING);
+  ASSERT_EQ(warnings.size(), 3u);  // the 1st, 2nd and 4th
+  EXPECT_EQ(warnings[0], "Skipped line 2, column 6: not a viseme of this format (1 bad so far)");
+  EXPECT_TRUE(messages(bus_, GST_MESSAGE_ERROR).empty());
+}
+
+TEST_F(MarksParse, RhubarbJsonIsReadWholeAtEos) {
+  make("pfapmarksparse format=rhubarb");
+  const std::string doc =
+      "{\"metadata\":{\"soundFile\":\"a.wav\",\"duration\":0.30},\n"
+      "\"mouthCues\":[{\"start\":0.00,\"end\":0.10,\"value\":\"X\"},\n"
+      "{\"start\":0.10,\"end\":0.30,\"value\":\"F\"}]}\n";
+  for (size_t i = 0; i < doc.size(); i += 7) {
+    const std::string piece = doc.substr(i, 7);
+    ASSERT_EQ(gst_harness_push(h_, gst_buffer_new_memdup(piece.data(), piece.size())),
+              GST_FLOW_OK);
+  }
+  EXPECT_EQ(gst_harness_buffers_in_queue(h_), 0u);
+  gst_harness_push_event(h_, gst_event_new_eos());
+  const std::vector<pfap::testing::Event> events = pull_events(h_);
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[1].pts, 100 * kMs);
+  EXPECT_EQ(events[1].duration, 200 * kMs);
+  EXPECT_EQ(events[1].phoneme.symbol, 6);  // F
+}
+
+// ---------------------------------------------------------------------------------------------
+// DocumentedMarks: docs/elements.md, "Speech marks: avatars' vocabularies in and out"
+
+constexpr const char* kSection = "## Speech marks: avatars' vocabularies in and out";
+
+std::vector<std::string> documented_commands() {
+  std::istringstream doc(read_file(source_path("docs/elements.md")));
+  std::vector<std::string> commands;
+  bool in_section = false, in_block = false;
+  std::string line;
+  while (std::getline(doc, line)) {
+    if (!in_block && line.rfind("## ", 0) == 0) in_section = line == kSection;
+    if (!in_section) continue;
+    if (line.rfind("```", 0) == 0) {
+      in_block = !in_block;
+      continue;
+    }
+    if (in_block && !line.empty() && line[0] != '#') commands.push_back(line);
+  }
+  return commands;
+}
+
+void replace_all(std::string& s, const std::string& from, const std::string& to) {
+  for (size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size())) {
+    s.replace(at, from.size(), to);
+  }
+}
+
+TEST(DocumentedMarks, EveryCommandGivesTheExampleFile) {
+  ASSERT_TRUE(pfap::testing::plugin_available(kElements));
+  const std::vector<std::string> commands = documented_commands();
+  ASSERT_EQ(commands.size(), 10u);
+  TempDir dir;
+  int compared = 0;
+  for (std::string command : commands) {
+    SCOPED_TRACE(command);
+    ASSERT_EQ(command.rfind("gst-launch-1.0 ", 0), 0u);
+    command.erase(0, std::string("gst-launch-1.0 ").size());
+    replace_all(command, "docs/examples/", source_path("docs/examples/"));
+    replace_all(command, "autovideosink", "fakesink name=video");
+    // The output file, to a temporary one of the same name.
+    std::string output;
+    const size_t sink = command.find("filesink location=");
+    if (sink != std::string::npos) {
+      const size_t start = sink + std::string("filesink location=").size();
+      output = command.substr(start);
+      command.replace(start, std::string::npos, dir.file(output));
+    }
+    Pipeline p(command);
+    ASSERT_TRUE(p.ok()) << p.error();
+    // pfapface's frames, counted.
+    int frames = 0;
+    if (GstElement* video = p.by_name("video")) {
+      GstPad* pad = gst_element_get_static_pad(video, "sink");
+      gst_pad_add_probe(
+          pad, GST_PAD_PROBE_TYPE_BUFFER,
+          [](GstPad*, GstPadProbeInfo*, gpointer data) {
+            ++*static_cast<int*>(data);
+            return GST_PAD_PROBE_OK;
+          },
+          &frames, nullptr);
+      gst_object_unref(pad);
+    }
+    ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+    // Warnings fail too: pfapface warns of phonemes whose alphabet it does not know.
+    ASSERT_EQ(p.wait_eos(20s, true), "");
+    if (output.empty()) {
+      EXPECT_GT(frames, 30);  // hello's 1.7 s at pfapface's default frame rate
+      continue;
+    }
+    EXPECT_EQ(read_file(dir.file(output)), read_file(source_path("docs/examples/marks/" + output)))
+        << output;
+    ++compared;
+  }
+  EXPECT_EQ(compared, 9);
+}
+
+}  // namespace
