@@ -129,7 +129,7 @@ struct Stats {
 struct Stream {
   pfap::Packet packet;      // reused, so decoding stops allocating
   pfap::MarkupEvent event;  // one output event, reused
-  pfap::RecoveryReceiver receiver;
+  pfap::RecoveryReceiver receiver{};
   std::optional<guint32> ssrc;  // the stream's; none until a good packet starts one
 };
 

@@ -116,7 +116,7 @@ struct Stats {
 // src event handler sends requested packets under it too). GObject runs no C++
 // constructors, so it lives behind a pointer made in init and deleted in finalize.
 struct Stream {
-  pfap::Sender sender;
+  pfap::Sender sender{};
   pfap::EventTimeline timeline;  // where a phoneme without PTS starts
   bool pushing = false;          // inside a push: a request from this thread must wait
   pfap::MarkupEvent event;       // reused for every buffer so that streaming does not allocate
