@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "espeak.h"
+#include "mfcc.h"  // kMinRate, kMaxRate: the rates align() takes
 #include "speech.h"
 #include "utterance.h"
 
