@@ -42,6 +42,14 @@ double map_boundary(size_t sample, const Features& syn, const Features& rec, con
   return from + t * (to - from);
 }
 
+// How long `f` has speech: its frames within 30 dB of the loudest, in seconds.
+double speech_seconds(const Features& f) {
+  const float loudest = *std::max_element(f.level_db.begin(), f.level_db.end());
+  const auto n = std::count_if(f.level_db.begin(), f.level_db.end(),
+                               [&](float db) { return db > loudest - 30; });
+  return static_cast<double>(n) * static_cast<double>(f.hop) / f.rate;
+}
+
 }  // namespace
 
 const char* problem_text(Problem p) {
@@ -80,16 +88,26 @@ bool align(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
     pause_over(utterance, audio.size(), rate, out);
     return true;
   }
-  const Features synf = mfcc(syn.samples, syn.sample_rate);
+  // The synthetic speech has almost no silence about it, a recording often has much: padded
+  // with silence, its ends have pause frames to match the recording's.
+  const size_t pad = syn.sample_rate / 10;
+  std::vector<int16_t> padded(pad, 0);
+  padded.insert(padded.end(), syn.samples.begin(), syn.samples.end());
+  padded.resize(padded.size() + pad, 0);
+  const Features synf = mfcc(padded, syn.sample_rate);
   const Warp w = warp(synf, rec);
   out.relative_cost = w.relative_cost;
-  if (w.relative_cost >= kPoorMatchCost) out.problem = Problem::kPoorMatch;
+  const double ratio = speech_seconds(rec) / std::max(speech_seconds(synf), 0.01);
+  if (w.relative_cost >= kPoorMatchCost || ratio < 1 / kMaxSpeechRatio ||
+      ratio > kMaxSpeechRatio) {
+    out.problem = Problem::kPoorMatch;
+  }
 
   // Each phoneme's start on the recording, no earlier than the one before.
   std::vector<size_t> bounds;
   bounds.push_back(0);
   for (size_t k = 1; k < syn.phonemes.size(); ++k) {
-    const double at = map_boundary(syn.phonemes[k].start, synf, rec, w);
+    const double at = map_boundary(syn.phonemes[k].start + pad, synf, rec, w);
     const size_t s = static_cast<size_t>(std::clamp(std::lround(at), 0L,
                                                     static_cast<long>(audio.size())));
     bounds.push_back(std::max(s, bounds.back()));

@@ -24,13 +24,15 @@ enum class Problem {
   kEmptyText,    // no phonemes to align: one pause over the audio
   kNoSpeech,     // the audio is all below kSpeechLevelDb: one pause, bookmarks on it
   kBadRate,      // the rate is outside kMinRate..kMaxRate: one pause, bookmarks on it
-  kPoorMatch,    // aligned, but the audio matches the text poorly (relative_cost high)
+  kPoorMatch,    // aligned, but the audio matches the text poorly: relative_cost high, or
+                 // its speech much longer or shorter than the text's spoken by espeak-ng
 };
 
 const char* problem_text(Problem p);
 
 inline constexpr float kSpeechLevelDb = -50;      // a frame this loud or louder may be speech
-inline constexpr double kPoorMatchCost = 0.75;    // Warp::relative_cost from which kPoorMatch
+inline constexpr double kPoorMatchCost = 0.85;  // Warp::relative_cost from which kPoorMatch
+inline constexpr double kMaxSpeechRatio = 2.5;  // recording's speech over espeak-ng's, or back
 
 struct Alignment {
   // Phonemes on the recording: contiguous from sample 0 to the audio's end; starts in

@@ -13,9 +13,9 @@ struct Warp {
   // (first[i] <= last[i] <= first[i + 1]).
   std::vector<size_t> first;
   std::vector<size_t> last;
-  // The mean distance between matched frames along the path, over the mean distance between
-  // frames of `a` and `b` taken at random: near 0 for the same words, near 1 for unrelated
-  // sounds. What tells a text that does not match its audio.
+  // The summed distance between matched frames along the path over that along a linear warp
+  // of as many steps: well under 1 for the same words, near 1 for unrelated sounds. What
+  // tells a text that does not match its audio.
   double relative_cost = 0;
 };
 

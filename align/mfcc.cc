@@ -15,6 +15,8 @@ constexpr uint_t kFilters = 40;
 constexpr smpl_t kLowHz = 100;
 constexpr smpl_t kHighHz = 7000;  // under 8 kHz, half the lowest rate
 constexpr float kFloorDb = -120;
+constexpr float kLevelRangeDb = 50;
+constexpr float kLevelWeight = 6;
 
 }  // namespace
 
@@ -33,7 +35,7 @@ Features mfcc(std::span<const int16_t> samples, unsigned rate) {
   f.n_frames = samples.size() <= f.window ? 1 : 1 + (samples.size() - f.window) / f.hop;
 
   std::unique_ptr<aubio_mfcc_t, decltype(&del_aubio_mfcc)> mf(
-      new_aubio_mfcc(static_cast<uint_t>(f.window), kFilters, Features::kDims + 1, rate),
+      new_aubio_mfcc(static_cast<uint_t>(f.window), kFilters, Features::kMfccs + 1, rate),
       &del_aubio_mfcc);
   aubio_mfcc_set_mel_coeffs(mf.get(), kLowHz, kHighHz);
   std::unique_ptr<fvec_t, decltype(&del_fvec)> in(new_fvec(static_cast<uint_t>(f.window)),
@@ -44,7 +46,7 @@ Features mfcc(std::span<const int16_t> samples, unsigned rate) {
       new_aubio_fft(static_cast<uint_t>(f.window)), &del_aubio_fft);
   std::unique_ptr<cvec_t, decltype(&del_cvec)> spectrum(
       new_cvec(static_cast<uint_t>(f.window)), &del_cvec);
-  std::unique_ptr<fvec_t, decltype(&del_fvec)> out(new_fvec(Features::kDims + 1), &del_fvec);
+  std::unique_ptr<fvec_t, decltype(&del_fvec)> out(new_fvec(Features::kMfccs + 1), &del_fvec);
 
   f.data.resize(f.n_frames * Features::kDims);
   f.level_db.resize(f.n_frames);
@@ -61,11 +63,11 @@ Features mfcc(std::span<const int16_t> samples, unsigned rate) {
                                : kFloorDb;
     aubio_fft_do(fft.get(), in.get(), spectrum.get());
     aubio_mfcc_do(mf.get(), spectrum.get(), out.get());
-    std::copy(out->data + 1, out->data + 1 + Features::kDims,
+    std::copy(out->data + 1, out->data + Features::kMfccs + 1,
               f.data.begin() + static_cast<ptrdiff_t>(k * Features::kDims));
   }
 
-  for (size_t d = 0; d < Features::kDims; ++d) {
+  for (size_t d = 0; d < Features::kMfccs; ++d) {
     double sum = 0, sum2 = 0;
     for (size_t k = 0; k < f.n_frames; ++k) {
       const double x = f.data[k * Features::kDims + d];
@@ -79,6 +81,13 @@ Features mfcc(std::span<const int16_t> samples, unsigned rate) {
       float& x = f.data[k * Features::kDims + d];
       x = static_cast<float>((x - mean) * scale);
     }
+  }
+  // The level below the utterance's loudest frame, the same scale in any recording, so that
+  // pauses match pauses (the MFCCs of silence, normalized, are anything).
+  const float loudest = *std::max_element(f.level_db.begin(), f.level_db.end());
+  for (size_t k = 0; k < f.n_frames; ++k) {
+    const float below = std::clamp(f.level_db[k] - loudest, -kLevelRangeDb, 0.0f);
+    f.data[k * Features::kDims + Features::kMfccs] = below / kLevelRangeDb * kLevelWeight;
   }
   return f;
 }

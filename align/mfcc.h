@@ -15,13 +15,16 @@ inline constexpr unsigned kMinRate = 16000;
 inline constexpr unsigned kMaxRate = 48000;
 
 struct Features {
-  static constexpr size_t kDims = 13;  // MFCC 1..13 (c0, the level, is left out)
+  static constexpr size_t kMfccs = 13;  // MFCC 1..13 (c0, the level, is left out)
+  static constexpr size_t kDims = kMfccs + 1;  // and the level below the loudest frame
   unsigned rate = 0;
   size_t hop = 0;     // samples between frames
   size_t window = 0;  // samples per frame
   size_t n_frames = 0;
-  // n_frames x kDims, each coefficient normalized to mean 0 and variance 1 over the
-  // utterance, which takes away most of what differs between two voices and two microphones.
+  // n_frames x kDims: the MFCCs, each normalized to mean 0 and variance 1 over the utterance,
+  // which takes away most of what differs between two voices and two microphones; then the
+  // frame's level below the loudest frame's, 0 (loudest) to -kLevelWeight (50 dB below or
+  // less), which tells pauses in any recording.
   std::vector<float> data;
   std::vector<float> level_db;  // each frame's RMS level in dBFS
 
