@@ -237,9 +237,10 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
       s.text_changed.wait(guard, [&] { return s.text_eos || s.flushing; });
     }
     if (s.flushing) return GST_FLOW_FLUSHING;
+    // No audio yet (the first caps and segment): the texts wait for it.
+    if (s.samples.empty() || s.rate == 0) return GST_FLOW_OK;
     texts.swap(s.texts);
   }
-  if (s.samples.empty() || s.rate == 0) return GST_FLOW_OK;
 
   // Utterances as (first sample, text), in order.
   const size_t n = s.samples.size();

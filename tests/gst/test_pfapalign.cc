@@ -4,13 +4,18 @@
 #include <gst/check/gstharness.h>
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "pfapbuffer.h"
+#include "pipeline.h"
 #include "speech.h"
+#include "temp_dir.h"
 
 namespace {
 
@@ -219,6 +224,88 @@ TEST(PfapAlign, StereoIsRefusedAtNegotiation) {
   EXPECT_EQ(gst_harness_push(h, gst_buffer_new_allocate(nullptr, 400, nullptr)),
             GST_FLOW_NOT_NEGOTIATED);
   gst_harness_teardown(h);
+}
+
+// The launch lines of docs/elements.md's pfapalign section, each run on a WAV pfaptts makes.
+std::vector<std::string> documented_commands() {
+  std::ifstream in(PFAP_SOURCE_DIR "/docs/elements.md");
+  std::stringstream all;
+  all << in.rdbuf();
+  const std::string doc = all.str();
+  const size_t from = doc.find("## pfapalign");
+  const size_t to = doc.find("\n## ", from + 1);
+  std::istringstream section(doc.substr(from, to - from));
+  std::vector<std::string> out;
+  for (std::string line; std::getline(section, line);) {
+    if (line.starts_with("gst-launch-1.0 ")) out.push_back(line);
+  }
+  return out;
+}
+
+std::string replace_all(std::string s, const std::string& from, const std::string& to) {
+  for (size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size())) {
+    s.replace(at, from.size(), to);
+  }
+  return s;
+}
+
+std::string run_line(const std::string& line, const pfap::testing::TempDir& dir) {
+  std::string d = line.substr(std::string("gst-launch-1.0 ").size());
+  if (d.starts_with("-e ")) d = d.substr(3);
+  for (const char* f : {"speech.wav", "speech.txt", "speech.pfap", "face.webm"}) {
+    d = replace_all(d, std::string("location=") + f, "location=" + dir.file(f));
+  }
+  pfap::testing::Pipeline p(d);
+  if (!p.ok()) return p.error();
+  std::string e = p.set_state(GST_STATE_PLAYING);
+  if (e.empty()) e = p.wait_eos(std::chrono::seconds(60));
+  return e;
+}
+
+size_t file_size(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  return in ? static_cast<size_t>(in.tellg()) : 0;
+}
+
+TEST(PfapAlignDocumented, EveryCommandRuns) {
+  const std::vector<std::string> commands = documented_commands();
+  ASSERT_EQ(commands.size(), 3u);
+  const pfap::testing::TempDir dir;
+  const std::string text =
+      "Please call Stella. Ask her to bring these things with her from the store.";
+  {
+    // The "recording": pfaptts at another rate and pitch than pfapalign's voice.
+    pfap::testing::Pipeline make("pfaptts rate=140 pitch=30 text=\"" + text +
+                                 "\" name=t t.audio ! queue ! wavenc ! filesink location=" +
+                                 dir.file("speech.wav") + " t.pfap ! queue ! fakesink");
+    ASSERT_TRUE(make.ok()) << make.error();
+    ASSERT_EQ(make.set_state(GST_STATE_PLAYING), "");
+    ASSERT_EQ(make.wait_eos(std::chrono::seconds(30)), "");
+    std::ofstream(dir.file("speech.txt")) << text;
+  }
+  auto read = [&](const char* name) {
+    std::ifstream in(dir.file(name));
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  };
+  ASSERT_EQ(run_line(commands[0], dir), "") << commands[0];
+  const std::string from_property = read("speech.pfap");
+  EXPECT_GT(std::count(from_property.begin(), from_property.end(), '\n'), 40);
+  ASSERT_EQ(run_line(commands[1], dir), "") << commands[1];
+  // The text from a file: the same phonemes (espeak-ng's synthesis differs by a few samples
+  // from one call to the next, and the times by a few ms).
+  auto symbols = [](const std::string& pfap_text) {
+    std::vector<std::string> out;
+    std::istringstream lines(pfap_text);
+    for (std::string start, symbol, rest; lines >> start >> symbol && std::getline(lines, rest);) {
+      out.push_back(symbol);
+    }
+    return out;
+  };
+  EXPECT_EQ(symbols(read("speech.pfap")), symbols(from_property));
+  ASSERT_EQ(run_line(commands[2], dir), "") << commands[2];
+  EXPECT_GT(file_size(dir.file("face.webm")), 20000u);
 }
 
 }  // namespace
