@@ -208,8 +208,8 @@ int main(int argc, char** argv) {
               percentile(equal_errors, 0.5) * 1000, percentile(equal_errors, 0.9) * 1000);
   std::printf("%-36s median %6.1f ms   p90 %6.1f ms\n", "baseline: espeak-ng times stretched",
               percentile(scaled_errors, 0.5) * 1000, percentile(scaled_errors, 0.9) * 1000);
-  std::printf("relative warp cost: median %.2f, max %.2f\n", percentile(costs, 0.5),
-              percentile(costs, 1));
+  std::printf("relative warp cost: min %.2f, median %.2f, max %.2f\n", percentile(costs, 0),
+              percentile(costs, 0.5), percentile(costs, 1));
   std::printf("real-time factor: %.3f (%.2f s to align %.1f s, with espeak-ng's synthesis)\n",
               align_seconds / audio_seconds, align_seconds, audio_seconds);
   return 0;
