@@ -4,12 +4,14 @@
 #include <gst/check/gstharness.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "pfapbuffer.h"
@@ -223,6 +225,30 @@ TEST(PfapAlign, StereoIsRefusedAtNegotiation) {
   gst_harness_set_src_caps_str(h, caps_at(16000, 2).c_str());
   EXPECT_EQ(gst_harness_push(h, gst_buffer_new_allocate(nullptr, 400, nullptr)),
             GST_FLOW_NOT_NEGOTIATED);
+  gst_harness_teardown(h);
+}
+
+TEST(PfapAlign, WaitForTheTextsEosEndsWithTheStream) {
+  // text_sink linked, its EOS never comes: the audio's EOS waits for it, and stopping the
+  // element ends the wait instead of hanging.
+  GstHarness* h = gst_harness_new_with_padnames("pfapalign", "sink", "src");
+  GstHarness* t = gst_harness_new_with_element(h->element, "text_sink", nullptr);
+  gst_harness_set_src_caps_str(h, caps_at(16000).c_str());
+  gst_harness_set_src_caps_str(t, "text/x-raw, format=(string)utf8");
+  const std::vector<int16_t> audio(1600, 1000);
+  ASSERT_EQ(gst_harness_push(h, gst_buffer_new_memdup(audio.data(), audio.size() * 2)),
+            GST_FLOW_OK);
+  std::atomic<bool> returned = false;
+  std::thread eos([&] {
+    gst_harness_push_event(h, gst_event_new_eos());
+    returned = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EXPECT_FALSE(returned);
+  gst_element_set_state(h->element, GST_STATE_READY);
+  eos.join();
+  EXPECT_TRUE(returned);
+  gst_harness_teardown(t);
   gst_harness_teardown(h);
 }
 
