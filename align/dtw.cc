@@ -8,10 +8,12 @@
 namespace pfap::align {
 namespace {
 
+// Finite for any input, so that every cell of the band has a finite cost and a step.
 float distance(std::span<const float> x, std::span<const float> y) {
   float s = 0;
   for (size_t d = 0; d < x.size(); ++d) s += (x[d] - y[d]) * (x[d] - y[d]);
-  return std::sqrt(s);
+  const float r = std::sqrt(s);
+  return std::isfinite(r) ? r : 1e6f;
 }
 
 enum Step : uint8_t { kDiagonal, kUp, kLeft };  // from (i-1, j-1), (i-1, j), (i, j-1)
@@ -68,9 +70,11 @@ Warp warp(const Features& a, const Features& b, size_t max_cells) {
     path_cost += distance(a.frame(i), b.frame(j));
     ++path_length;
     if (i == 0 && j == 0) break;
-    const Step step = j >= lo[i] && j < hi[i] ? static_cast<Step>(steps[i][j - lo[i]])
-                      : i > 0                ? kUp
-                                             : kLeft;
+    // Along the first row or column only one step leads back to (0, 0), whatever was stored.
+    const Step step = i == 0                      ? kLeft
+                      : j == 0                    ? kUp
+                      : j >= lo[i] && j < hi[i]   ? static_cast<Step>(steps[i][j - lo[i]])
+                                                  : kUp;
     if (step == kLeft) {
       --j;
     } else {

@@ -63,8 +63,11 @@ Features mfcc(std::span<const int16_t> samples, unsigned rate) {
                                : kFloorDb;
     aubio_fft_do(fft.get(), in.get(), spectrum.get());
     aubio_mfcc_do(mf.get(), spectrum.get(), out.get());
-    std::copy(out->data + 1, out->data + Features::kMfccs + 1,
-              f.data.begin() + static_cast<ptrdiff_t>(k * Features::kDims));
+    for (size_t d = 0; d < Features::kMfccs; ++d) {
+      // A log of a band with no energy at all would be -inf: such a coefficient counts as 0.
+      const smpl_t c = out->data[d + 1];
+      f.data[k * Features::kDims + d] = std::isfinite(c) ? c : 0;
+    }
   }
 
   for (size_t d = 0; d < Features::kMfccs; ++d) {

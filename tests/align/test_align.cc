@@ -124,6 +124,22 @@ TEST(Dtw, RecoversAStretch) {
   EXPECT_EQ(narrow.last.back(), fb.n_frames - 1);
 }
 
+TEST(Dtw, DigitalSilenceAndExtremesGiveAPathEndToEnd) {
+  // Zeros, full-scale square waves and a tone: every frame finite, the path from (0, 0) to
+  // the end.
+  const unsigned rate = 16000;
+  std::vector<int16_t> a(rate / 2, 0), b = tone(440, 0.3, rate);
+  for (size_t i = 0; i < rate / 4; ++i) a.push_back(i % 40 < 20 ? 32767 : -32768);
+  b.insert(b.end(), rate / 3, 0);
+  const Features fa = mfcc(a, rate), fb = mfcc(b, rate);
+  for (const float x : fa.data) ASSERT_TRUE(std::isfinite(x));
+  for (const float x : fb.data) ASSERT_TRUE(std::isfinite(x));
+  const Warp w = warp(fa, fb);
+  EXPECT_EQ(w.first.front(), 0u);
+  EXPECT_EQ(w.last.back(), fb.n_frames - 1);
+  EXPECT_TRUE(std::isfinite(w.relative_cost));
+}
+
 constexpr const char* kSentences[] = {
     "The quick brown fox jumps over the lazy dog.",
     "Please call Stella and ask her to bring these things with her from the store.",
