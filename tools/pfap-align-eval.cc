@@ -7,7 +7,8 @@
 // two baselines, the share of phonemes matched and the real-time factor. docs/align.md.
 //
 //   pfap-align-eval DIR NAME...      (tools/align-eval-festival makes DIR and runs this)
-// With PFAP_ALIGN_EVAL_VERBOSE set it prints both phoneme sequences with their starts in ms.
+// With PFAP_ALIGN_EVAL_VERBOSE set it prints both phoneme sequences with their starts in ms;
+// PFAP_ALIGN_EVAL_VOICE picks the espeak-ng voice (default "en").
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -129,6 +130,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string dir = argv[1];
+  // PFAP_ALIGN_EVAL_VOICE: the espeak-ng voice to align with (pfapalign's voice property).
+  pfap::tts::VoiceSettings voice;
+  if (const char* v = std::getenv("PFAP_ALIGN_EVAL_VOICE")) voice.voice = v;
   const pfap::PhonemeAlphabet& arpabet = *pfap::find_alphabet(pfap::kArpabetAlphabet);
   std::vector<double> aligned_errors, equal_errors, scaled_errors, costs;
   size_t matched_total = 0, truth_total = 0;
@@ -154,7 +158,7 @@ int main(int argc, char** argv) {
     pfap::align::Alignment alignment;
     std::string error;
     const auto t0 = std::chrono::steady_clock::now();
-    if (!pfap::align::align(utterance, {}, samples, rate, alignment, error)) {
+    if (!pfap::align::align(utterance, voice, samples, rate, alignment, error)) {
       std::fprintf(stderr, "%s\n", error.c_str());
       return 1;
     }
@@ -170,7 +174,7 @@ int main(int argc, char** argv) {
                      static_cast<double>(p.start) / rate});
     }
     pfap::tts::Speech syn;
-    pfap::tts::speak(utterance, {}, syn, error);
+    pfap::tts::speak(utterance, voice, syn, error);
     const double syn_duration = static_cast<double>(syn.samples.size()) / syn.sample_rate;
     for (size_t k = 0; k < syn.phonemes.size(); ++k) {
       const std::string name =
