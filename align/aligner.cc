@@ -11,8 +11,7 @@ namespace pfap::align {
 namespace {
 
 // The whole audio as one pause carrying every bookmark's FAPs.
-void pause_over(const tts::Utterance& utterance, size_t n_samples, unsigned rate,
-                Alignment& out) {
+void pause_over(const tts::Utterance& utterance, size_t n_samples, unsigned rate, Alignment& out) {
   MarkupEvent e;
   e.kind = PFAP_EVENT_PHONEME;
   e.sentence_start = true;
@@ -54,12 +53,16 @@ double speech_seconds(const Features& f) {
 
 const char* problem_text(Problem p) {
   switch (p) {
-    case Problem::kNone: return "aligned";
-    case Problem::kEmptyText: return "the text has nothing to speak: the audio is one pause";
-    case Problem::kNoSpeech: return "the audio is silent: it is one pause";
+    case Problem::kNone:
+      return "aligned";
+    case Problem::kEmptyText:
+      return "the text has nothing to speak: the audio is one pause";
+    case Problem::kNoSpeech:
+      return "the audio is silent: it is one pause";
     case Problem::kBadRate:
       return "the sample rate is outside 16000..48000 Hz: the audio is one pause";
-    case Problem::kPoorMatch: return "the audio matches the text poorly: the times may be wrong";
+    case Problem::kPoorMatch:
+      return "the audio matches the text poorly: the times may be wrong";
   }
   return "?";
 }
@@ -82,8 +85,8 @@ bool align(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
     return true;
   }
   const Features rec = mfcc(audio, rate);
-  if (audio.empty() || *std::max_element(rec.level_db.begin(), rec.level_db.end()) <
-                           kSpeechLevelDb) {
+  if (audio.empty() ||
+      *std::max_element(rec.level_db.begin(), rec.level_db.end()) < kSpeechLevelDb) {
     out.problem = Problem::kNoSpeech;
     pause_over(utterance, audio.size(), rate, out);
     return true;
@@ -98,8 +101,7 @@ bool align(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
   const Warp w = warp(synf, rec);
   out.relative_cost = w.relative_cost;
   const double ratio = speech_seconds(rec) / std::max(speech_seconds(synf), 0.01);
-  if (w.relative_cost >= kPoorMatchCost || ratio < 1 / kMaxSpeechRatio ||
-      ratio > kMaxSpeechRatio) {
+  if (w.relative_cost >= kPoorMatchCost || ratio < 1 / kMaxSpeechRatio || ratio > kMaxSpeechRatio) {
     out.problem = Problem::kPoorMatch;
   }
 
@@ -108,8 +110,8 @@ bool align(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
   bounds.push_back(0);
   for (size_t k = 1; k < syn.phonemes.size(); ++k) {
     const double at = map_boundary(syn.phonemes[k].start + pad, synf, rec, w);
-    const size_t s = static_cast<size_t>(std::clamp(std::lround(at), 0L,
-                                                    static_cast<long>(audio.size())));
+    const size_t s =
+        static_cast<size_t>(std::clamp(std::lround(at), 0L, static_cast<long>(audio.size())));
     bounds.push_back(std::max(s, bounds.back()));
   }
   bounds.push_back(audio.size());

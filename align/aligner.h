@@ -21,16 +21,16 @@ namespace pfap::align {
 // Why an alignment is only a pause or may be wrong; each a warning for the user.
 enum class Problem {
   kNone,
-  kEmptyText,    // no phonemes to align: one pause over the audio
-  kNoSpeech,     // the audio is all below kSpeechLevelDb: one pause, bookmarks on it
-  kBadRate,      // the rate is outside kMinRate..kMaxRate: one pause, bookmarks on it
-  kPoorMatch,    // aligned, but the audio matches the text poorly: relative_cost high, or
-                 // its speech much longer or shorter than the text's spoken by espeak-ng
+  kEmptyText,  // no phonemes to align: one pause over the audio
+  kNoSpeech,   // the audio is all below kSpeechLevelDb: one pause, bookmarks on it
+  kBadRate,    // the rate is outside kMinRate..kMaxRate: one pause, bookmarks on it
+  kPoorMatch,  // aligned, but the audio matches the text poorly: relative_cost high, or
+               // its speech much longer or shorter than the text's spoken by espeak-ng
 };
 
 const char* problem_text(Problem p);
 
-inline constexpr float kSpeechLevelDb = -50;      // a frame this loud or louder may be speech
+inline constexpr float kSpeechLevelDb = -50;    // a frame this loud or louder may be speech
 inline constexpr double kPoorMatchCost = 0.85;  // Warp::relative_cost from which kPoorMatch
 inline constexpr double kMaxSpeechRatio = 2.5;  // recording's speech over espeak-ng's, or back
 

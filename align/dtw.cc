@@ -71,10 +71,10 @@ Warp warp(const Features& a, const Features& b, size_t max_cells) {
     ++path_length;
     if (i == 0 && j == 0) break;
     // Along the first row or column only one step leads back to (0, 0), whatever was stored.
-    const Step step = i == 0                      ? kLeft
-                      : j == 0                    ? kUp
-                      : j >= lo[i] && j < hi[i]   ? static_cast<Step>(steps[i][j - lo[i]])
-                                                  : kUp;
+    const Step step = i == 0                    ? kLeft
+                      : j == 0                  ? kUp
+                      : j >= lo[i] && j < hi[i] ? static_cast<Step>(steps[i][j - lo[i]])
+                                                : kUp;
     if (step == kLeft) {
       --j;
     } else {

@@ -22,8 +22,8 @@ constexpr float kLevelWeight = 6;
 
 size_t Features::frame_at(size_t sample) const {
   if (n_frames == 0) return 0;
-  const double k = (static_cast<double>(sample) - static_cast<double>(window) / 2) /
-                   static_cast<double>(hop);
+  const double k =
+      (static_cast<double>(sample) - static_cast<double>(window) / 2) / static_cast<double>(hop);
   return static_cast<size_t>(std::clamp(std::lround(k), 0L, static_cast<long>(n_frames - 1)));
 }
 
@@ -44,8 +44,8 @@ Features mfcc(std::span<const int16_t> samples, unsigned rate) {
       new_aubio_window(const_cast<char*>("hanningz"), static_cast<uint_t>(f.window)), &del_fvec);
   std::unique_ptr<aubio_fft_t, decltype(&del_aubio_fft)> fft(
       new_aubio_fft(static_cast<uint_t>(f.window)), &del_aubio_fft);
-  std::unique_ptr<cvec_t, decltype(&del_cvec)> spectrum(
-      new_cvec(static_cast<uint_t>(f.window)), &del_cvec);
+  std::unique_ptr<cvec_t, decltype(&del_cvec)> spectrum(new_cvec(static_cast<uint_t>(f.window)),
+                                                        &del_cvec);
   std::unique_ptr<fvec_t, decltype(&del_fvec)> out(new_fvec(Features::kMfccs + 1), &del_fvec);
 
   f.data.resize(f.n_frames * Features::kDims);
@@ -58,9 +58,11 @@ Features mfcc(std::span<const int16_t> samples, unsigned rate) {
       energy += static_cast<double>(x) * x;
       in->data[i] = x * window->data[i];
     }
-    f.level_db[k] = energy > 0 ? std::max(kFloorDb, static_cast<float>(10 * std::log10(
-                                                        energy / static_cast<double>(f.window))))
-                               : kFloorDb;
+    f.level_db[k] =
+        energy > 0
+            ? std::max(kFloorDb,
+                       static_cast<float>(10 * std::log10(energy / static_cast<double>(f.window))))
+            : kFloorDb;
     aubio_fft_do(fft.get(), in.get(), spectrum.get());
     aubio_mfcc_do(mf.get(), spectrum.get(), out.get());
     for (size_t d = 0; d < Features::kMfccs; ++d) {

@@ -15,7 +15,7 @@ inline constexpr unsigned kMinRate = 16000;
 inline constexpr unsigned kMaxRate = 48000;
 
 struct Features {
-  static constexpr size_t kMfccs = 13;  // MFCC 1..13 (c0, the level, is left out)
+  static constexpr size_t kMfccs = 13;         // MFCC 1..13 (c0, the level, is left out)
   static constexpr size_t kDims = kMfccs + 1;  // and the level below the loudest frame
   unsigned rate = 0;
   size_t hop = 0;     // samples between frames

@@ -179,7 +179,8 @@ int main(int argc, char** argv) {
     for (size_t k = 0; k < syn.phonemes.size(); ++k) {
       const std::string name =
           lower(pfap::find_phoneme(arpabet, syn.phonemes[k].event.phoneme.symbol)->name);
-      equal.push_back({name, duration * static_cast<double>(k) / static_cast<double>(syn.phonemes.size())});
+      equal.push_back(
+          {name, duration * static_cast<double>(k) / static_cast<double>(syn.phonemes.size())});
       scaled.push_back({name, static_cast<double>(syn.phonemes[k].start) / syn.sample_rate *
                                   duration / syn_duration});
     }
@@ -199,10 +200,11 @@ int main(int argc, char** argv) {
     matched_total += matched;
     truth_total += truth.size();
     costs.push_back(alignment.relative_cost);
-    std::printf("%s: %.2f s, %zu of %zu phonemes matched, median %.1f ms, p90 %.1f ms, cost %.2f%s\n",
-                argv[a], duration, matched, truth.size(), percentile(e, 0.5) * 1000,
-                percentile(e, 0.9) * 1000, alignment.relative_cost,
-                alignment.problem == pfap::align::Problem::kNone ? "" : " (poor)");
+    std::printf(
+        "%s: %.2f s, %zu of %zu phonemes matched, median %.1f ms, p90 %.1f ms, cost %.2f%s\n",
+        argv[a], duration, matched, truth.size(), percentile(e, 0.5) * 1000,
+        percentile(e, 0.9) * 1000, alignment.relative_cost,
+        alignment.problem == pfap::align::Problem::kNone ? "" : " (poor)");
   }
   std::printf("\n%d sentences, %.1f s of audio, %zu boundaries (%zu of %zu phonemes matched)\n",
               argc - 2, audio_seconds, aligned_errors.size(), matched_total, truth_total);

@@ -80,7 +80,7 @@ struct Stream {
   std::vector<int16_t> samples;
   bool overflow_warned = false;
   bool pfap_discont = true;
-  std::array<guint64, 5> problems{};      // per pfap::align::Problem, for pfap_warn_at
+  std::array<guint64, 5> problems{};  // per pfap::align::Problem, for pfap_warn_at
   guint64 bad_bookmarks = 0;
 
   std::mutex lock;  // guards what follows, shared with the text pad's thread
@@ -108,7 +108,7 @@ struct _GstPfapAlign {
   Stream* stream;
 };
 
-#define AUDIO_CAPS                                                                      \
+#define AUDIO_CAPS                                                                          \
   "audio/x-raw, format = (string) S16LE, layout = (string) interleaved, rate = (int) [ 1, " \
   "MAX ], channels = (int) 1"
 
@@ -150,11 +150,12 @@ static void warn_problem(GstPfapAlign* self, pfap::align::Problem problem, GstCl
   Stream& s = *self->stream;
   if (problem == pfap::align::Problem::kNone) return;
   if (!pfap_warn_at(++s.problems[static_cast<size_t>(problem)])) return;
-  GST_ELEMENT_WARNING(self, STREAM, DECODE, ("Utterance at %" GST_TIME_FORMAT ": %s",
-                                             GST_TIME_ARGS(at), pfap::align::problem_text(problem)),
-                      ("relative warp cost %.2f (poor from %.2f); %" G_GUINT64_FORMAT " so far",
-                       cost, pfap::align::kPoorMatchCost,
-                       s.problems[static_cast<size_t>(problem)]));
+  GST_ELEMENT_WARNING(
+      self, STREAM, DECODE,
+      ("Utterance at %" GST_TIME_FORMAT ": %s", GST_TIME_ARGS(at),
+       pfap::align::problem_text(problem)),
+      ("relative warp cost %.2f (poor from %.2f); %" G_GUINT64_FORMAT " so far", cost,
+       pfap::align::kPoorMatchCost, s.problems[static_cast<size_t>(problem)]));
 }
 
 // Aligns `bytes` to samples [from, to) and pushes its phonemes on `pfap`. `is_text`: false
@@ -165,21 +166,21 @@ static GstFlowReturn align_utterance(GstPfapAlign* self, const std::string& byte
   const GstClockTime at = s.first + gst_util_uint64_scale(from, GST_SECOND, s.rate);
   std::string text = bytes;
   if (!g_utf8_validate(text.data(), static_cast<gssize>(text.size()), nullptr)) {
-    GST_ELEMENT_WARNING(self, STREAM, DECODE,
-                        ("The text of the utterance at %" GST_TIME_FORMAT " is not UTF-8",
-                         GST_TIME_ARGS(at)),
-                        ("aligned as an empty text"));
+    GST_ELEMENT_WARNING(
+        self, STREAM, DECODE,
+        ("The text of the utterance at %" GST_TIME_FORMAT " is not UTF-8", GST_TIME_ARGS(at)),
+        ("aligned as an empty text"));
     text.clear();
   }
   std::vector<pfap::tts::BadBookmark> bad;
   const pfap::tts::Utterance utterance = pfap::tts::parse_utterance(text, bad);
   for (const pfap::tts::BadBookmark& b : bad) {
     if (!pfap_warn_at(++s.bad_bookmarks)) continue;
-    GST_ELEMENT_WARNING(self, STREAM, FORMAT,
-                        ("Left out a bad bookmark at character %zu of the utterance at %" GST_TIME_FORMAT
-                         ": %s",
-                         b.character + 1, GST_TIME_ARGS(at), pfap::to_string(b.status)),
-                        ("%" G_GUINT64_FORMAT " so far", s.bad_bookmarks));
+    GST_ELEMENT_WARNING(
+        self, STREAM, FORMAT,
+        ("Left out a bad bookmark at character %zu of the utterance at %" GST_TIME_FORMAT ": %s",
+         b.character + 1, GST_TIME_ARGS(at), pfap::to_string(b.status)),
+        ("%" G_GUINT64_FORMAT " so far", s.bad_bookmarks));
   }
   GST_OBJECT_LOCK(self);
   pfap::tts::VoiceSettings voice;
@@ -309,7 +310,8 @@ static GstFlowReturn gst_pfap_align_chain(GstPad*, GstObject* parent, GstBuffer*
   GstMapInfo map;
   if (gst_buffer_map(buffer, &map, GST_MAP_READ)) {
     const size_t count = map.size / sizeof(int16_t);
-    const size_t room = kMaxSeconds * s.rate - std::min<size_t>(s.samples.size(), kMaxSeconds * s.rate);
+    const size_t room =
+        kMaxSeconds * s.rate - std::min<size_t>(s.samples.size(), kMaxSeconds * s.rate);
     if (count > room && !s.overflow_warned) {
       s.overflow_warned = true;
       GST_ELEMENT_WARNING(self, STREAM, TOO_LAZY,
@@ -360,8 +362,7 @@ static gboolean gst_pfap_align_sink_event(GstPad* pad, GstObject* parent, GstEve
         s.rate = static_cast<unsigned>(rate);
         if (s.rate < pfap::align::kMinRate || s.rate > pfap::align::kMaxRate) {
           GST_ELEMENT_WARNING(self, STREAM, FORMAT,
-                              ("Audio at %u Hz cannot be aligned: its phonemes are pauses",
-                               s.rate),
+                              ("Audio at %u Hz cannot be aligned: its phonemes are pauses", s.rate),
                               ("the alignment takes %u to %u Hz: put audioresample before",
                                pfap::align::kMinRate, pfap::align::kMaxRate));
         }

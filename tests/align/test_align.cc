@@ -110,7 +110,8 @@ TEST(Dtw, RecoversAStretch) {
   ASSERT_EQ(w.first.size(), fa.n_frames);
   // The step from 900 to 1500 Hz: 0.5 s into a, 0.7 s into b.
   const size_t i = fa.frame_at(rate / 2);
-  const double b_sample = (static_cast<double>(fb.centre(w.last[i - 1])) + fb.centre(w.first[i])) / 2;
+  const double b_sample =
+      (static_cast<double>(fb.centre(w.last[i - 1])) + fb.centre(w.first[i])) / 2;
   EXPECT_NEAR(b_sample / rate, 0.7, 0.012);
   for (size_t k = 1; k < fa.n_frames; ++k) {
     EXPECT_LE(w.first[k - 1], w.last[k - 1]);
@@ -211,8 +212,9 @@ TEST(Aligner, KeepsWordStartsStressAndBookmarks) {
     EXPECT_NEAR(got.phoneme.f0, want.phoneme.f0, 5) << k;
   }
   // The bookmark is on "world"'s first phoneme.
-  const auto with_faps = std::find_if(a.phonemes.begin(), a.phonemes.end(),
-                                      [](const tts::SpokenPhoneme& p) { return !p.event.faps.empty(); });
+  const auto with_faps =
+      std::find_if(a.phonemes.begin(), a.phonemes.end(),
+                   [](const tts::SpokenPhoneme& p) { return !p.event.faps.empty(); });
   ASSERT_NE(with_faps, a.phonemes.end());
   EXPECT_TRUE(with_faps->event.phoneme.word_begin);
   EXPECT_GT(with_faps->start, 0u);
@@ -257,8 +259,9 @@ TEST(Aligner, NoiseAndAnotherTextMatchPoorly) {
   EXPECT_EQ(right.problem, Problem::kNone);
   // A text of three other sentences: what the cost tells apart (a text of one other sentence,
   // of about the same length, mostly is not: docs/align.md).
-  const Alignment wrong = aligned(std::string(kSentences[1]) + " " + kSentences[2] + " " + kSentences[3],
-                                  s.samples, s.sample_rate);
+  const Alignment wrong =
+      aligned(std::string(kSentences[1]) + " " + kSentences[2] + " " + kSentences[3], s.samples,
+              s.sample_rate);
   std::vector<int16_t> noise(s.samples.size());
   uint32_t x = 12345;
   for (int16_t& v : noise) {

@@ -44,8 +44,8 @@ pfap::tts::Speech say(const std::string& text, int rate = 140, int pitch = 30) {
   std::vector<pfap::tts::BadBookmark> bad;
   pfap::tts::Speech s;
   std::string error;
-  EXPECT_TRUE(pfap::tts::speak(pfap::tts::parse_utterance(text, bad), {"en", rate, pitch, 100},
-                               s, error));
+  EXPECT_TRUE(
+      pfap::tts::speak(pfap::tts::parse_utterance(text, bad), {"en", rate, pitch, 100}, s, error));
   return s;
 }
 
@@ -55,7 +55,8 @@ Result run(const std::vector<int16_t>& samples, unsigned rate, const char* text,
            const std::vector<std::pair<GstClockTime, std::string>>& texts = {}) {
   GstHarness* h = gst_harness_new_with_padnames("pfapalign", "sink", "src");
   GstHarness* pfap = gst_harness_new_with_element(h->element, nullptr, "pfap");
-  GstHarness* t = texts.empty() ? nullptr : gst_harness_new_with_element(h->element, "text_sink", nullptr);
+  GstHarness* t =
+      texts.empty() ? nullptr : gst_harness_new_with_element(h->element, "text_sink", nullptr);
   GstBus* bus = gst_bus_new();
   gst_element_set_bus(h->element, bus);
   if (text != nullptr) g_object_set(h->element, "text", text, nullptr);
@@ -155,7 +156,8 @@ TEST(PfapAlign, UtterancesOnTheTextPadStartAtTheirPts) {
   const size_t b_start = audio.size();
   audio.insert(audio.end(), b.samples.begin(), b.samples.end());
   const GstClockTime b_time = gst_util_uint64_scale(b_start, GST_SECOND, a.sample_rate);
-  const Result r = run(audio, a.sample_rate, nullptr, {{0, "Good morning."}, {b_time, "See you tomorrow."}});
+  const Result r =
+      run(audio, a.sample_rate, nullptr, {{0, "Good morning."}, {b_time, "See you tomorrow."}});
   EXPECT_TRUE(r.warnings.empty()) << r.warnings.front();
   expect_tiles(r, gst_util_uint64_scale(audio.size(), GST_SECOND, a.sample_rate));
   EXPECT_EQ(r.events.size(), a.phonemes.size() + b.phonemes.size());
@@ -180,10 +182,11 @@ TEST(PfapAlign, SilenceWarnsAndIsOnePause) {
 
 TEST(PfapAlign, NoiseAndAnotherTextWarnOfAPoorMatch) {
   const pfap::tts::Speech s = say(kText);
-  const Result wrong = run(s.samples, s.sample_rate,
-                           "How much wood would a woodchuck chuck if a woodchuck could chuck wood? "
-                           "She sells sea shells by the sea shore. The quick brown fox jumps over the lazy "
-                           "dog. Peter Piper picked a peck of pickled peppers.");
+  const Result wrong =
+      run(s.samples, s.sample_rate,
+          "How much wood would a woodchuck chuck if a woodchuck could chuck wood? "
+          "She sells sea shells by the sea shore. The quick brown fox jumps over the lazy "
+          "dog. Peter Piper picked a peck of pickled peppers.");
   EXPECT_TRUE(has_warning(wrong, "poorly"));
   expect_tiles(wrong, gst_util_uint64_scale(s.samples.size(), GST_SECOND, s.sample_rate));
   std::vector<int16_t> noise(s.samples.size());
