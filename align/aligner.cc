@@ -72,6 +72,7 @@ bool align(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
   out = Alignment{};
   tts::Speech syn;
   if (!tts::speak(utterance, voice, syn, error)) return false;
+  out.inexact = syn.inexact;
 
   if (rate < kMinRate || rate > kMaxRate) {
     out.problem = Problem::kBadRate;

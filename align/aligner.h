@@ -40,6 +40,8 @@ struct Alignment {
   std::vector<tts::SpokenPhoneme> phonemes;
   Problem problem = Problem::kNone;
   double relative_cost = 0;  // dtw.h; 0 when nothing was aligned
+  // espeak-ng's mnemonics with no exact x-pfap-arpabet symbol, as tts::Speech gives them.
+  std::vector<tts::Speech::Inexact> inexact;
 };
 
 // Aligns `utterance` to `audio` (mono, `rate` Hz). False with `error` only when espeak-ng

@@ -44,6 +44,7 @@
 #include <array>
 #include <condition_variable>
 #include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -82,6 +83,7 @@ struct Stream {
   bool pfap_discont = true;
   std::array<guint64, 5> problems{};  // per pfap::align::Problem, for pfap_warn_at
   guint64 bad_bookmarks = 0;
+  std::set<std::string> warned_phonemes;  // inexact mnemonics already warned about
 
   std::mutex lock;  // guards what follows, shared with the text pad's thread
   std::condition_variable text_changed;
@@ -198,6 +200,15 @@ static GstFlowReturn align_utterance(GstPfapAlign* self, const std::string& byte
                    GST_TIME_ARGS(at), alignment.phonemes.size(), audio.size(),
                    alignment.relative_cost);
   if (is_text) warn_problem(self, alignment.problem, at, alignment.relative_cost);
+  // As pfaptts warns: once per mnemonic of a voice whose phonemes x-pfap-arpabet lacks.
+  for (const pfap::tts::Speech::Inexact& i : alignment.inexact) {
+    if (!s.warned_phonemes.insert(i.mnemonic).second) continue;
+    const std::string sent_as(i.sent_as);
+    GST_ELEMENT_WARNING(self, STREAM, FORMAT,
+                        ("espeak-ng phoneme \"%s\" of voice \"%s\" is not in x-pfap-arpabet",
+                         i.mnemonic.c_str(), voice.voice.c_str()),
+                        ("sent as %s", sent_as.c_str()));
+  }
 
   GstFlowReturn ret = GST_FLOW_OK;
   for (const pfap::tts::SpokenPhoneme& p : alignment.phonemes) {
@@ -478,6 +489,7 @@ static GstStateChangeReturn gst_pfap_align_change_state(GstElement* element,
     s.rate = 0;
     s.problems = {};
     s.bad_bookmarks = 0;
+    s.warned_phonemes.clear();
     unsigned rate = 0;
     std::string error;
     GST_OBJECT_LOCK(self);

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -49,10 +50,11 @@ pfap::tts::Speech say(const std::string& text, int rate = 140, int pitch = 30) {
   return s;
 }
 
-// Runs pfapalign over `samples` at `rate` with the `text` property (nullptr: none), or, when
-// `texts` is not empty, with those (PTS, text) buffers on text_sink.
+// Runs pfapalign (espeak-ng voice `voice`) over `samples` at `rate` with the `text` property
+// (nullptr: none), or, when `texts` is not empty, with those (PTS, text) buffers on text_sink.
 Result run(const std::vector<int16_t>& samples, unsigned rate, const char* text,
-           const std::vector<std::pair<GstClockTime, std::string>>& texts = {}) {
+           const std::vector<std::pair<GstClockTime, std::string>>& texts = {},
+           const char* voice = "en") {
   GstHarness* h = gst_harness_new_with_padnames("pfapalign", "sink", "src");
   GstHarness* pfap = gst_harness_new_with_element(h->element, nullptr, "pfap");
   GstHarness* t =
@@ -60,6 +62,7 @@ Result run(const std::vector<int16_t>& samples, unsigned rate, const char* text,
   GstBus* bus = gst_bus_new();
   gst_element_set_bus(h->element, bus);
   if (text != nullptr) g_object_set(h->element, "text", text, nullptr);
+  g_object_set(h->element, "voice", voice, nullptr);
   gst_harness_set_src_caps_str(h, caps_at(rate).c_str());
   if (t != nullptr) {
     gst_harness_set_src_caps_str(t, "text/x-raw, format=(string)utf8");
@@ -221,6 +224,20 @@ TEST(PfapAlign, UnsupportedRateWarnsAndPassesTheAudio) {
   EXPECT_EQ(r.audio, audio);
   ASSERT_EQ(r.events.size(), 1u);
   expect_tiles(r, GST_SECOND);
+}
+
+TEST(PfapAlign, PhonemesOutsideTheAlphabetWarnOncePerMnemonic) {
+  // German through voice "de": "ich" has a phoneme x-pfap-arpabet lacks (espeak-ng's "C").
+  const pfap::tts::Speech s = say(kText);
+  const Result r = run(s.samples, s.sample_rate, "Ich spreche, ich lache.", {}, "de");
+  size_t outside = 0;
+  for (const std::string& w : r.warnings) {
+    if (w.find("is not in x-pfap-arpabet") != std::string::npos) ++outside;
+  }
+  EXPECT_GT(outside, 0u);
+  const std::set<std::string> distinct(r.warnings.begin(), r.warnings.end());
+  EXPECT_EQ(distinct.size(), r.warnings.size());  // once per mnemonic
+  expect_tiles(r, gst_util_uint64_scale(s.samples.size(), GST_SECOND, s.sample_rate));
 }
 
 TEST(PfapAlign, StereoIsRefusedAtNegotiation) {
