@@ -479,6 +479,7 @@ TEST(GstInspect, EachPluginListsItsElements) {
         "pfapmarksenc", "pfapmarksparse"}, 1},
       {"pfaptts", {"pfaptts"}, 0},
       {"pfapface", {"pfapface"}, 0},
+      {"pfapalign", {"pfapalign"}, 0},
   };
   for (const auto& [plugin, elements, typefinders] : plugins) {
     const Inspect r = gst_inspect(plugin, "--plugin");

@@ -15,7 +15,7 @@
 
 namespace {
 
-constexpr const char* kPlugins[] = {"pfap", "pfaptts", "pfapface"};
+constexpr const char* kPlugins[] = {"pfap", "pfaptts", "pfapface", "pfapalign"};
 constexpr const char* kSection = "## Registry reference";
 
 std::string rank_name(guint rank) {

@@ -1,0 +1,129 @@
+#include "aligner.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "dtw.h"
+#include "f0.h"
+#include "mfcc.h"
+
+namespace pfap::align {
+namespace {
+
+// The whole audio as one pause carrying every bookmark's FAPs.
+void pause_over(const tts::Utterance& utterance, size_t n_samples, unsigned rate, Alignment& out) {
+  MarkupEvent e;
+  e.kind = PFAP_EVENT_PHONEME;
+  e.sentence_start = true;
+  e.phoneme.end_of_text = true;
+  for (const tts::Bookmark& b : utterance.bookmarks) {
+    e.faps.insert(e.faps.end(), b.faps.begin(), b.faps.end());
+  }
+  tts::add_phoneme(e, 0, n_samples, rate, out.phonemes);
+}
+
+// Where the synthetic boundary at `sample` falls in the recording, by the warp between the
+// frames either side of it.
+double map_boundary(size_t sample, const Features& syn, const Features& rec, const Warp& w) {
+  const double centre0 = static_cast<double>(syn.centre(0));
+  const double pos = (static_cast<double>(sample) - centre0) / static_cast<double>(syn.hop);
+  const double scale = static_cast<double>(rec.rate) / syn.rate;
+  if (pos <= 0) return static_cast<double>(sample) * scale;
+  const size_t i = static_cast<size_t>(std::ceil(pos));
+  if (i >= syn.n_frames) {
+    return static_cast<double>(rec.centre(w.last.back())) +
+           (static_cast<double>(sample) - static_cast<double>(syn.centre(syn.n_frames - 1))) *
+               scale;
+  }
+  const double t = pos - static_cast<double>(i - 1);  // 0..1 between the two centres
+  const double from = static_cast<double>(rec.centre(w.last[i - 1]));
+  const double to = static_cast<double>(rec.centre(w.first[i]));
+  return from + t * (to - from);
+}
+
+// How long `f` has speech: its frames within 30 dB of the loudest, in seconds.
+double speech_seconds(const Features& f) {
+  const float loudest = *std::max_element(f.level_db.begin(), f.level_db.end());
+  const auto n = std::count_if(f.level_db.begin(), f.level_db.end(),
+                               [&](float db) { return db > loudest - 30; });
+  return static_cast<double>(n) * static_cast<double>(f.hop) / f.rate;
+}
+
+}  // namespace
+
+const char* problem_text(Problem p) {
+  switch (p) {
+    case Problem::kNone:
+      return "aligned";
+    case Problem::kEmptyText:
+      return "the text has nothing to speak: the audio is one pause";
+    case Problem::kNoSpeech:
+      return "the audio is silent: it is one pause";
+    case Problem::kBadRate:
+      return "the sample rate is outside 16000..48000 Hz: the audio is one pause";
+    case Problem::kPoorMatch:
+      return "the audio matches the text poorly: the times may be wrong";
+  }
+  return "?";
+}
+
+bool align(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
+           std::span<const int16_t> audio, unsigned rate, Alignment& out, std::string& error) {
+  out = Alignment{};
+  tts::Speech syn;
+  if (!tts::speak(utterance, voice, syn, error)) return false;
+  out.inexact = syn.inexact;
+
+  if (rate < kMinRate || rate > kMaxRate) {
+    out.problem = Problem::kBadRate;
+    pause_over(utterance, audio.size(), rate, out);
+    return true;
+  }
+  if (std::none_of(syn.phonemes.begin(), syn.phonemes.end(),
+                   [](const tts::SpokenPhoneme& p) { return p.event.phoneme.symbol != 0; })) {
+    out.problem = Problem::kEmptyText;
+    pause_over(utterance, audio.size(), rate, out);
+    return true;
+  }
+  const Features rec = mfcc(audio, rate);
+  if (audio.empty() ||
+      *std::max_element(rec.level_db.begin(), rec.level_db.end()) < kSpeechLevelDb) {
+    out.problem = Problem::kNoSpeech;
+    pause_over(utterance, audio.size(), rate, out);
+    return true;
+  }
+  // The synthetic speech has almost no silence about it, a recording often has much: padded
+  // with silence, its ends have pause frames to match the recording's.
+  const size_t pad = syn.sample_rate / 10;
+  std::vector<int16_t> padded(pad, 0);
+  padded.insert(padded.end(), syn.samples.begin(), syn.samples.end());
+  padded.resize(padded.size() + pad, 0);
+  const Features synf = mfcc(padded, syn.sample_rate);
+  const Warp w = warp(synf, rec);
+  out.relative_cost = w.relative_cost;
+  const double ratio = speech_seconds(rec) / std::max(speech_seconds(synf), 0.01);
+  if (w.relative_cost >= kPoorMatchCost || ratio < 1 / kMaxSpeechRatio || ratio > kMaxSpeechRatio) {
+    out.problem = Problem::kPoorMatch;
+  }
+
+  // Each phoneme's start on the recording, no earlier than the one before.
+  std::vector<size_t> bounds;
+  bounds.push_back(0);
+  for (size_t k = 1; k < syn.phonemes.size(); ++k) {
+    const double at = map_boundary(syn.phonemes[k].start + pad, synf, rec, w);
+    const size_t s =
+        static_cast<size_t>(std::clamp(std::lround(at), 0L, static_cast<long>(audio.size())));
+    bounds.push_back(std::max(s, bounds.back()));
+  }
+  bounds.push_back(audio.size());
+
+  const std::vector<double> f0 = tts::segment_f0(audio, rate, bounds);
+  for (size_t k = 0; k < syn.phonemes.size(); ++k) {
+    MarkupEvent e = syn.phonemes[k].event;
+    e.phoneme.f0 = f0_code(static_cast<unsigned>(std::lround(f0[k])));
+    tts::add_phoneme(e, bounds[k], bounds[k + 1], rate, out.phonemes);
+  }
+  return true;
+}
+
+}  // namespace pfap::align

@@ -1,0 +1,53 @@
+// Forced alignment of a text to a recording of it: the text is spoken by espeak-ng (tts/,
+// with its phonemes' times, stress, word starts and bookmarks), both are turned into MFCC
+// frames, dynamic time warping matches the frames, and each synthetic phoneme boundary is
+// moved to the recording's time it matches. f0 is measured on the recording. The method and
+// its measured accuracy: docs/align.md.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "espeak.h"
+#include "mfcc.h"  // kMinRate, kMaxRate: the rates align() takes
+#include "speech.h"
+#include "utterance.h"
+
+namespace pfap::align {
+
+// Why an alignment is only a pause or may be wrong; each a warning for the user.
+enum class Problem {
+  kNone,
+  kEmptyText,  // no phonemes to align: one pause over the audio
+  kNoSpeech,   // the audio is all below kSpeechLevelDb: one pause, bookmarks on it
+  kBadRate,    // the rate is outside kMinRate..kMaxRate: one pause, bookmarks on it
+  kPoorMatch,  // aligned, but the audio matches the text poorly: relative_cost high, or
+               // its speech much longer or shorter than the text's spoken by espeak-ng
+};
+
+const char* problem_text(Problem p);
+
+inline constexpr float kSpeechLevelDb = -50;    // a frame this loud or louder may be speech
+inline constexpr double kPoorMatchCost = 0.85;  // Warp::relative_cost from which kPoorMatch
+inline constexpr double kMaxSpeechRatio = 2.5;  // recording's speech over espeak-ng's, or back
+
+struct Alignment {
+  // Phonemes on the recording: contiguous from sample 0 to the audio's end; starts in
+  // samples of the recording, duration_ms on its ms grid as tts::speak gives them.
+  std::vector<tts::SpokenPhoneme> phonemes;
+  Problem problem = Problem::kNone;
+  double relative_cost = 0;  // dtw.h; 0 when nothing was aligned
+  // espeak-ng's mnemonics with no exact x-pfap-arpabet symbol, as tts::Speech gives them.
+  std::vector<tts::Speech::Inexact> inexact;
+};
+
+// Aligns `utterance` to `audio` (mono, `rate` Hz). False with `error` only when espeak-ng
+// cannot speak (no such voice); every other input gives phonemes, with `problem` saying what
+// was wrong. The voice should speak the recording's language; its rate and pitch matter little.
+bool align(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
+           std::span<const int16_t> audio, unsigned rate, Alignment& out, std::string& error);
+
+}  // namespace pfap::align

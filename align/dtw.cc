@@ -1,0 +1,99 @@
+#include "dtw.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace pfap::align {
+namespace {
+
+// Finite for any input, so that every cell of the band has a finite cost and a step.
+float distance(std::span<const float> x, std::span<const float> y) {
+  float s = 0;
+  for (size_t d = 0; d < x.size(); ++d) s += (x[d] - y[d]) * (x[d] - y[d]);
+  const float r = std::sqrt(s);
+  return std::isfinite(r) ? r : 1e6f;
+}
+
+enum Step : uint8_t { kDiagonal, kUp, kLeft };  // from (i-1, j-1), (i-1, j), (i, j-1)
+
+}  // namespace
+
+Warp warp(const Features& a, const Features& b, size_t max_cells) {
+  const size_t n = a.n_frames, m = b.n_frames;
+  // Row i covers columns [lo[i], hi[i]) about the diagonal's column i * m / n.
+  size_t radius = std::max(n, m) / 2 + 1;
+  if (n * (2 * radius + 1) > max_cells) radius = std::max<size_t>(max_cells / n / 2, 1);
+  radius = std::max(radius, (m + n - 1) / n);  // neighbouring rows' bands must touch
+  std::vector<size_t> lo(n), hi(n);
+  for (size_t i = 0; i < n; ++i) {
+    const size_t c = n > 1 ? i * (m - 1) / (n - 1) : 0;
+    lo[i] = c > radius ? c - radius : 0;
+    hi[i] = std::min(m, c + radius + 1);
+  }
+  lo[0] = 0;
+  hi[n - 1] = m;
+
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  std::vector<std::vector<uint8_t>> steps(n);
+  std::vector<float> prev(m, kInf), cur(m, kInf);
+  for (size_t i = 0; i < n; ++i) {
+    steps[i].resize(hi[i] - lo[i]);
+    std::fill(cur.begin(), cur.end(), kInf);
+    for (size_t j = lo[i]; j < hi[i]; ++j) {
+      const float d = distance(a.frame(i), b.frame(j));
+      float best = kInf;
+      Step step = kDiagonal;
+      if (i == 0 && j == 0) {
+        best = 0;
+      } else {
+        if (i > 0 && j > 0 && prev[j - 1] < best) best = prev[j - 1], step = kDiagonal;
+        if (i > 0 && prev[j] < best) best = prev[j], step = kUp;
+        if (j > 0 && cur[j - 1] < best) best = cur[j - 1], step = kLeft;
+      }
+      cur[j] = best + d;
+      steps[i][j - lo[i]] = step;
+    }
+    std::swap(prev, cur);
+  }
+
+  Warp w;
+  w.first.assign(n, 0);
+  w.last.assign(n, 0);
+  double path_cost = 0;
+  size_t path_length = 0;
+  size_t i = n - 1, j = m - 1;
+  w.last[i] = j;
+  for (;;) {
+    w.first[i] = j;
+    path_cost += distance(a.frame(i), b.frame(j));
+    ++path_length;
+    if (i == 0 && j == 0) break;
+    // Along the first row or column only one step leads back to (0, 0), whatever was stored.
+    const Step step = i == 0                    ? kLeft
+                      : j == 0                  ? kUp
+                      : j >= lo[i] && j < hi[i] ? static_cast<Step>(steps[i][j - lo[i]])
+                                                : kUp;
+    if (step == kLeft) {
+      --j;
+    } else {
+      if (step == kDiagonal) --j;
+      --i;
+      w.last[i] = j;
+    }
+  }
+
+  // What the path saves over a linear warp (one sequence stretched evenly onto the other),
+  // along the same number of steps: the same words gain much, unrelated sounds little.
+  double linear_cost = 0;
+  for (size_t k = 0; k < path_length; ++k) {
+    const size_t pi = path_length > 1 ? k * (n - 1) / (path_length - 1) : 0;
+    const size_t pj = path_length > 1 ? k * (m - 1) / (path_length - 1) : 0;
+    linear_cost += distance(a.frame(pi), b.frame(pj));
+  }
+  w.relative_cost = linear_cost > 0 ? path_cost / linear_cost : 0;
+  return w;
+}
+
+}  // namespace pfap::align

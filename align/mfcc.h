@@ -1,0 +1,42 @@
+// Spectral features for aligning two recordings of the same words: MFCCs computed with aubio
+// on windows of the same duration and over the same band whatever the sample rate, so that
+// speech at 16 kHz and at 22.05 kHz give comparable frames.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace pfap::align {
+
+// The sample rates the features are defined for: the mel band (below) must fit under half.
+inline constexpr unsigned kMinRate = 16000;
+inline constexpr unsigned kMaxRate = 48000;
+
+struct Features {
+  static constexpr size_t kMfccs = 13;         // MFCC 1..13 (c0, the level, is left out)
+  static constexpr size_t kDims = kMfccs + 1;  // and the level below the loudest frame
+  unsigned rate = 0;
+  size_t hop = 0;     // samples between frames
+  size_t window = 0;  // samples per frame
+  size_t n_frames = 0;
+  // n_frames x kDims: the MFCCs, each normalized to mean 0 and variance 1 over the utterance,
+  // which takes away most of what differs between two voices and two microphones; then the
+  // frame's level below the loudest frame's, 0 (loudest) to -kLevelWeight (50 dB below or
+  // less), which tells pauses in any recording.
+  std::vector<float> data;
+  std::vector<float> level_db;  // each frame's RMS level in dBFS
+
+  std::span<const float> frame(size_t k) const { return {data.data() + k * kDims, kDims}; }
+  // The sample at the middle of frame k's window (frame k covers [k * hop, k * hop + window)).
+  size_t centre(size_t k) const { return k * hop + window / 2; }
+  // The frame whose centre is nearest `sample`.
+  size_t frame_at(size_t sample) const;
+};
+
+// Features of `samples` at `rate` (kMinRate..kMaxRate): 25 ms Hann windows every 5 ms, 40 mel
+// bands over 100..7000 Hz. Audio shorter than a window gives one frame (zero-padded).
+Features mfcc(std::span<const int16_t> samples, unsigned rate);
+
+}  // namespace pfap::align

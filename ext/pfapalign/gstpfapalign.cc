@@ -1,0 +1,639 @@
+// The example pipelines stay on one line, to be copied.
+// clang-format off
+/**
+ * SECTION:element-pfapalign
+ * @title: pfapalign
+ * @see_also: pfaptts, pfapface, pfaptextenc, rtppfappay
+ *
+ * PFAP from speech that was not synthesized here: a recording and its text in, the audio out
+ * unchanged on `src` and its phonemes on `pfap` (application/x-pfap,
+ * `alphabet=x-pfap-arpabet`), on the audio's timeline. The text is spoken by espeak-ng
+ * (#GstPfapAlign:voice, the recording's language), both are turned into MFCC frames and
+ * matched by dynamic time warping, and each phoneme boundary of the synthetic speech is moved
+ * to the time of the recording it matches; word starts, stress and `<FAP ...>` bookmarks are
+ * those pfaptts gives, f0 is measured on the recording (docs/align.md).
+ *
+ * Audio: S16LE mono. The alignment takes 16000 to 48000 Hz; at another rate (put
+ * `audioresample` before) the audio still passes and each utterance is one pause, with a
+ * warning. Other formats and channel counts are refused at negotiation: put `audioconvert`
+ * before.
+ *
+ * Text: #GstPfapAlign:text, the whole stream's, when `text_sink` is not linked; else
+ * `text_sink` (text/x-raw or text/plain), one utterance per buffer, which lasts from its PTS
+ * (running time) to the next utterance's or the end. A text buffer without a PTS continues
+ * the one before (so a file read in blocks is one utterance); the first starts at the audio's
+ * start. Audio before the first utterance is a pause.
+ *
+ * The phonemes come when the audio ends (EOS, a new segment or sample rate), after the text
+ * pad's EOS: this element is for recordings, not live sources (docs/align.md says what is not
+ * done). Silence, noise, a text that does not match, an empty text, bad bookmarks and
+ * unsupported rates each give a warning (rate-limited), and the stream goes on: an utterance
+ * that cannot be aligned is one pause carrying its bookmarks.
+ *
+ * ## Example pipelines
+ * |[
+ * gst-launch-1.0 filesrc location=speech.wav ! wavparse ! audioconvert ! audioresample ! pfapalign text="Hello world." name=a a.src ! fakesink a.pfap ! pfaptextenc ! filesink location=speech.pfap
+ * ]| A WAV and its text to a .pfap file.
+ */
+// clang-format on
+#include "gstpfapalign.h"
+
+#include <gst/base/gstflowcombiner.h>
+
+#include <algorithm>
+#include <array>
+#include <condition_variable>
+#include <mutex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "aligner.h"
+#include "pfap/markup.h"
+#include "markupbuffer.h"
+#include "ratelimit.h"
+#include "sparse.h"
+
+GST_DEBUG_CATEGORY_STATIC(pfapalign_debug);
+#define GST_CAT_DEFAULT pfapalign_debug
+
+namespace {
+
+constexpr const char* kDefaultVoice = "en";
+// Audio kept for one alignment at most: 10 minutes. Beyond, the rest is a pause (warned).
+constexpr uint64_t kMaxSeconds = 600;
+
+enum {
+  PROP_0,
+  PROP_TEXT,
+  PROP_VOICE,
+};
+
+// One text buffer: its running time (NONE: it continues the one before) and bytes.
+struct Text {
+  GstClockTime running_time;
+  std::string bytes;
+};
+
+// The audio streaming thread's, but for what `lock` guards.
+struct Stream {
+  unsigned rate = 0;
+  GstSegment segment;                        // the audio's, also sent on `pfap`
+  GstClockTime first = GST_CLOCK_TIME_NONE;  // segment position of samples[0]
+  std::vector<int16_t> samples;
+  bool overflow_warned = false;
+  bool pfap_discont = true;
+  std::array<guint64, 5> problems{};  // per pfap::align::Problem, for pfap_warn_at
+  guint64 bad_bookmarks = 0;
+  std::set<std::string> warned_phonemes;  // inexact mnemonics already warned about
+
+  std::mutex lock;  // guards what follows, shared with the text pad's thread
+  std::condition_variable text_changed;
+  std::vector<Text> texts;
+  bool text_eos = false;
+  bool flushing = false;  // the audio pad flushes or the element stops: stop waiting for text
+  GstSegment text_segment;
+};
+
+}  // namespace
+
+struct _GstPfapAlign {
+  GstElement parent;
+  GstPad* sinkpad;
+  GstPad* textpad;
+  GstPad* srcpad;
+  GstPad* pfappad;
+  GstFlowCombiner* flow_combiner;
+
+  // Properties, under the object lock.
+  gchar* text;
+  gchar* voice;
+
+  Stream* stream;
+};
+
+#define AUDIO_CAPS                                                                          \
+  "audio/x-raw, format = (string) S16LE, layout = (string) interleaved, rate = (int) [ 1, " \
+  "MAX ], channels = (int) 1"
+
+static GstStaticPadTemplate sink_template =
+    GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS(AUDIO_CAPS));
+
+static GstStaticPadTemplate text_template =
+    GST_STATIC_PAD_TEMPLATE("text_sink", GST_PAD_SINK, GST_PAD_ALWAYS,
+                            GST_STATIC_CAPS("text/x-raw, format = (string) utf8; text/plain"));
+
+static GstStaticPadTemplate src_template =
+    GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(AUDIO_CAPS));
+
+static GstStaticPadTemplate pfap_template = GST_STATIC_PAD_TEMPLATE(
+    "pfap", GST_PAD_SRC, GST_PAD_ALWAYS,
+    GST_STATIC_CAPS(PFAP_MARKUP_CAPS ", alphabet = (string) x-pfap-arpabet"));
+
+G_DEFINE_TYPE(GstPfapAlign, gst_pfap_align, GST_TYPE_ELEMENT)
+GST_ELEMENT_REGISTER_DEFINE(pfapalign, "pfapalign", GST_RANK_NONE, GST_TYPE_PFAP_ALIGN)
+
+// The audio kept and the texts dropped: at a new stream or a flush.
+static void reset(GstPfapAlign* self) {
+  Stream& s = *self->stream;
+  s.first = GST_CLOCK_TIME_NONE;
+  s.samples.clear();
+  s.overflow_warned = false;
+  s.pfap_discont = true;
+  gst_segment_init(&s.segment, GST_FORMAT_TIME);
+  std::lock_guard<std::mutex> guard(s.lock);
+  s.texts.clear();
+  s.text_eos = false;
+  s.flushing = false;
+  gst_segment_init(&s.text_segment, GST_FORMAT_TIME);
+  gst_flow_combiner_reset(self->flow_combiner);
+}
+
+static void warn_problem(GstPfapAlign* self, pfap::align::Problem problem, GstClockTime at,
+                         double cost) {
+  Stream& s = *self->stream;
+  if (problem == pfap::align::Problem::kNone) return;
+  if (!pfap_warn_at(++s.problems[static_cast<size_t>(problem)])) return;
+  GST_ELEMENT_WARNING(
+      self, STREAM, DECODE,
+      ("Utterance at %" GST_TIME_FORMAT ": %s", GST_TIME_ARGS(at),
+       pfap::align::problem_text(problem)),
+      ("relative warp cost %.2f (poor from %.2f); %" G_GUINT64_FORMAT " so far", cost,
+       pfap::align::kPoorMatchCost, s.problems[static_cast<size_t>(problem)]));
+}
+
+// Aligns `bytes` to samples [from, to) and pushes its phonemes on `pfap`. `is_text`: false
+// for the audio before the first utterance, whose empty text is no problem.
+static GstFlowReturn align_utterance(GstPfapAlign* self, const std::string& bytes, size_t from,
+                                     size_t to, bool is_text) {
+  Stream& s = *self->stream;
+  const GstClockTime at = s.first + gst_util_uint64_scale(from, GST_SECOND, s.rate);
+  std::string text = bytes;
+  if (!g_utf8_validate(text.data(), static_cast<gssize>(text.size()), nullptr)) {
+    GST_ELEMENT_WARNING(
+        self, STREAM, DECODE,
+        ("The text of the utterance at %" GST_TIME_FORMAT " is not UTF-8", GST_TIME_ARGS(at)),
+        ("aligned as an empty text"));
+    text.clear();
+  }
+  std::vector<pfap::tts::BadBookmark> bad;
+  const pfap::tts::Utterance utterance = pfap::tts::parse_utterance(text, bad);
+  for (const pfap::tts::BadBookmark& b : bad) {
+    if (!pfap_warn_at(++s.bad_bookmarks)) continue;
+    GST_ELEMENT_WARNING(
+        self, STREAM, FORMAT,
+        ("Left out a bad bookmark at character %zu of the utterance at %" GST_TIME_FORMAT ": %s",
+         b.character + 1, GST_TIME_ARGS(at), pfap::to_string(b.status)),
+        ("%" G_GUINT64_FORMAT " so far", s.bad_bookmarks));
+  }
+  GST_OBJECT_LOCK(self);
+  pfap::tts::VoiceSettings voice;
+  voice.voice = self->voice;
+  GST_OBJECT_UNLOCK(self);
+
+  pfap::align::Alignment alignment;
+  std::string error;
+  const std::span<const int16_t> audio(s.samples.data() + from, to - from);
+  if (!pfap::align::align(utterance, voice, audio, s.rate, alignment, error)) {
+    GST_ELEMENT_ERROR(self, LIBRARY, FAILED, ("%s", error.c_str()), (nullptr));
+    return GST_FLOW_ERROR;
+  }
+  GST_DEBUG_OBJECT(self, "utterance at %" GST_TIME_FORMAT ": %zu phonemes, %zu samples, cost %.2f",
+                   GST_TIME_ARGS(at), alignment.phonemes.size(), audio.size(),
+                   alignment.relative_cost);
+  if (is_text) warn_problem(self, alignment.problem, at, alignment.relative_cost);
+  // As pfaptts warns: once per mnemonic of a voice whose phonemes x-pfap-arpabet lacks.
+  for (const pfap::tts::Speech::Inexact& i : alignment.inexact) {
+    if (!s.warned_phonemes.insert(i.mnemonic).second) continue;
+    const std::string sent_as(i.sent_as);
+    GST_ELEMENT_WARNING(self, STREAM, FORMAT,
+                        ("espeak-ng phoneme \"%s\" of voice \"%s\" is not in x-pfap-arpabet",
+                         i.mnemonic.c_str(), voice.voice.c_str()),
+                        ("sent as %s", sent_as.c_str()));
+  }
+
+  GstFlowReturn ret = GST_FLOW_OK;
+  for (const pfap::tts::SpokenPhoneme& p : alignment.phonemes) {
+    if (ret != GST_FLOW_OK) break;
+    GstBuffer* buffer = pfap_buffer_new(p.event);
+    if (buffer == nullptr) {
+      // align() keeps every value in range: a bug.
+      GST_ELEMENT_ERROR(self, STREAM, FAILED, (nullptr), ("a phoneme x-pfap cannot hold"));
+      return GST_FLOW_ERROR;
+    }
+    const GstClockTime start = s.first + gst_util_uint64_scale(from + p.start, GST_SECOND, s.rate);
+    const GstClockTime end =
+        s.first + gst_util_uint64_scale(from + p.start + p.n_samples, GST_SECOND, s.rate);
+    GST_BUFFER_PTS(buffer) = start;
+    GST_BUFFER_DURATION(buffer) = end - start;
+    if (s.pfap_discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
+    s.pfap_discont = false;
+    ret = gst_flow_combiner_update_pad_flow(self->flow_combiner, self->pfappad,
+                                            gst_pad_push(self->pfappad, buffer));
+  }
+  return ret;
+}
+
+// Aligns the audio kept so far with its texts and pushes the phonemes, then forgets both. At
+// the end of the stream (`eos`) it first waits for the text pad's EOS, when it is linked.
+static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
+  Stream& s = *self->stream;
+  GST_OBJECT_LOCK(self);
+  const std::string property = self->text != nullptr ? self->text : "";
+  const bool has_property = self->text != nullptr;
+  GST_OBJECT_UNLOCK(self);
+  const bool text_linked = gst_pad_is_linked(self->textpad);
+
+  std::vector<Text> texts;
+  {
+    std::unique_lock<std::mutex> guard(s.lock);
+    if (eos && text_linked) {
+      s.text_changed.wait(guard, [&] { return s.text_eos || s.flushing; });
+    }
+    if (s.flushing) return GST_FLOW_FLUSHING;
+    // No audio yet (the first caps and segment): the texts wait for it.
+    if (s.samples.empty() || s.rate == 0) return GST_FLOW_OK;
+    texts.swap(s.texts);
+  }
+
+  // Utterances as (first sample, text), in order.
+  const size_t n = s.samples.size();
+  std::vector<std::pair<size_t, std::string>> utterances;
+  std::vector<Text> later;  // texts for audio still to come
+  if (!text_linked && has_property) utterances.emplace_back(0, property);
+  for (Text& t : texts) {
+    if (!GST_CLOCK_TIME_IS_VALID(t.running_time)) {
+      if (utterances.empty()) {
+        utterances.emplace_back(0, std::move(t.bytes));
+      } else {
+        utterances.back().second += t.bytes;
+      }
+      continue;
+    }
+    const guint64 position =
+        gst_segment_position_from_running_time(&s.segment, GST_FORMAT_TIME, t.running_time);
+    size_t from = 0;
+    if (GST_CLOCK_TIME_IS_VALID(position) && position > s.first) {
+      from = gst_util_uint64_scale_round(position - s.first, s.rate, GST_SECOND);
+    }
+    if (from >= n && !eos) {
+      later.push_back(std::move(t));
+      continue;
+    }
+    utterances.emplace_back(std::min(from, n), std::move(t.bytes));
+  }
+  if (!later.empty()) {
+    std::lock_guard<std::mutex> guard(s.lock);
+    s.texts.insert(s.texts.begin(), later.begin(), later.end());
+  }
+  std::stable_sort(utterances.begin(), utterances.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  if (utterances.empty()) {
+    GST_ELEMENT_WARNING(self, STREAM, DECODE, ("No text for the audio: it is one pause"),
+                        ("set the text property or link text_sink"));
+  }
+
+  GstFlowReturn ret = GST_FLOW_OK;
+  if (utterances.empty() || utterances.front().first > 0) {
+    ret = align_utterance(self, "", 0, utterances.empty() ? n : utterances.front().first, false);
+  }
+  for (size_t i = 0; i < utterances.size() && ret == GST_FLOW_OK; ++i) {
+    const size_t to = i + 1 < utterances.size() ? utterances[i + 1].first : n;
+    ret = align_utterance(self, utterances[i].second, utterances[i].first, to, true);
+  }
+  s.samples.clear();
+  s.first = GST_CLOCK_TIME_NONE;
+  return ret;
+}
+
+static GstFlowReturn gst_pfap_align_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
+  GstPfapAlign* self = GST_PFAP_ALIGN(parent);
+  Stream& s = *self->stream;
+  if (s.rate == 0) {
+    gst_buffer_unref(buffer);
+    GST_ELEMENT_ERROR(self, CORE, NEGOTIATION, (nullptr), ("audio before caps"));
+    return GST_FLOW_NOT_NEGOTIATED;
+  }
+  if (!GST_CLOCK_TIME_IS_VALID(s.first)) {
+    s.first = GST_BUFFER_PTS_IS_VALID(buffer) ? GST_BUFFER_PTS(buffer) : s.segment.start;
+    // The phonemes come when the audio ends: a gap meanwhile lets sinks after `pfap` preroll
+    // (and the audio sink, which waits for the pipeline, start).
+    gst_pad_push_event(self->pfappad, gst_event_new_gap(s.first, 0));
+  }
+  GstMapInfo map;
+  if (gst_buffer_map(buffer, &map, GST_MAP_READ)) {
+    const size_t count = map.size / sizeof(int16_t);
+    const size_t room =
+        kMaxSeconds * s.rate - std::min<size_t>(s.samples.size(), kMaxSeconds * s.rate);
+    if (count > room && !s.overflow_warned) {
+      s.overflow_warned = true;
+      GST_ELEMENT_WARNING(self, STREAM, TOO_LAZY,
+                          ("More than %" G_GUINT64_FORMAT " s of audio in one stream: the rest "
+                           "is not aligned",
+                           kMaxSeconds),
+                          ("give the text as utterances with PTS on text_sink"));
+    }
+    const auto* in = reinterpret_cast<const uint8_t*>(map.data);
+    for (size_t i = 0; i < std::min(count, room); ++i) {
+      s.samples.push_back(static_cast<int16_t>(GST_READ_UINT16_LE(in + 2 * i)));
+    }
+    gst_buffer_unmap(buffer, &map);
+  }
+  return gst_flow_combiner_update_pad_flow(self->flow_combiner, self->srcpad,
+                                           gst_pad_push(self->srcpad, buffer));
+}
+
+// `pfap`'s stream-start (in the audio's group, sparse) and caps, when the audio's stream starts.
+static void push_pfap_start(GstPfapAlign* self, GstEvent* audio_start) {
+  const gchar* audio_id = nullptr;
+  gst_event_parse_stream_start(audio_start, &audio_id);
+  gchar* id = g_strdup_printf("%s/pfap", audio_id != nullptr ? audio_id : "pfapalign");
+  GstEvent* start = gst_event_new_stream_start(id);
+  g_free(id);
+  guint group = 0;
+  if (gst_event_parse_group_id(audio_start, &group)) gst_event_set_group_id(start, group);
+  gst_pad_push_event(self->pfappad, pfap_make_sparse(start));
+  GstCaps* caps = gst_static_pad_template_get_caps(&pfap_template);
+  gst_pad_push_event(self->pfappad, gst_event_new_caps(caps));
+  gst_caps_unref(caps);
+}
+
+static gboolean gst_pfap_align_sink_event(GstPad* pad, GstObject* parent, GstEvent* event) {
+  GstPfapAlign* self = GST_PFAP_ALIGN(parent);
+  Stream& s = *self->stream;
+  switch (GST_EVENT_TYPE(event)) {
+    case GST_EVENT_STREAM_START:
+      push_pfap_start(self, event);
+      break;
+    case GST_EVENT_CAPS: {
+      GstCaps* caps = nullptr;
+      gst_event_parse_caps(event, &caps);
+      gint rate = 0;
+      gst_structure_get_int(gst_caps_get_structure(caps, 0), "rate", &rate);
+      if (static_cast<unsigned>(rate) != s.rate) {
+        align_kept(self, false);
+        s.rate = static_cast<unsigned>(rate);
+        if (s.rate < pfap::align::kMinRate || s.rate > pfap::align::kMaxRate) {
+          GST_ELEMENT_WARNING(self, STREAM, FORMAT,
+                              ("Audio at %u Hz cannot be aligned: its phonemes are pauses", s.rate),
+                              ("the alignment takes %u to %u Hz: put audioresample before",
+                               pfap::align::kMinRate, pfap::align::kMaxRate));
+        }
+      }
+      break;
+    }
+    case GST_EVENT_SEGMENT: {
+      align_kept(self, false);
+      const GstSegment* segment = nullptr;
+      gst_event_parse_segment(event, &segment);
+      gst_segment_copy_into(segment, &s.segment);
+      gst_pad_push_event(self->pfappad, gst_event_new_segment(segment));
+      break;
+    }
+    case GST_EVENT_GAP:
+      gst_pad_push_event(self->pfappad, gst_event_ref(event));
+      break;
+    case GST_EVENT_EOS:
+      align_kept(self, true);
+      gst_pad_push_event(self->pfappad, gst_event_new_eos());
+      break;
+    case GST_EVENT_FLUSH_START: {
+      {
+        std::lock_guard<std::mutex> guard(s.lock);
+        s.flushing = true;
+      }
+      s.text_changed.notify_all();
+      gst_pad_push_event(self->pfappad, gst_event_ref(event));
+      break;
+    }
+    case GST_EVENT_FLUSH_STOP:
+      reset(self);
+      gst_pad_push_event(self->pfappad, gst_event_ref(event));
+      break;
+    default:
+      break;
+  }
+  return gst_pad_event_default(pad, parent, event);
+}
+
+static GstFlowReturn gst_pfap_align_text_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
+  GstPfapAlign* self = GST_PFAP_ALIGN(parent);
+  Stream& s = *self->stream;
+  Text t{GST_CLOCK_TIME_NONE, {}};
+  GstMapInfo map;
+  if (gst_buffer_map(buffer, &map, GST_MAP_READ)) {
+    t.bytes.assign(reinterpret_cast<const char*>(map.data), map.size);
+    gst_buffer_unmap(buffer, &map);
+  }
+  {
+    std::lock_guard<std::mutex> guard(s.lock);
+    if (GST_BUFFER_PTS_IS_VALID(buffer) && s.text_segment.format == GST_FORMAT_TIME) {
+      t.running_time =
+          gst_segment_to_running_time(&s.text_segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
+    }
+    s.texts.push_back(std::move(t));
+  }
+  gst_buffer_unref(buffer);
+  return GST_FLOW_OK;
+}
+
+// The text pad's events end here: its segment times the utterances, its EOS lets the
+// alignment at the audio's end go on.
+static gboolean gst_pfap_align_text_event(GstPad*, GstObject* parent, GstEvent* event) {
+  GstPfapAlign* self = GST_PFAP_ALIGN(parent);
+  Stream& s = *self->stream;
+  {
+    std::lock_guard<std::mutex> guard(s.lock);
+    switch (GST_EVENT_TYPE(event)) {
+      case GST_EVENT_SEGMENT: {
+        const GstSegment* segment = nullptr;
+        gst_event_parse_segment(event, &segment);
+        gst_segment_copy_into(segment, &s.text_segment);
+        break;
+      }
+      case GST_EVENT_EOS:
+        s.text_eos = true;
+        break;
+      case GST_EVENT_FLUSH_STOP:
+        s.texts.clear();
+        s.text_eos = false;
+        break;
+      default:
+        break;
+    }
+  }
+  if (GST_EVENT_TYPE(event) == GST_EVENT_EOS) s.text_changed.notify_all();
+  gst_event_unref(event);
+  return TRUE;
+}
+
+// `src` and `sink` are a pass-through pair; `text_sink` and `pfap` link to no other pad.
+static GstIterator* gst_pfap_align_internal_links(GstPad* pad, GstObject* parent) {
+  GstPfapAlign* self = GST_PFAP_ALIGN(parent);
+  GstPad* other = pad == self->sinkpad  ? self->srcpad
+                  : pad == self->srcpad ? self->sinkpad
+                                        : nullptr;
+  if (other == nullptr) return nullptr;
+  GValue value = G_VALUE_INIT;
+  g_value_init(&value, GST_TYPE_PAD);
+  g_value_set_object(&value, other);
+  GstIterator* it = gst_iterator_new_single(GST_TYPE_PAD, &value);
+  g_value_unset(&value);
+  return it;
+}
+
+static GstStateChangeReturn gst_pfap_align_change_state(GstElement* element,
+                                                        GstStateChange transition) {
+  GstPfapAlign* self = GST_PFAP_ALIGN(element);
+  Stream& s = *self->stream;
+  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) {
+    reset(self);
+    s.rate = 0;
+    s.problems = {};
+    s.bad_bookmarks = 0;
+    s.warned_phonemes.clear();
+    unsigned rate = 0;
+    std::string error;
+    GST_OBJECT_LOCK(self);
+    pfap::tts::VoiceSettings voice;
+    voice.voice = self->voice;
+    GST_OBJECT_UNLOCK(self);
+    if (!pfap::tts::check_voice(voice, rate, error)) {
+      GST_ELEMENT_ERROR(self, RESOURCE, NOT_FOUND, ("%s", error.c_str()), (nullptr));
+      return GST_STATE_CHANGE_FAILURE;
+    }
+  } else if (transition == GST_STATE_CHANGE_PAUSED_TO_READY) {
+    // An EOS waiting for the text's stops before the pads deactivate.
+    {
+      std::lock_guard<std::mutex> guard(s.lock);
+      s.flushing = true;
+    }
+    s.text_changed.notify_all();
+  }
+  return GST_ELEMENT_CLASS(gst_pfap_align_parent_class)->change_state(element, transition);
+}
+
+static void gst_pfap_align_set_property(GObject* object, guint prop_id, const GValue* value,
+                                        GParamSpec* pspec) {
+  GstPfapAlign* self = GST_PFAP_ALIGN(object);
+  GST_OBJECT_LOCK(self);
+  switch (prop_id) {
+    case PROP_TEXT:
+      g_free(self->text);
+      self->text = g_value_dup_string(value);
+      break;
+    case PROP_VOICE:
+      g_free(self->voice);
+      self->voice = g_value_dup_string(value);
+      if (self->voice == nullptr) self->voice = g_strdup(kDefaultVoice);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
+  GST_OBJECT_UNLOCK(self);
+}
+
+static void gst_pfap_align_get_property(GObject* object, guint prop_id, GValue* value,
+                                        GParamSpec* pspec) {
+  GstPfapAlign* self = GST_PFAP_ALIGN(object);
+  GST_OBJECT_LOCK(self);
+  switch (prop_id) {
+    case PROP_TEXT:
+      g_value_set_string(value, self->text);
+      break;
+    case PROP_VOICE:
+      g_value_set_string(value, self->voice);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
+  GST_OBJECT_UNLOCK(self);
+}
+
+static void gst_pfap_align_finalize(GObject* object) {
+  GstPfapAlign* self = GST_PFAP_ALIGN(object);
+  delete self->stream;
+  gst_flow_combiner_free(self->flow_combiner);
+  g_free(self->text);
+  g_free(self->voice);
+  G_OBJECT_CLASS(gst_pfap_align_parent_class)->finalize(object);
+}
+
+static void gst_pfap_align_class_init(GstPfapAlignClass* klass) {
+  GObjectClass* gobject_class = G_OBJECT_CLASS(klass);
+  GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
+
+  GST_DEBUG_CATEGORY_INIT(pfapalign_debug, "pfapalign", 0, "PFAP forced alignment");
+
+  gobject_class->set_property = gst_pfap_align_set_property;
+  gobject_class->get_property = gst_pfap_align_get_property;
+  gobject_class->finalize = gst_pfap_align_finalize;
+
+  constexpr auto kReady = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                   GST_PARAM_MUTABLE_READY);
+  /**
+   * GstPfapAlign:text:
+   *
+   * The text of the whole stream, with MPEG-4 bookmarks `<FAP ...>`, when `text_sink` is not
+   * linked. Ignored when it is.
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_TEXT,
+      g_param_spec_string("text", "Text",
+                          "What the audio says, with <FAP ...> bookmarks, when text_sink is not "
+                          "linked",
+                          nullptr, kReady));
+  /**
+   * GstPfapAlign:voice:
+   *
+   * The espeak-ng voice that speaks the text to align against: the recording's language
+   * ("en", "en-us", "de", ...). Its phonemes go to x-pfap-arpabet as pfaptts's do.
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_VOICE,
+      g_param_spec_string("voice", "Voice", "espeak-ng voice of the recording's language",
+                          kDefaultVoice, kReady));
+
+  gst_element_class_add_static_pad_template(element_class, &sink_template);
+  gst_element_class_add_static_pad_template(element_class, &text_template);
+  gst_element_class_add_static_pad_template(element_class, &src_template);
+  gst_element_class_add_static_pad_template(element_class, &pfap_template);
+  gst_element_class_set_static_metadata(
+      element_class, "PFAP forced alignment", "Filter/Analyzer/Audio",
+      "Aligns the phonemes of a text to a recording of it: the audio unchanged, and its "
+      "phonemes with bookmarks' facial animation parameters (PFAP) as application/x-pfap",
+      "gst-pfap developers");
+
+  element_class->change_state = gst_pfap_align_change_state;
+}
+
+static void gst_pfap_align_init(GstPfapAlign* self) {
+  self->sinkpad = gst_pad_new_from_static_template(&sink_template, "sink");
+  gst_pad_set_chain_function(self->sinkpad, gst_pfap_align_chain);
+  gst_pad_set_event_function(self->sinkpad, gst_pfap_align_sink_event);
+  self->textpad = gst_pad_new_from_static_template(&text_template, "text_sink");
+  gst_pad_set_chain_function(self->textpad, gst_pfap_align_text_chain);
+  gst_pad_set_event_function(self->textpad, gst_pfap_align_text_event);
+  self->srcpad = gst_pad_new_from_static_template(&src_template, "src");
+  self->pfappad = gst_pad_new_from_static_template(&pfap_template, "pfap");
+  gst_pad_use_fixed_caps(self->pfappad);
+  for (GstPad* pad : {self->sinkpad, self->srcpad}) {
+    GST_PAD_SET_PROXY_CAPS(pad);
+    GST_PAD_SET_PROXY_ALLOCATION(pad);
+    gst_pad_set_iterate_internal_links_function(pad, gst_pfap_align_internal_links);
+  }
+  for (GstPad* pad : {self->sinkpad, self->textpad, self->srcpad, self->pfappad}) {
+    gst_element_add_pad(GST_ELEMENT(self), pad);
+  }
+  self->flow_combiner = gst_flow_combiner_new();
+  gst_flow_combiner_add_pad(self->flow_combiner, self->srcpad);
+  gst_flow_combiner_add_pad(self->flow_combiner, self->pfappad);
+
+  self->text = nullptr;
+  self->voice = g_strdup(kDefaultVoice);
+  self->stream = new Stream{};
+  gst_segment_init(&self->stream->segment, GST_FORMAT_TIME);
+  gst_segment_init(&self->stream->text_segment, GST_FORMAT_TIME);
+}

@@ -1,0 +1,291 @@
+// The forced aligner (align/): features comparable across rates, the warp, and alignment of
+// espeak-ng speech spoken at another rate and pitch, whose phoneme times are known, with the
+// boundary error bounded; and each kind of bad input giving a pause and its problem.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "aligner.h"
+#include "dtw.h"
+#include "features.h"
+
+namespace pfap::align {
+namespace {
+
+std::vector<int16_t> tone(double hz, double seconds, unsigned rate) {
+  std::vector<int16_t> s(static_cast<size_t>(seconds * rate));
+  for (size_t i = 0; i < s.size(); ++i) {
+    s[i] = static_cast<int16_t>(8000 * std::sin(2 * std::numbers::pi * hz * i / rate));
+  }
+  return s;
+}
+
+tts::Utterance utterance(const std::string& text) {
+  std::vector<tts::BadBookmark> bad;
+  tts::Utterance u = tts::parse_utterance(text, bad);
+  EXPECT_TRUE(bad.empty());
+  return u;
+}
+
+tts::Speech say(const std::string& text, const tts::VoiceSettings& voice) {
+  tts::Speech s;
+  std::string error;
+  EXPECT_TRUE(tts::speak(utterance(text), voice, s, error)) << error;
+  return s;
+}
+
+// Linear interpolation: enough for speech whose energy is well under 8 kHz.
+std::vector<int16_t> resample(const std::vector<int16_t>& in, unsigned from, unsigned to) {
+  std::vector<int16_t> out(in.size() * to / from);
+  for (size_t i = 0; i < out.size(); ++i) {
+    const double x = static_cast<double>(i) * from / to;
+    const size_t k = static_cast<size_t>(x);
+    const double t = x - static_cast<double>(k);
+    const double b = k + 1 < in.size() ? in[k + 1] : in[k];
+    out[i] = static_cast<int16_t>(std::lround(in[k] * (1 - t) + b * t));
+  }
+  return out;
+}
+
+Alignment aligned(const std::string& text, const std::vector<int16_t>& audio, unsigned rate) {
+  Alignment a;
+  std::string error;
+  EXPECT_TRUE(align(utterance(text), {}, audio, rate, a, error)) << error;
+  return a;
+}
+
+// The phonemes tile the audio and their durations add up to its length in ms.
+void expect_tiles(const Alignment& a, size_t n_samples, unsigned rate) {
+  ASSERT_FALSE(a.phonemes.empty());
+  size_t next = 0;
+  uint64_t ms = 0;
+  for (const tts::SpokenPhoneme& p : a.phonemes) {
+    EXPECT_EQ(p.start, next);
+    next = p.start + p.n_samples;
+    ms += p.event.phoneme.duration_ms;
+  }
+  EXPECT_EQ(next, n_samples);
+  EXPECT_EQ(ms, (static_cast<uint64_t>(n_samples) * 1000 + rate / 2) / rate);
+}
+
+TEST(Features, SameSoundAtTwoRatesGivesTheSameFrames) {
+  // A tone that steps from 300 to 1200 Hz, at 16 and 48 kHz: same frame count and times.
+  auto at = [](unsigned rate) {
+    std::vector<int16_t> s = tone(300, 0.5, rate);
+    const std::vector<int16_t> b = tone(1200, 0.5, rate);
+    s.insert(s.end(), b.begin(), b.end());
+    return mfcc(s, rate);
+  };
+  const Features lo = at(16000), hi = at(48000);
+  ASSERT_EQ(lo.n_frames, hi.n_frames);
+  EXPECT_EQ(lo.n_frames, 196u);  // 1 s, 25 ms windows every 5 ms
+  double diff = 0, spread = 0;
+  for (size_t k = 0; k < lo.n_frames; ++k) {
+    for (size_t d = 0; d < Features::kDims; ++d) {
+      diff += std::abs(lo.frame(k)[d] - hi.frame(k)[d]);
+      spread += std::abs(lo.frame(k)[d] - lo.frame(lo.n_frames - 1 - k)[d]);
+    }
+  }
+  EXPECT_LT(diff, spread / 10);
+  EXPECT_EQ(lo.frame_at(lo.centre(40)), 40u);
+  EXPECT_EQ(hi.frame_at(hi.centre(40) + hi.hop / 3), 40u);
+}
+
+TEST(Dtw, RecoversAStretch) {
+  // b is a with its second half twice as slow: frames of a's second half map to 2k.
+  const unsigned rate = 16000;
+  std::vector<int16_t> a = tone(300, 0.3, rate), b = a;
+  for (const double hz : {500.0, 900.0, 1500.0, 700.0}) {
+    const std::vector<int16_t> x = tone(hz, 0.1, rate), y = tone(hz, 0.2, rate);
+    a.insert(a.end(), x.begin(), x.end());
+    b.insert(b.end(), y.begin(), y.end());
+  }
+  const Features fa = mfcc(a, rate), fb = mfcc(b, rate);
+  const Warp w = warp(fa, fb);
+  ASSERT_EQ(w.first.size(), fa.n_frames);
+  // The step from 900 to 1500 Hz: 0.5 s into a, 0.7 s into b.
+  const size_t i = fa.frame_at(rate / 2);
+  const double b_sample =
+      (static_cast<double>(fb.centre(w.last[i - 1])) + fb.centre(w.first[i])) / 2;
+  EXPECT_NEAR(b_sample / rate, 0.7, 0.012);
+  for (size_t k = 1; k < fa.n_frames; ++k) {
+    EXPECT_LE(w.first[k - 1], w.last[k - 1]);
+    EXPECT_LE(w.last[k - 1], w.first[k]);
+  }
+  EXPECT_LT(w.relative_cost, 0.5);
+
+  // A narrow band (few cells) still gives a monotonic path end to end.
+  const Warp narrow = warp(fa, fb, fa.n_frames * 40);
+  EXPECT_EQ(narrow.first.front(), 0u);
+  EXPECT_EQ(narrow.last.back(), fb.n_frames - 1);
+}
+
+TEST(Dtw, DigitalSilenceAndExtremesGiveAPathEndToEnd) {
+  // Zeros, full-scale square waves and a tone: every frame finite, the path from (0, 0) to
+  // the end.
+  const unsigned rate = 16000;
+  std::vector<int16_t> a(rate / 2, 0), b = tone(440, 0.3, rate);
+  for (size_t i = 0; i < rate / 4; ++i) a.push_back(i % 40 < 20 ? 32767 : -32768);
+  b.insert(b.end(), rate / 3, 0);
+  const Features fa = mfcc(a, rate), fb = mfcc(b, rate);
+  for (const float x : fa.data) ASSERT_TRUE(std::isfinite(x));
+  for (const float x : fb.data) ASSERT_TRUE(std::isfinite(x));
+  const Warp w = warp(fa, fb);
+  EXPECT_EQ(w.first.front(), 0u);
+  EXPECT_EQ(w.last.back(), fb.n_frames - 1);
+  EXPECT_TRUE(std::isfinite(w.relative_cost));
+}
+
+constexpr const char* kSentences[] = {
+    "The quick brown fox jumps over the lazy dog.",
+    "Please call Stella and ask her to bring these things with her from the store.",
+    "She sells sea shells by the sea shore, and the shells she sells are surely seashells.",
+    "How much wood would a woodchuck chuck if a woodchuck could chuck wood?",
+};
+
+// Boundary errors in ms of aligning each sentence spoken at `voice` (as the recording, at
+// `rate`) with the aligner's default voice.
+std::vector<double> boundary_errors(const tts::VoiceSettings& voice, unsigned rate) {
+  std::vector<double> errors;
+  for (const char* text : kSentences) {
+    SCOPED_TRACE(text);
+    const tts::Speech truth = say(text, voice);
+    const std::vector<int16_t> audio = resample(truth.samples, truth.sample_rate, rate);
+    const Alignment a = aligned(text, audio, rate);
+    EXPECT_EQ(a.problem, Problem::kNone) << a.relative_cost;
+    expect_tiles(a, audio.size(), rate);
+    // Same voice, same phonemes: compare boundary by boundary.
+    EXPECT_EQ(a.phonemes.size(), truth.phonemes.size());
+    if (a.phonemes.size() != truth.phonemes.size()) continue;
+    for (size_t k = 1; k < a.phonemes.size(); ++k) {
+      EXPECT_EQ(a.phonemes[k].event.phoneme.symbol, truth.phonemes[k].event.phoneme.symbol);
+      errors.push_back(std::abs(static_cast<double>(a.phonemes[k].start) / rate -
+                                static_cast<double>(truth.phonemes[k].start) / truth.sample_rate) *
+                       1000);
+    }
+  }
+  std::sort(errors.begin(), errors.end());
+  return errors;
+}
+
+double percentile(const std::vector<double>& sorted, double p) {
+  return sorted.empty() ? 1e9 : sorted[static_cast<size_t>(p * (sorted.size() - 1))];
+}
+
+TEST(Aligner, BoundaryErrorOnSlowerLowerSpeech) {
+  const std::vector<double> e = boundary_errors({"en", 130, 25, 100}, 22050);
+  ASSERT_GT(e.size(), 100u);
+  std::printf("boundaries %zu, median %.1f ms, p90 %.1f ms\n", e.size(), percentile(e, 0.5),
+              percentile(e, 0.9));
+  EXPECT_LT(percentile(e, 0.5), 20);
+  EXPECT_LT(percentile(e, 0.9), 50);
+}
+
+TEST(Aligner, BoundaryErrorAt16kHz) {
+  const std::vector<double> e = boundary_errors({"en", 220, 70, 100}, 16000);
+  ASSERT_GT(e.size(), 100u);
+  std::printf("boundaries %zu, median %.1f ms, p90 %.1f ms\n", e.size(), percentile(e, 0.5),
+              percentile(e, 0.9));
+  EXPECT_LT(percentile(e, 0.5), 20);
+  EXPECT_LT(percentile(e, 0.9), 50);
+}
+
+TEST(Aligner, KeepsWordStartsStressAndBookmarks) {
+  const std::string text = "Hello <FAP 4 1 0 1> world.";
+  const tts::Speech truth = say(text, {"en", 140, 30, 100});
+  const Alignment a = aligned(text, truth.samples, truth.sample_rate);
+  ASSERT_EQ(a.phonemes.size(), truth.phonemes.size());
+  for (size_t k = 0; k < a.phonemes.size(); ++k) {
+    const MarkupEvent& got = a.phonemes[k].event;
+    const MarkupEvent& want = truth.phonemes[k].event;
+    EXPECT_EQ(got.phoneme.word_begin, want.phoneme.word_begin) << k;
+    EXPECT_EQ(got.phoneme.stress, want.phoneme.stress) << k;
+    EXPECT_EQ(got.phoneme.end_of_text, want.phoneme.end_of_text) << k;
+    EXPECT_EQ(got.sentence_start, want.sentence_start) << k;
+    EXPECT_EQ(got.faps, want.faps) << k;
+    // f0 measured on the recording: espeak-ng's at pitch 30 is that of the truth's phoneme.
+    EXPECT_NEAR(got.phoneme.f0, want.phoneme.f0, 5) << k;
+  }
+  // The bookmark is on "world"'s first phoneme.
+  const auto with_faps =
+      std::find_if(a.phonemes.begin(), a.phonemes.end(),
+                   [](const tts::SpokenPhoneme& p) { return !p.event.faps.empty(); });
+  ASSERT_NE(with_faps, a.phonemes.end());
+  EXPECT_TRUE(with_faps->event.phoneme.word_begin);
+  EXPECT_GT(with_faps->start, 0u);
+}
+
+// Bad input: one pause (or an alignment flagged poor), the audio covered, nothing lost.
+TEST(Aligner, SilenceIsOnePauseWithTheBookmarks) {
+  const std::vector<int16_t> silence(16000, 0);
+  const Alignment a = aligned("<FAP 3 1 0 1>Hello world.", silence, 16000);
+  EXPECT_EQ(a.problem, Problem::kNoSpeech);
+  ASSERT_EQ(a.phonemes.size(), 1u);
+  EXPECT_EQ(a.phonemes[0].event.phoneme.symbol, 0);
+  EXPECT_EQ(a.phonemes[0].event.faps.size(), 1u);
+  expect_tiles(a, silence.size(), 16000);
+}
+
+TEST(Aligner, EmptyTextIsOnePause) {
+  const tts::Speech s = say("Hello world.", {});
+  for (const char* text : {"", "   ", "<FAP 3 1 0 1>"}) {
+    SCOPED_TRACE(text);
+    const Alignment a = aligned(text, s.samples, s.sample_rate);
+    EXPECT_EQ(a.problem, Problem::kEmptyText);
+    ASSERT_EQ(a.phonemes.size(), 1u);
+    EXPECT_EQ(a.phonemes[0].event.faps.size(), std::string(text).starts_with("<FAP") ? 1u : 0u);
+    expect_tiles(a, s.samples.size(), s.sample_rate);
+  }
+}
+
+TEST(Aligner, RateOutsideTheFeaturesIsOnePause) {
+  const tts::Speech s = say("Hello world.", {});
+  const std::vector<int16_t> audio = resample(s.samples, s.sample_rate, 8000);
+  const Alignment a = aligned("Hello world.", audio, 8000);
+  EXPECT_EQ(a.problem, Problem::kBadRate);
+  ASSERT_EQ(a.phonemes.size(), 1u);
+  expect_tiles(a, audio.size(), 8000);
+}
+
+TEST(Aligner, NoiseAndAnotherTextMatchPoorly) {
+  const tts::Speech s = say(kSentences[0], {"en", 150, 40, 100});
+  // The right text matches well; another text, or noise, does not, yet still tiles the audio.
+  const Alignment right = aligned(kSentences[0], s.samples, s.sample_rate);
+  EXPECT_EQ(right.problem, Problem::kNone);
+  // A text of three other sentences: what the cost tells apart (a text of one other sentence,
+  // of about the same length, mostly is not: docs/align.md).
+  const Alignment wrong =
+      aligned(std::string(kSentences[1]) + " " + kSentences[2] + " " + kSentences[3], s.samples,
+              s.sample_rate);
+  std::vector<int16_t> noise(s.samples.size());
+  uint32_t x = 12345;
+  for (int16_t& v : noise) {
+    x = x * 1664525 + 1013904223;
+    v = static_cast<int16_t>((x >> 16) % 16000) - 8000;
+  }
+  const Alignment noisy = aligned(kSentences[0], noise, s.sample_rate);
+  std::printf("relative cost: right %.2f, other text %.2f, noise %.2f\n", right.relative_cost,
+              wrong.relative_cost, noisy.relative_cost);
+  EXPECT_EQ(wrong.problem, Problem::kPoorMatch);
+  EXPECT_EQ(noisy.problem, Problem::kPoorMatch);
+  expect_tiles(wrong, s.samples.size(), s.sample_rate);
+  expect_tiles(noisy, noise.size(), s.sample_rate);
+}
+
+TEST(Aligner, ShortAudioAndLongText) {
+  // 50 ms of audio for a sentence: every phoneme squeezed in, none lost, no crash.
+  const tts::Speech s = say("Hi.", {});
+  const std::vector<int16_t> audio(s.samples.begin(), s.samples.begin() + 1102);
+  const Alignment a = aligned(kSentences[1], audio, s.sample_rate);
+  expect_tiles(a, audio.size(), s.sample_rate);
+  const Alignment none = aligned(kSentences[1], {}, s.sample_rate);
+  EXPECT_EQ(none.problem, Problem::kNoSpeech);
+}
+
+}  // namespace
+}  // namespace pfap::align

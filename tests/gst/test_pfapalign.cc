@@ -1,0 +1,357 @@
+// pfapalign: recorded speech and its text in, the audio unchanged and its phonemes on `pfap`.
+// GstHarness on sink/src, one on `pfap` and one on `text_sink` when the text comes as buffers.
+// The "recordings" are espeak-ng's at another rate and pitch, whose phoneme times are known.
+#include <gst/check/gstharness.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "markupbuffer.h"
+#include "pipeline.h"
+#include "speech.h"
+#include "temp_dir.h"
+
+namespace {
+
+constexpr const char* kText = "Please call Stella and ask her to bring these things.";
+
+struct Event {
+  GstClockTime pts;
+  GstClockTime duration;
+  pfap::MarkupEvent event;
+};
+
+struct Result {
+  std::vector<int16_t> audio;
+  std::vector<Event> events;
+  std::vector<std::string> warnings;
+};
+
+std::string caps_at(unsigned rate, int channels = 1) {
+  return "audio/x-raw, format=(string)S16LE, layout=(string)interleaved, channels=(int)" +
+         std::to_string(channels) + ", rate=(int)" + std::to_string(rate);
+}
+
+pfap::tts::Speech say(const std::string& text, int rate = 140, int pitch = 30) {
+  std::vector<pfap::tts::BadBookmark> bad;
+  pfap::tts::Speech s;
+  std::string error;
+  EXPECT_TRUE(
+      pfap::tts::speak(pfap::tts::parse_utterance(text, bad), {"en", rate, pitch, 100}, s, error));
+  return s;
+}
+
+// Runs pfapalign (espeak-ng voice `voice`) over `samples` at `rate` with the `text` property
+// (nullptr: none), or, when `texts` is not empty, with those (PTS, text) buffers on text_sink.
+Result run(const std::vector<int16_t>& samples, unsigned rate, const char* text,
+           const std::vector<std::pair<GstClockTime, std::string>>& texts = {},
+           const char* voice = "en") {
+  GstHarness* h = gst_harness_new_with_padnames("pfapalign", "sink", "src");
+  GstHarness* pfap = gst_harness_new_with_element(h->element, nullptr, "pfap");
+  GstHarness* t =
+      texts.empty() ? nullptr : gst_harness_new_with_element(h->element, "text_sink", nullptr);
+  GstBus* bus = gst_bus_new();
+  gst_element_set_bus(h->element, bus);
+  if (text != nullptr) g_object_set(h->element, "text", text, nullptr);
+  g_object_set(h->element, "voice", voice, nullptr);
+  gst_harness_set_src_caps_str(h, caps_at(rate).c_str());
+  if (t != nullptr) {
+    gst_harness_set_src_caps_str(t, "text/x-raw, format=(string)utf8");
+    for (const auto& [pts, bytes] : texts) {
+      GstBuffer* b = gst_buffer_new_memdup(bytes.data(), bytes.size());
+      GST_BUFFER_PTS(b) = pts;
+      EXPECT_EQ(gst_harness_push(t, b), GST_FLOW_OK);
+    }
+    gst_harness_push_event(t, gst_event_new_eos());
+  }
+  // In buffers of 100 ms, as a decoder gives them.
+  const size_t chunk = rate / 10;
+  for (size_t i = 0; i < samples.size(); i += chunk) {
+    const size_t n = std::min(chunk, samples.size() - i);
+    GstBuffer* b = gst_buffer_new_memdup(samples.data() + i, n * 2);
+    GST_BUFFER_PTS(b) = gst_util_uint64_scale(i, GST_SECOND, rate);
+    GST_BUFFER_DURATION(b) = gst_util_uint64_scale(n, GST_SECOND, rate);
+    EXPECT_EQ(gst_harness_push(h, b), GST_FLOW_OK);
+  }
+  gst_harness_push_event(h, gst_event_new_eos());
+
+  Result r;
+  while (GstBuffer* b = gst_harness_try_pull(h)) {
+    GstMapInfo map;
+    gst_buffer_map(b, &map, GST_MAP_READ);
+    const auto* s = reinterpret_cast<const int16_t*>(map.data);
+    r.audio.insert(r.audio.end(), s, s + map.size / 2);
+    gst_buffer_unmap(b, &map);
+    gst_buffer_unref(b);
+  }
+  while (GstBuffer* b = gst_harness_try_pull(pfap)) {
+    Event e{GST_BUFFER_PTS(b), GST_BUFFER_DURATION(b), {}};
+    EXPECT_TRUE(pfap_buffer_read(b, e.event));
+    r.events.push_back(e);
+    gst_buffer_unref(b);
+  }
+  while (GstMessage* m = gst_bus_pop_filtered(bus, GST_MESSAGE_WARNING)) {
+    GError* error = nullptr;
+    gst_message_parse_warning(m, &error, nullptr);
+    r.warnings.push_back(error->message);
+    g_error_free(error);
+    gst_message_unref(m);
+  }
+  gst_bus_set_flushing(bus, TRUE);
+  if (t != nullptr) gst_harness_teardown(t);
+  gst_harness_teardown(pfap);
+  gst_harness_teardown(h);
+  gst_object_unref(bus);
+  return r;
+}
+
+// The events tile [0, end): each starts where the one before ended.
+void expect_tiles(const Result& r, GstClockTime end) {
+  ASSERT_FALSE(r.events.empty());
+  GstClockTime next = 0;
+  for (const Event& e : r.events) {
+    EXPECT_EQ(e.pts, next);
+    next = e.pts + e.duration;
+  }
+  EXPECT_EQ(next, end);
+}
+
+bool has_warning(const Result& r, const std::string& part) {
+  for (const std::string& w : r.warnings) {
+    if (w.find(part) != std::string::npos) return true;
+  }
+  return false;
+}
+
+TEST(PfapAlign, PhonemesOnTheRecordingsTimelineAndTheAudioUnchanged) {
+  const pfap::tts::Speech truth = say(kText);
+  const Result r = run(truth.samples, truth.sample_rate, kText);
+  EXPECT_EQ(r.audio, truth.samples);
+  EXPECT_TRUE(r.warnings.empty()) << r.warnings.front();
+  ASSERT_EQ(r.events.size(), truth.phonemes.size());
+  expect_tiles(r, gst_util_uint64_scale(truth.samples.size(), GST_SECOND, truth.sample_rate));
+  std::vector<double> errors;
+  for (size_t k = 0; k < r.events.size(); ++k) {
+    EXPECT_EQ(r.events[k].event.phoneme.symbol, truth.phonemes[k].event.phoneme.symbol);
+    EXPECT_EQ(r.events[k].event.phoneme.word_begin, truth.phonemes[k].event.phoneme.word_begin);
+    const double want = static_cast<double>(truth.phonemes[k].start) / truth.sample_rate;
+    errors.push_back(std::abs(static_cast<double>(r.events[k].pts) / GST_SECOND - want));
+  }
+  std::sort(errors.begin(), errors.end());
+  EXPECT_LT(errors[errors.size() / 2], 0.020);
+  EXPECT_LT(errors[errors.size() * 9 / 10], 0.050);
+}
+
+TEST(PfapAlign, UtterancesOnTheTextPadStartAtTheirPts) {
+  const pfap::tts::Speech a = say("Good morning.");
+  const pfap::tts::Speech b = say("See you tomorrow.");
+  std::vector<int16_t> audio = a.samples;
+  audio.resize(audio.size() + a.sample_rate / 2, 0);  // half a second of silence
+  const size_t b_start = audio.size();
+  audio.insert(audio.end(), b.samples.begin(), b.samples.end());
+  const GstClockTime b_time = gst_util_uint64_scale(b_start, GST_SECOND, a.sample_rate);
+  const Result r =
+      run(audio, a.sample_rate, nullptr, {{0, "Good morning."}, {b_time, "See you tomorrow."}});
+  EXPECT_TRUE(r.warnings.empty()) << r.warnings.front();
+  expect_tiles(r, gst_util_uint64_scale(audio.size(), GST_SECOND, a.sample_rate));
+  EXPECT_EQ(r.events.size(), a.phonemes.size() + b.phonemes.size());
+  // The second utterance's first phoneme (a pause, then "S") starts at its PTS.
+  const auto second = std::find_if(r.events.begin(), r.events.end(),
+                                   [&](const Event& e) { return e.pts >= b_time; });
+  ASSERT_NE(second, r.events.end());
+  EXPECT_EQ(second->pts, b_time);
+  EXPECT_TRUE(second->event.sentence_start);
+}
+
+TEST(PfapAlign, SilenceWarnsAndIsOnePause) {
+  const std::vector<int16_t> silence(16000, 0);
+  const Result r = run(silence, 16000, "<FAP 3 1 0 1>Hello.");
+  EXPECT_TRUE(has_warning(r, "silent"));
+  ASSERT_EQ(r.events.size(), 1u);
+  EXPECT_EQ(r.events[0].event.phoneme.symbol, 0);
+  EXPECT_EQ(r.events[0].event.faps.size(), 1u);  // the bookmark is not lost
+  expect_tiles(r, GST_SECOND);
+  EXPECT_EQ(r.audio, silence);
+}
+
+TEST(PfapAlign, NoiseAndAnotherTextWarnOfAPoorMatch) {
+  const pfap::tts::Speech s = say(kText);
+  const Result wrong =
+      run(s.samples, s.sample_rate,
+          "How much wood would a woodchuck chuck if a woodchuck could chuck wood? "
+          "She sells sea shells by the sea shore. The quick brown fox jumps over the lazy "
+          "dog. Peter Piper picked a peck of pickled peppers.");
+  EXPECT_TRUE(has_warning(wrong, "poorly"));
+  expect_tiles(wrong, gst_util_uint64_scale(s.samples.size(), GST_SECOND, s.sample_rate));
+  std::vector<int16_t> noise(s.samples.size());
+  uint32_t x = 1;
+  for (int16_t& v : noise) {
+    x = x * 1664525 + 1013904223;
+    v = static_cast<int16_t>(static_cast<int>((x >> 16) % 16000) - 8000);
+  }
+  const Result noisy = run(noise, s.sample_rate, kText);
+  EXPECT_TRUE(has_warning(noisy, "poorly"));
+  expect_tiles(noisy, gst_util_uint64_scale(noise.size(), GST_SECOND, s.sample_rate));
+}
+
+TEST(PfapAlign, EmptyOrMissingTextWarnsAndIsOnePause) {
+  const pfap::tts::Speech s = say(kText);
+  const GstClockTime end = gst_util_uint64_scale(s.samples.size(), GST_SECOND, s.sample_rate);
+  const Result empty = run(s.samples, s.sample_rate, "");
+  EXPECT_TRUE(has_warning(empty, "nothing to speak"));
+  ASSERT_EQ(empty.events.size(), 1u);
+  expect_tiles(empty, end);
+  const Result none = run(s.samples, s.sample_rate, nullptr);
+  EXPECT_TRUE(has_warning(none, "No text"));
+  ASSERT_EQ(none.events.size(), 1u);
+  expect_tiles(none, end);
+  EXPECT_EQ(none.audio, s.samples);
+}
+
+TEST(PfapAlign, UnsupportedRateWarnsAndPassesTheAudio) {
+  const std::vector<int16_t> audio(8000, 100);
+  const Result r = run(audio, 8000, kText);
+  EXPECT_TRUE(has_warning(r, "8000 Hz cannot be aligned"));
+  EXPECT_EQ(r.audio, audio);
+  ASSERT_EQ(r.events.size(), 1u);
+  expect_tiles(r, GST_SECOND);
+}
+
+TEST(PfapAlign, PhonemesOutsideTheAlphabetWarnOncePerMnemonic) {
+  // German through voice "de": "ich" has a phoneme x-pfap-arpabet lacks (espeak-ng's "C").
+  const pfap::tts::Speech s = say(kText);
+  const Result r = run(s.samples, s.sample_rate, "Ich spreche, ich lache.", {}, "de");
+  size_t outside = 0;
+  for (const std::string& w : r.warnings) {
+    if (w.find("is not in x-pfap-arpabet") != std::string::npos) ++outside;
+  }
+  EXPECT_GT(outside, 0u);
+  const std::set<std::string> distinct(r.warnings.begin(), r.warnings.end());
+  EXPECT_EQ(distinct.size(), r.warnings.size());  // once per mnemonic
+  expect_tiles(r, gst_util_uint64_scale(s.samples.size(), GST_SECOND, s.sample_rate));
+}
+
+TEST(PfapAlign, StereoIsRefusedAtNegotiation) {
+  GstHarness* h = gst_harness_new_with_padnames("pfapalign", "sink", "src");
+  gst_harness_set_src_caps_str(h, caps_at(16000, 2).c_str());
+  EXPECT_EQ(gst_harness_push(h, gst_buffer_new_allocate(nullptr, 400, nullptr)),
+            GST_FLOW_NOT_NEGOTIATED);
+  gst_harness_teardown(h);
+}
+
+TEST(PfapAlign, WaitForTheTextsEosEndsWithTheStream) {
+  // text_sink linked, its EOS never comes: the audio's EOS waits for it, and stopping the
+  // element ends the wait instead of hanging.
+  GstHarness* h = gst_harness_new_with_padnames("pfapalign", "sink", "src");
+  GstHarness* t = gst_harness_new_with_element(h->element, "text_sink", nullptr);
+  gst_harness_set_src_caps_str(h, caps_at(16000).c_str());
+  gst_harness_set_src_caps_str(t, "text/x-raw, format=(string)utf8");
+  const std::vector<int16_t> audio(1600, 1000);
+  ASSERT_EQ(gst_harness_push(h, gst_buffer_new_memdup(audio.data(), audio.size() * 2)),
+            GST_FLOW_OK);
+  std::atomic<bool> returned = false;
+  std::thread eos([&] {
+    gst_harness_push_event(h, gst_event_new_eos());
+    returned = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EXPECT_FALSE(returned);
+  gst_element_set_state(h->element, GST_STATE_READY);
+  eos.join();
+  EXPECT_TRUE(returned);
+  gst_harness_teardown(t);
+  gst_harness_teardown(h);
+}
+
+// The launch lines of docs/elements.md's pfapalign section, each run on a WAV pfaptts makes.
+std::vector<std::string> documented_commands() {
+  std::ifstream in(PFAP_SOURCE_DIR "/docs/elements.md");
+  std::stringstream all;
+  all << in.rdbuf();
+  const std::string doc = all.str();
+  const size_t from = doc.find("## pfapalign");
+  const size_t to = doc.find("\n## ", from + 1);
+  std::istringstream section(doc.substr(from, to - from));
+  std::vector<std::string> out;
+  for (std::string line; std::getline(section, line);) {
+    if (line.starts_with("gst-launch-1.0 ")) out.push_back(line);
+  }
+  return out;
+}
+
+std::string replace_all(std::string s, const std::string& from, const std::string& to) {
+  for (size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size())) {
+    s.replace(at, from.size(), to);
+  }
+  return s;
+}
+
+std::string run_line(const std::string& line, const pfap::testing::TempDir& dir) {
+  std::string d = line.substr(std::string("gst-launch-1.0 ").size());
+  if (d.starts_with("-e ")) d = d.substr(3);
+  for (const char* f : {"speech.wav", "speech.txt", "speech.pfap", "face.webm"}) {
+    d = replace_all(d, std::string("location=") + f, "location=" + dir.file(f));
+  }
+  pfap::testing::Pipeline p(d);
+  if (!p.ok()) return p.error();
+  std::string e = p.set_state(GST_STATE_PLAYING);
+  if (e.empty()) e = p.wait_eos(std::chrono::seconds(60));
+  return e;
+}
+
+size_t file_size(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  return in ? static_cast<size_t>(in.tellg()) : 0;
+}
+
+TEST(PfapAlignDocumented, EveryCommandRuns) {
+  const std::vector<std::string> commands = documented_commands();
+  ASSERT_EQ(commands.size(), 3u);
+  const pfap::testing::TempDir dir;
+  const std::string text =
+      "Please call Stella. Ask her to bring these things with her from the store.";
+  {
+    // The "recording": pfaptts at another rate and pitch than pfapalign's voice.
+    pfap::testing::Pipeline make("pfaptts rate=140 pitch=30 text=\"" + text +
+                                 "\" name=t t.audio ! queue ! wavenc ! filesink location=" +
+                                 dir.file("speech.wav") + " t.pfap ! queue ! fakesink");
+    ASSERT_TRUE(make.ok()) << make.error();
+    ASSERT_EQ(make.set_state(GST_STATE_PLAYING), "");
+    ASSERT_EQ(make.wait_eos(std::chrono::seconds(30)), "");
+    std::ofstream(dir.file("speech.txt")) << text;
+  }
+  auto read = [&](const char* name) {
+    std::ifstream in(dir.file(name));
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  };
+  ASSERT_EQ(run_line(commands[0], dir), "") << commands[0];
+  const std::string from_property = read("speech.pfap");
+  EXPECT_GT(std::count(from_property.begin(), from_property.end(), '\n'), 40);
+  ASSERT_EQ(run_line(commands[1], dir), "") << commands[1];
+  // The text from a file: the same phonemes (espeak-ng's synthesis differs by a few samples
+  // from one call to the next, and the times by a few ms).
+  auto symbols = [](const std::string& pfap_text) {
+    std::vector<std::string> out;
+    std::istringstream lines(pfap_text);
+    for (std::string start, symbol, rest; lines >> start >> symbol && std::getline(lines, rest);) {
+      out.push_back(symbol);
+    }
+    return out;
+  };
+  EXPECT_EQ(symbols(read("speech.pfap")), symbols(from_property));
+  ASSERT_EQ(run_line(commands[2], dir), "") << commands[2];
+  EXPECT_GT(file_size(dir.file("face.webm")), 20000u);
+}
+
+}  // namespace
