@@ -32,8 +32,8 @@
 //   gst-launch-1.0 rtspsrc location=rtsp://127.0.0.1:8554/pfap name=src
 //     src. ! rtppfapdepay ! pfaptextenc ! fdsink  src. ! rtpL16depay ! fakesink
 //
-// The plugin comes from GST_PLUGIN_PATH; run from the build tree, that defaults to the
-// build's gst/ directory.
+// The plugins are found where GStreamer looks: installed, or in GST_PLUGIN_PATH (from a build
+// tree GST_PLUGIN_PATH=build/gst:build/ext, as scripts/demo and `meson devenv` set it).
 #include <glib-unix.h>
 #include <gst/gst.h>
 #include <gst/rtsp-server/rtsp-server.h>
@@ -43,6 +43,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <initializer_list>
 #include <memory>
 
@@ -162,12 +163,16 @@ void on_media_configure(GstRTSPMediaFactory*, GstRTSPMedia* media, gpointer file
 }  // namespace
 
 int main(int argc, char** argv) {
-#ifdef PFAP_PLUGIN_DIR
-  // Run from the build tree: find the plugin there unless told otherwise.
-  g_setenv("GST_PLUGIN_PATH", PFAP_PLUGIN_DIR, FALSE);
-#endif
   gst_init(&argc, &argv);
 
+  if (argc == 2 && (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0)) {
+    std::printf(
+        "usage: pfap-rtsp-server FILE.pfap [PORT]   (PORT 0: any free port)\n"
+        "Serves audio and the PFAP stream of FILE.pfap at rtsp://127.0.0.1:PORT/pfap, prints\n"
+        "that URL, and serves until SIGINT or SIGTERM. The pfap plugin must be installed or\n"
+        "in GST_PLUGIN_PATH.\n");
+    return 0;
+  }
   char* end = nullptr;
   const long port = argc == 3 ? std::strtol(argv[2], &end, 10) : 0;
   if (argc < 2 || argc > 3 || (argc == 3 && (*end != '\0' || port < 0 || port > 65535))) {

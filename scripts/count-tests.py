@@ -1,14 +1,16 @@
 """Counts the test cases behind meson test logs: GoogleTest cases from each gtest program's
 result lines, pytest's from its summary line, node's test runner's from its closing '# pass N'
-and '# fail N' (web/), one case for any other test. With one log, prints 'tests: N passed,
-M failed'; with several (one per build), a line for each and then that line for them all."""
+and '# fail N' (web/), one case for any other test (scripts/check-install and
+scripts/check-packages write their checks in the same format). With one log, prints 'tests: N
+passed, M failed' (and ', K skipped' when a test was skipped); with several (one per build or
+step), a line for each and then that line for them all."""
 import json
 import re
 import sys
 
 
 def count(path):
-    passed = failed = 0
+    passed = failed = skipped = 0
     with open(path) as log:
         for line in log:
             test = json.loads(line)
@@ -32,15 +34,21 @@ def count(path):
                     failed += 1  # crashed or timed out after its last finished case
             elif test["result"] in ("OK", "EXPECTEDFAIL"):
                 passed += 1
-            elif test["result"] != "SKIP":
+            elif test["result"] == "SKIP":
+                skipped += 1
+            else:
                 failed += 1
-    return passed, failed
+    return passed, failed, skipped
 
 
-total_passed = total_failed = 0
+def line(passed, failed, skipped):
+    return f"{passed} passed, {failed} failed" + (f", {skipped} skipped" if skipped else "")
+
+
+total = [0, 0, 0]
 for path in sys.argv[1:]:
-    passed, failed = count(path)
+    counts = count(path)
     if len(sys.argv) > 2:
-        print(f"{path}: {passed} passed, {failed} failed")
-    total_passed, total_failed = total_passed + passed, total_failed + failed
-print(f"tests: {total_passed} passed, {total_failed} failed")
+        print(f"{path}: {line(*counts)}")
+    total = [t + c for t, c in zip(total, counts)]
+print(f"tests: {line(*total)}")

@@ -74,9 +74,21 @@ void print(const pfap::Packet& packet) {
 
 }  // namespace
 
+void usage(std::FILE* out) {
+  std::fprintf(out,
+               "usage: pfap-dump FILE|-\n"
+               "Decodes PFAP payloads, one per line in hex ('#' starts a comment), from FILE or\n"
+               "standard input, and prints every descriptor. Exit status: 0 when every payload\n"
+               "decoded, 1 when some did not, 2 on a usage or input error.\n");
+}
+
 int main(int argc, char** argv) {
+  if (argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
+    usage(stdout);
+    return 0;
+  }
   if (argc != 2) {
-    std::fprintf(stderr, "usage: %s FILE|-\n", argv[0]);
+    usage(stderr);
     return 2;
   }
   const std::string path = argv[1];

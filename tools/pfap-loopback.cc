@@ -31,8 +31,8 @@
 // no progress for --timeout seconds, ends it with status 1 and a message saying what
 // happened; a usage error is status 2.
 //
-// The plugin comes from GST_PLUGIN_PATH; run from the build tree, that defaults to the
-// build's gst/ directory.
+// The plugins are found where GStreamer looks: installed, or in GST_PLUGIN_PATH (from a build
+// tree GST_PLUGIN_PATH=build/gst:build/ext, as scripts/demo and `meson devenv` set it).
 #include <gst/gst.h>
 
 #include <atomic>
@@ -272,10 +272,6 @@ std::string depay_summary(GstElement* receiver) {
 }  // namespace
 
 int main(int argc, char** argv) {
-#ifdef PFAP_PLUGIN_DIR
-  // Run from the build tree: find the plugin there unless told otherwise.
-  g_setenv("GST_PLUGIN_PATH", PFAP_PLUGIN_DIR, FALSE);
-#endif
   gst_init(&argc, &argv);
 
   Options options;

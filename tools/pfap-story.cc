@@ -307,9 +307,6 @@ GstElement* parse(const std::string& description, const char* what) {
 }  // namespace
 
 int main(int argc, char** argv) {
-#ifdef PFAP_PLUGIN_DIR
-  g_setenv("GST_PLUGIN_PATH", PFAP_PLUGIN_DIR, FALSE);
-#endif
   gst_init(&argc, &argv);
   Options options;
   if (const int status = parse_options(argc, argv, options); status != 0) {
