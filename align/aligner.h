@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Forced alignment of a text to a recording of it: the text is spoken by espeak-ng (tts/,
 // with its phonemes' times, stress, word starts and bookmarks), both are turned into MFCC
 // frames, dynamic time warping matches the frames, and each synthetic phoneme boundary is

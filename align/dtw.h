@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Dynamic time warping of two feature sequences: which frames of one match which of the other.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Spectral features for aligning two recordings of the same words: MFCCs computed with aubio
 // on windows of the same duration and over the same band whatever the sample rate, so that
 // speech at 16 kHz and at 22.05 kHz give comparable frames.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // pfap-rtsp-server: an RTSP server that streams a talking head's data, audio plus the PFAP
 // phonemes and FAPs of a .pfap file, as one RTSP presentation (gst-rtsp-server).
 //

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Counts the test cases behind meson test logs: GoogleTest cases from each gtest program's
 result lines, pytest's from its summary line, node's test runner's from its closing '# pass N'
 and '# fail N' (web/), one case for any other test (scripts/check-install and

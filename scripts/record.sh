@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Sourced by scripts/check-install and scripts/check-packages: `record LOG NAME RESULT FILE`
 # appends one check to LOG as a line of meson's testlog.json (name, result OK/FAIL/SKIP, and
 # FILE's text as its output), so that scripts/count-tests.py counts it with the meson tests,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Measures pfapalign's alignment (align/) against phoneme times known from another
 // synthesizer: for each `name` in a corpus directory, name.wav (16-bit mono PCM), name.txt
 // (its text) and name.segs (Festival's segment file: "end_time 100 phone" lines after "#").

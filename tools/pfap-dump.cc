@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // pfap-dump: decodes PFAP payloads and prints what they carry, one line per descriptor.
 //
 // Input (a file, or standard input with "-"): one payload per line in hex, white space

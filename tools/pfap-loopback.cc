@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // pfap-loopback: sends a .pfap text file as PFAP RTP packets over loopback UDP and prints, as
 // .pfap text, what arrives. Sender and receiver run in this one process:
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // pfap-story: the whole story on one machine (scripts/demo). A text is spoken by pfaptts, its
 // audio and PFAP streams go out as two RTP sessions of one rtpbin, the PFAP packets lose some
 // of their number on the way (netsim), and the receiver's rtpbin gives the audio and the

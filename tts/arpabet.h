@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // espeak-ng's phoneme mnemonics (its -x transcription and phoneme events) for English voices,
 // as the x-pfap-arpabet symbols of pfap/phoneme_table.h. docs/tts.md has the table and why.
 #pragma once

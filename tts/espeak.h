@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // espeak-ng 1.51 as a function: text in, audio and its events out. espeak-ng is one
 // process-wide synthesizer that is not reentrant (its voice, parameters and callback are
 // global), so every call runs under one mutex, synchronously, and sets all of them.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Each phoneme's f0, measured from the synthesized audio with aubio's YIN.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // An utterance in pieces of about a sentence, spoken one after the other, so that a long text
 // starts speaking after its first sentence and the speech held at a time is one piece's,
 // whatever the length of the text.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The MPEG-4 bookmark rule (draft section 3, ISO/IEC 14496-3 TtsFAPInterface): "the start
 // time of a FAP in a bookmark is the start time of the first phoneme of the first word
 // following the bookmark of the current sentence. If there is no word after the bookmark in

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // An utterance spoken: the audio and its phonemes as x-pfap events (x-pfap-arpabet symbols),
 // each with the FAPs of the bookmarks that start with it. The whole of tts/ put together.
 #pragma once

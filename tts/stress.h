@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Stress from espeak-ng's stressed transcription (espeak_TextToPhonemes, as `espeak-ng -x`
 // prints it: "h@l'oU w'3:ld"), whose marks the phoneme events do not carry.
 #pragma once

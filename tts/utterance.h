@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // An utterance as pfaptts receives it: plain text with MPEG-4 bookmarks `<FAP ...>` inline
 // (pfap/bookmark.h), split into the text espeak-ng speaks and the bookmarks with the
 // character positions where they stood.

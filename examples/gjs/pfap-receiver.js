@@ -1,4 +1,5 @@
 #!/usr/bin/gjs
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Prints the phonemes of a PFAP RTP stream received on UDP, in JavaScript (gjs): the same
 // GstPfap-1.0 API as examples/python/pfap-receiver.py, through GObject-Introspection.
 //

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """A mouth in the terminal, moved by the FAPs of a PFAP stream.
 
 Events from appsink go into a GstPfap.FapState at their time; a timer asks it the jaw and lip

@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Prints the phonemes and FAPs of a PFAP RTP stream received on UDP.
 
     udpsrc ! rtpjitterbuffer ! rtppfapdepay ! appsink

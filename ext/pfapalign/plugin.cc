@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The pfapalign plugin: PFAP from recorded speech and its text, by forced alignment against
 // espeak-ng's speech of the text (aubio MFCCs, dynamic time warping).
 #include <gst/gst.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The pfapface plugin: a talking head drawn with cairo from a PFAP stream.
 #include <gst/gst.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The pfaptts plugin: text to speech with PFAP markup, through espeak-ng and aubio.
 #include <gst/gst.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The example pipelines stay on one line, to be copied.
 // clang-format off
 /**

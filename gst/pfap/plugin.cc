@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The pfap plugin: RTP payloading of PFAP streams (draft-ietf-avt-rtp-pfap-00) and their text
 // markup. Needs only GStreamer core, base and rtp.
 #include <gst/gst.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // MPEG-4 bookmarks (draft section 5) and their transformed form (section 6.3).
 //
 // A bookmark is checked in three steps, so that every error has one position:

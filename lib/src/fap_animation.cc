@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // MPEG-4 FAP files as PFAP events and back (docs/fap-files.md).
 #include "pfap/fap_animation.h"
 

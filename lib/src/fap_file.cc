@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // MPEG-4 FAP files (docs/fap-files.md).
 //
 // Line by line: the header, then for each frame a mask line and a value line. Each line is

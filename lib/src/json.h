@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A small JSON reader and string writer for the speech-mark formats (pfap/speech_marks.h).
 // Internal to libpfap, not installed. Strict RFC 8259, with hard limits on depth and size.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // application/x-pfap events: the byte layout of pfap/markup.h, read and written for the C API
 // and for pfap::MarkupEvent alike.
 #include "pfap/markup.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Decimal integers as the text formats write them (bookmark fields, .pfap line fields).
 // Internal to libpfap, not installed.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // PFAP payload, draft-ietf-avt-rtp-pfap-00 section 6. Figure 1 is lost from the draft; the
 // order below is the one its text gives (docs/format.md, "Payload layout").
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The .pfap text format (docs/text-format.md).
 //
 // A line is read field by field, left to right, into a local event; the first bad field is

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The forced aligner (align/): features comparable across rates, the warp, and alignment of
 // espeak-ng speech spoken at another rate and pitch, whose phoneme times are known, with the
 // boundary error bounded; and each kind of bad input giving a pause and its problem.

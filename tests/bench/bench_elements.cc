@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Pipeline throughput of the PFAP elements beside GStreamer's own RTP payloaders for opaque
 // data and for metadata:
 //

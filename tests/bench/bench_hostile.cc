@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // What a hostile sender can make a receiver pay (issue 6; docs/security.md, "Bounded cost"
 // and "Memory per depayloader").
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The library's costs: encode and decode+validate beside memcpy of the same bytes (the
 // ceiling), FAP-state evaluation and bookmarks applied as a receiver does them, the sender's
 // recovery work per packet, and how the cost of a packet grows with its size.

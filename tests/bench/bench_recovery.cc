@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Loss recovery measured: what each protection of a PFAP stream costs in bytes, and how many
 // received phonemes still see a wrong FAP state, on one seeded session and the same seeded
 // loss patterns, side by side.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Many listeners, one server: what each concurrent PFAP stream costs a process that runs N of
 // them, in CPU time per second of stream and in memory, for N = 1, 100 and 1000.
 //

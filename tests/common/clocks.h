@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // CPU and wall-clock time in seconds, and the median of repeated runs, for benchmarks that
 // print what they measure.
 #pragma once

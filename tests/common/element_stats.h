@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // An element's `stats` property (rtppfappay, rtppfapdepay, rtpjitterbuffer, ...) read by tests
 // and benchmarks.
 #pragma once

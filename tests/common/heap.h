@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // What a process holds in memory now, for benchmarks and tests that show memory does not
 // grow: the heap in use (malloc's own count; under AddressSanitizer, its allocator's) and the
 // resident set size.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Seeded random PFAP markup for round-trip and property tests.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // For tests that draw text with cairo: its toy-font cache and fontconfig's configuration live
 // as long as the process. Including this header releases both when the tests end, so that
 // LeakSanitizer reports only real leaks.

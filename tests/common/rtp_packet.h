@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The one RTP packet builder of the tests, benchmarks and fuzz harnesses: a payload and the
 // header fields in, an RTP GstBuffer out.
 #pragma once

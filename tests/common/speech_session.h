@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A seeded session as a TTS engine gives it, for recovery tests and benchmarks: sentences of
 // 6..14 contiguous phonemes of 40..100 ms with pauses of 100..300 ms between them (about 11
 // phonemes per second of stream time). Before a phoneme, with probability `fap_chance`, 1..3

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A temporary directory for a test's files, removed with the files in it (not subdirectories)
 // when the test ends.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The face over time: FAP state, mouth shapes from phonemes, state events, expressions.
 #include <gtest/gtest.h>
 

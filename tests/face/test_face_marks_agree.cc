@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // libpfap's blendshapes (pfap/blendshapes.h) agree with what pfapface draws: a viseme's mouth
 // is the one pfapface's animator gives it, and each expression's blendshape combination moves
 // the features pfapface's own FAP displacements for it move.

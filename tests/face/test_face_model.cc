@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The face's geometry: each FAP group moves its feature the right way, by its FAP units.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Drawing: a face on a background, the styles differ, the alpha format stays opaque, the
 // overlay writes text. Pictures themselves are compared in tests/gst/test_pfapface.cc.
 #include <cairo.h>

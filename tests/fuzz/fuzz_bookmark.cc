@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // pfap::parse_bookmark and pfap::parse_bookmarks on arbitrary text. On success every FAP is
 // valid, and the FAPs formatted (format_bookmarks) parse back to the same FAPs; on error
 // nothing is appended, the position is unchanged and the error points inside the text.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // What the fuzz harnesses share: FUZZ_CHECK, which aborts with a message when a property the
 // harness checks does not hold, so that libFuzzer saves the input and the corpus replay fails.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // rtppfapdepay in a GstHarness, fed RTP packets cut from the input. Each packet is
 //   2 bytes   n, big endian: the length of what follows (cut to what the input has left)
 //   1 byte    control: bit 0 the marker; bit 1 the second SSRC; bits 2-3 what comes before

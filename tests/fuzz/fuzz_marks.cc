@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // pfap::MarksReader on arbitrary text: the first byte picks the format (Polly, Rhubarb lines,
 // Rhubarb JSON document, Azure), the rest is read as pfapmarksparse reads it. Every event must
 // be a valid phoneme of the format's alphabet at a time that never goes back, an error must

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // pfap::decode_payload on arbitrary bytes. A payload that decodes must hold only valid values
 // and encode back to the same bytes, but for the two canonical forms docs/format.md gives:
 // negative zero (s = 1, amplitude 0) is written with s = 0, and PP, ignored when C = 1, as 000.

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Writes the seed corpora of the fuzz harnesses, corpus/<harness>/, from the test vectors
 (tests/lib/test_payload.cc), samples/hello.pfap-hex and docs/examples/*.pfap. Run from
 anywhere; it replaces the directories' contents. The files are committed: rerun it when the

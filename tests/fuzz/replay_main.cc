@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // main() for a fuzz harness built without libFuzzer: runs every file in the directories (or
 // the files) named on the command line through LLVMFuzzerTestOneInput once, so the normal and
 // sanitizer builds check the seed corpus and the saved regressions. A harness check that

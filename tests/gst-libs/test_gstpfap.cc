@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // libgstpfap's C API (gst/pfap/pfap.h), as an application calls it: events from and to
 // buffers, refusals as GErrors (never a CRITICAL: main() makes criticals and warnings fatal),
 // alphabets, bookmarks, and the FAP state against libpfap's own.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The one harness-plus-bus fixture of the element tests: an element in a GstHarness with a bus
 // of its own, since the harness alone drops the element's messages (warnings, errors).
 #pragma once

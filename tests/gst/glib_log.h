@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Counts the GLib criticals and warnings logged while it lives (GStreamer's
 // g_return_if_fail checks, GObject's property checks), instead of printing them, so that a test
 // can assert that bad input got an element's own message and no CRITICAL.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // main() for element tests: GoogleTest with GStreamer initialised once; the plugin is found
 // through GST_PLUGIN_PATH, which meson sets to the build's gst/ directory.
 #include <gst/gst.h>

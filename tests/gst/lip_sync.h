@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Lip sync of audio and PFAP through a sending and a receiving rtpbin: what the sender sent and
 // when, what the receiver output and when, and the comparison of the two streams' offsets
 // (receiver minus sender running time). Used by LoopbackUdp.PhonemesKeepLipSyncWithAudio

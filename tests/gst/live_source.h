@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A live phoneme source for pipeline tests: phonemes pushed into an appsrc at their time.
 #pragma once
 

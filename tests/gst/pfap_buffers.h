@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // application/x-pfap buffers for element tests: make them from the library's types and read
 // them back, through the public C API in pfap/markup.h.
 #pragma once

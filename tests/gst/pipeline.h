@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A pipeline from a gst-launch description for element tests: made, driven and released in
 // one place. Methods that can fail return "" when fine, else what went wrong.
 #pragma once

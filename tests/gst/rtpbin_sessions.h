@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The one set of rtpbin pipeline builders of the pipeline tests: gst-launch fragments for one
 // RTP session of an rtpbin named `rtpbin`, sending or receiving over UDP on 127.0.0.1. The
 // elements are named after `prefix` (`<prefix>rtp`, `<prefix>rtcp`, `<prefix>rr`) so that a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // What users run, end to end: the sample sessions in docs/examples/, tools/pfap-loopback, the
 // RTSP server example and the commands of docs/elements.md, "Text markup: sending and
 // receiving a session".

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // fapparse and pfapfapenc (docs/fap-files.md, docs/elements.md "MPEG-4 FAP files"):
 //  - FapParse.*: each real file in ../shared/fap (or $PFAP_FAP_DIR) through fapparse, fed in
 //    odd-sized chunks: the events applied to a FapState and sampled at the frame times give

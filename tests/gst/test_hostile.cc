@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A receiver a hostile sender cannot silence (docs/security.md, "Floods"): a good PFAP stream
 // over UDP on 127.0.0.1 (one packet per 40 ms phoneme), and in the middle of it, within one
 // second, a flood of 20,000 of its own packets with random sequence numbers and timestamps

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Many listeners (docs/recovery.md, "Many listeners: multicast"): one PFAP stream sent once to
 // a multicast group, 100 receivers joining it at random times. Each must be whole (no event
 // flagged uncertain) from its first complete state on, which comes within one

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // pfapmarksenc and pfapmarksparse: element behaviour with GstHarness, and the commands of
 // docs/elements.md, "Speech marks", run as written against the files in docs/examples/.
 #include <gst/check/gstharness.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // pfapalign: recorded speech and its text in, the audio unchanged and its phonemes on `pfap`.
 // GstHarness on sink/src, one on `pfap` and one on `text_sink` when the text comes as buffers.
 // The "recordings" are espeak-ng's at another rate and pitch, whose phoneme times are known.

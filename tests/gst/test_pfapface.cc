@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // pfapface: x-pfap in, frames out. Frame timing, EOS, gaps, flushing, caps, bad input, live
 // input, golden frames of the example sessions against stored PNGs, pictures that must
 // differ (mouth shapes, expressions, head yaw), and the commands of docs/elements.md,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // pfapparse: .pfap text in, one application/x-pfap buffer per event out.
 #include <glib/gstdio.h>
 #include <gst/check/gstharness.h>

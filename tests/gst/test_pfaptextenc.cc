@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // pfaptextenc: x-pfap buffers in, .pfap text lines out, checked as exact strings and read
 // back with pfap::TextReader, the reader pfapparse uses.
 #include <gst/check/gstharness.h>

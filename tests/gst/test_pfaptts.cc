@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // pfaptts: text in, espeak-ng speech on `audio` and its phonemes on `pfap`, on one timeline.
 // GstHarness on the sink pad and the `audio` pad, a second harness on the `pfap` pad.
 #include <gst/check/gstharness.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Integration tests: rtppfappay and rtppfapdepay in real pipelines.
 //
 //  - LoopbackUdp.PhonemesKeepLipSyncWithAudio: audio (L16) and PFAP sent through one rtpbin

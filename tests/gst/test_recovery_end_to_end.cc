@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Loss recovery end to end (draft sections 6.1, 6.4 and 8; docs/recovery.md):
 //
 //  - RecoveryLoop.PliBringsACompleteStateAfterALongBurst: a sender and a receiver rtpbin over

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The reference in docs/elements.md ("Registry reference") against the registry: every
 // plugin's details, every element's metadata, rank, pad templates and own properties, and the
 // typefinders, as GStreamer holds them. The reference cannot drift: a change to any of them

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // rtppfapdepay: hand-built PFAP RTP packets in, x-pfap phoneme and state buffers out, read
 // back with pfap::testing::read_event; requests for a complete state out upstream.
 #include <gst/check/gstharness.h>

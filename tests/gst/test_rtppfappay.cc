@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // rtppfappay: x-pfap phoneme buffers in, PFAP RTP packets out, checked by decoding them.
 #include <gst/check/gstharness.h>
 #include <gst/rtp/gstrtpbuffer.h>

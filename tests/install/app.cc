@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // An application of libpfap built against an installed pfap.pc (scripts/check-install):
 // g++ -std=c++20 app.cc $(pkg-config --cflags --libs pfap). Parses MPEG-4 bookmarks and
 // prints them back in the transformed form; exit status 0 when they read back the same.

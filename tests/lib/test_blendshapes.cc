@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FAP states and visemes to ARKit blendshape weights: known states give the expected weights,
 // every weight stays in 0..1, and the names are ARKit's.
 #include <gtest/gtest.h>

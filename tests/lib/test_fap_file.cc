@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // MPEG-4 FAP files (pfap/fap_file.h, pfap/fap_animation.h; docs/fap-files.md):
 //  - SharedFapFiles.*: every file in ../shared/fap parses; its events, applied to a FapState
 //    and sampled at the frame times, give back every frame's values exactly; FapRecorder

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The application/x-pfap event layout (pfap/markup.h): bytes written by hand, round trips and
 // refusal of bad events.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 /* pfap/markup.h from C99 (docs/markup.md): compiled as C99 with -pedantic-errors and linked
  * with the shared libpfap, an event written and read back field by field, and a bad one
  * refused. Prints what failed; the exit status is the number of failures. */

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Payload encoder and decoder: byte-exact vectors from the draft's figures, round trips, and
 // one test per class of bad payload.
 #include <gtest/gtest.h>

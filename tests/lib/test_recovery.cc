@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Recovery: a receiver that loses packets ends with the FAP state of one that lost none,
 // whenever every gap is within the coverage of the packet after it.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // pfap::Sender: what is sent when. The complete-state schedule (the stream's first packet, the
 // interval, requests while busy and while idle, a state too large for the MTU, input whose
 // times go back), depth changes mid-stream, and the data packets' fields.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Speech-mark formats: exact output for a known utterance, round trips from .pfap through
 // each format back to x-pfap keeping every viseme's time to the ms, and readers' errors.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // pfap::EventTimeline: where an event without a time starts, and events that go back.
 #include "pfap/timeline.h"
 

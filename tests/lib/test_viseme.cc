@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The viseme tables: every phoneme of every alphabet has a viseme in each vocabulary, and the
 // rows of docs/visemes.md that come from the vocabularies' own documentation.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The C++ side of test_gstpfap.py's FAP state comparison: libpfap's pfap::FapState, driven by
 // lines on stdin, prints the amplitudes asked for, exactly (%.17g), one per line:
 //   E kind time_ns n_faps (index amplitude transition_ms curve){n_faps}   applies an event

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The example programs in examples/python and examples/gjs, run as a user runs them, against
 the build tree (tests/python/meson.build sets the paths)."""
 import os

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """libgstpfap from Python (GstPfap-1.0 through PyGObject), as an application uses it.
 
 meson runs these against the build tree (tests/python/meson.build): GI_TYPELIB_PATH and

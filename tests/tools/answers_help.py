@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Runs PROGRAM --help and checks that it answers: status 0, nothing on standard error, and a
 usage line naming NAME, then at least one line saying what it does, on standard output.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Sentences for the tts tests: the Harvard sentences and sentences made to reach the rarer
 // English phonemes (syllabic consonants, r-coloured vowels, flaps, glottal stops, loch).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The espeak-ng mnemonic table: every target is an x-pfap-arpabet symbol, and every phoneme
 // the en and en-us voices speak for a corpus maps exactly.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // segment_f0 on signals of known pitch: a voice-like pulse train and silence.
 #include <gtest/gtest.h>
 

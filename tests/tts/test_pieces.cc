@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // piece_end and piece: an utterance cut at sentence ends, no piece over kMaxPieceCodePoints,
 // bookmarks in the piece the MPEG-4 rule places them in.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // place_bookmark: the MPEG-4 rule, table-driven over one two-sentence text.
 #include <gtest/gtest.h>
 

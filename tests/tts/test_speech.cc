@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // speak(): espeak-ng's speech as x-pfap phonemes, checked against the audio and against
 // espeak-ng's own transcription.
 #include <gtest/gtest.h>

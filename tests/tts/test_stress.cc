@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // primary_stress: the transcription's ' marks on the spoken phonemes.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // parse_utterance: text and bookmarks apart, positions in code points, bad bookmarks named
 // where they are and left out.
 #include <gtest/gtest.h>

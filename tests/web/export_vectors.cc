@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // What libpfap, libface and GStreamer's RTP library make of seeded inputs, as JSON on stdout,
 // for the differential tests of the JavaScript package (web/test, docs/web.md). Each mode is
 // one part of the package:

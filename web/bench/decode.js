@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Decode speed in Node: decodePayload on the packet of bench_payload's BM_DecodeValidate (a
 // full 1388-byte payload as speech gives it: dynamic recovery over 4 packets with 3 entries,
 // then phonemes of which one in four carries 2 FAPs), and on a small packet of one phoneme

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The package's size as a page loads it: each module of src/ as is and minified (terser, a dev
 // dependency), and all of them gzipped. Run: node bench/size.js (docs/performance.md)
 import { readFileSync, readdirSync } from 'node:fs';

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A talking head in a page from RTP packets, with no server behind it: the packets of
 // docs/examples/hello.pfap are made here (encodePayload, makeRtp), as a sender would send
 // them, and handed to a PfapReceiver at their times; each animation frame draws the face at

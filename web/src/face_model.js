@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The face's geometry: FAP amplitudes in, the 2D shapes a renderer draws out; the same model
 // as pfapface's (face/src/model.cc, docs/face.md).
 //

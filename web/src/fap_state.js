@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The amplitude of every FAP over time at a receiver (draft section 5), as pfap::FapState
 // (lib/src/fap_state.cc) computes it, operation for operation, so that amplitudes agree with
 // libpfap's to the last bit. docs/format.md ("FAP amplitude over time") gives the rules:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Types of the pfap package (web/src/index.js). Times are nanoseconds as numbers; durations
 // and transitions milliseconds; f0 Hz.
 

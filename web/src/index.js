@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // pfap: the PFAP receiver (draft-ietf-avt-rtp-pfap-00) for browsers and Node, bit-exact with
 // libpfap. An ES module with no dependencies: import it from a served directory as is.
 export { RtpError, makeRtp, parseRtp } from './rtp.js';

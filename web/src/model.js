@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The TtsFAPInterface data as draft-ietf-avt-rtp-pfap-00 carries it (lib/include/pfap/model.h).
 
 export const NS_PER_MS = 1_000_000;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // PFAP payload decoder and encoder, bit-exact to draft-ietf-avt-rtp-pfap-00 section 6 and to
 // libpfap's pfap::decode_payload / pfap::encode_payload (lib/src/payload.cc): the same checks
 // in the same order, so the same status and byte offset for every bad payload. docs/format.md

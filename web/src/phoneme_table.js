@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Phoneme alphabets with the MPEG-4 viseme of each phoneme (lib/src/phoneme_table.cc).
 
 /** The MPEG-4 visemes (ISO/IEC 14496-2, FAP 1 viseme_select), as pfap::Viseme numbers them. */

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A PFAP receiver for a page or a Node program: RTP packets in (Uint8Array), events with their
 // times in the stream's clock out, and the face at any time. The same steps as rtppfapdepay
 // (gst/pfap/gstrtppfapdepay.cc) followed by pfapface's animator: RTP header, payload decoder,

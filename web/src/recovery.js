@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The receiver's side of FAP loss recovery (draft sections 6.1, 6.4 and 8), as
 // pfap::RecoveryReceiver (lib/src/recovery.cc): loss from sequence numbers, dynamic recovery
 // applied only after a gap its coverage spans, complete states, and whether the FAP state is

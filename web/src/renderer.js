@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Draws a face pose on a canvas 2D context: what pfapface draws with cairo
 // (face/src/renderer.cc, docs/face.md "Styles"), path for path and colour for colour, so that
 // a browser and a GStreamer pipeline show the same face for the same state.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // RTP fixed header (RFC 3550 section 5.1), read as strictly as GStreamer's gst_rtp_buffer_map:
 // version 2, not an RTCP packet type, the CSRCs, the extension and the padding all inside the packet.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Animator and face model against pfapface's (face::Animator, face::pose_from_faps): seeded
 // phonemes (x-pfap-arpabet, unknown symbols, no alphabet), FAPs, recovered and complete states
 // give the same FAP values and overlay text (poses: renderer.test.js); the phoneme table is

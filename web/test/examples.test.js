@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // examples/talking_head.js, the page's logic, run in Node: its packets decode into the hello
 // session's phonemes at their times, and play() draws the face over two rounds (a new SSRC
 // each) on @napi-rs/canvas with a fake clock.

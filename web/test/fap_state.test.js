@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FapState against pfap::FapState: after seeded bookmarks on the same FAPs (transitions
 // interrupting each other, at the same time, of every curve), amplitudes at and around the
 // times where curves change are equal to the last bit, as are settled values, at-rest and

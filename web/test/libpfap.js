@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The C++ side of the differential tests: runs tests/web/export_vectors (built by meson; its
 // path in PFAP_EXPORT_VECTORS, set by tests/web/meson.build) and parses what it writes.
 import { execFileSync } from 'node:child_process';

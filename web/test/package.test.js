@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The package as a page and a TypeScript user get it: every module imports only relative
 // paths with their extensions (a browser loads them from a served directory, no bundler) and
 // uses no Node-only API; index.d.ts declares every export; `npm pack` ships src/ and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The decoder against pfap::decode_payload on the fuzz corpus and on seeded valid, mutated and
 // arbitrary payloads: same status, same offset, same packet. The encoder against
 // pfap::decode_payload: every JS-encoded packet decodes in C++ to the packet it was made of.

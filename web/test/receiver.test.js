@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // PfapReceiver on RTP packets: the seeded sessions of the recovery vectors (libpfap's sender,
 // seeded loss) wrapped in RTP, plus what a network adds: malformed packets, duplicates, late
 // packets, a timestamp that wraps, a new SSRC. Events come with their times in the stream's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // RecoveryReceiver against pfap::RecoveryReceiver on the seeded speech sessions of
 // tests/common/speech_session.h, packetized, sent with dynamic recovery of depths 0..40 and
 // complete states, lost at seeded places (runs longer than the coverage among them, and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The canvas renderer against pfapface's cairo renderer: for face states (neutral, the 14
 // visemes, the 6 expressions, head turned, tilted and nodding, eyes, brows, cheeks, jaw), the
 // poses are equal and the frames drawn by renderFace on @napi-rs/canvas (Skia) match

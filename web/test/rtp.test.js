@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // parseRtp against gst_rtp_buffer_map on 20000 seeded packets, well formed and not: the same
 // packets refused, the same fields and payload read from the rest.
 import assert from 'node:assert/strict';

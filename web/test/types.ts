@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // What a TypeScript page writes against src/index.d.ts; package.test.js type-checks it with
 // tsc --strict (it is not run).
 import {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A face over time: the FAP state of every bookmark, the mouth shapes of the phonemes and the
 // expressions, as amplitudes of every FAP at any time (docs/face.md).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Draws a FacePose with cairo into a frame of 32-bit pixels (docs/face.md, "Styles").
 #pragma once
 

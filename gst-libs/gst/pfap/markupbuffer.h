@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: LGPL-2.1-or-later */
 // application/x-pfap GstBuffers from and to pfap::MarkupEvent, for the plugins' elements.
 // Header-only, like the rest of this folder, so that each plugin needs only libpfap.
 #pragma once

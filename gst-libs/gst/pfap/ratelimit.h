@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: LGPL-2.1-or-later */
 // The rate limit of every per-item warning the plugins post.
 #pragma once
 

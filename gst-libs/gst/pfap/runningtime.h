@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: LGPL-2.1-or-later */
 // The running time of a buffer's PTS as the x-pfap writers place events (pfap::EventTimeline).
 #pragma once
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: LGPL-2.1-or-later */
 // The sparse stream flag that the plugins' x-pfap outputs carry.
 #pragma once
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: LGPL-2.1-or-later */
 // The warnings several elements post for the same fault, rate-limited (ratelimit.h). Macros
 // so that each element's own debug category (GST_CAT_DEFAULT) logs them.
 #pragma once

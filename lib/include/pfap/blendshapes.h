@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // A face's FAP amplitudes and current viseme as Apple ARKit's 52 blendshape weights, and the
 // head's pose, which ARKit keeps outside the blendshapes (docs/visemes.md, "Blendshapes").
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // MPEG-4 bookmarks `<FAP n FAPfield T C>` (draft section 5, ISO/IEC 14496-2 Annex C).
 //
 //   n = 2      FAPfield = e1 a1 e2 a2: expressions e1 and e2 (1..6) become FAPs 68+e1 and

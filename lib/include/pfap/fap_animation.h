@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // MPEG-4 FAP files as PFAP events and back (docs/fap-files.md).
 //
 // File to events: frame k becomes a silence phoneme starting at frame_time_ms(k), lasting

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // MPEG-4 FAP files (.fap, the FBA text format of Xface, Greta and other MPEG-4 face players):
 // reading, writing, and the limits that keep hostile files small. docs/fap-files.md.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The amplitude of every FAP over time at a receiver (draft section 5).
 //
 // A bookmark's FAP starts from the amplitude actually reached at its start time (0 before

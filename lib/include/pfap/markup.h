@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: LGPL-2.1-or-later */
 /* The bytes of one application/x-pfap buffer: one event of the TtsFAPInterface.
  *
  * A C API (usable from C and C++) so that an application can read and write these buffers

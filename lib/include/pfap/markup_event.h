@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // One application/x-pfap event as library types: the C++ side of pfap/markup.h, used by the
 // elements so that the byte layout and its flags are read and written in one place.
 #pragma once

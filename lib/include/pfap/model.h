@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The TtsFAPInterface data as draft-ietf-avt-rtp-pfap-00 carries it (sections 5 and 6).
 //
 // Types hold wire values: every field's range is the range of its bits on the wire, and

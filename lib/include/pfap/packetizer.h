@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Plans PFAP packets from a stream of phonemes and the FAPs that start with them.
 //
 // Rules (draft sections 6 and 7):

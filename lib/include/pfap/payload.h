@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // PFAP payload encoder and decoder, bit-exact to draft-ietf-avt-rtp-pfap-00 section 6.
 //
 // A payload is a packet descriptor, then the recovery entries (if any), then phoneme and FAP

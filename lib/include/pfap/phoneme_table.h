@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Phoneme alphabets: the 8-bit symbol tables that the draft leaves to out-of-band signalling
 // (section 5: "the mapping ... is signalled out of band"; here the `alphabet` caps field and
 // SDP `a=fmtp:<pt> alphabet=<name>`), with the MPEG-4 viseme of each phoneme for renderers.

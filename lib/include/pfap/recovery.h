@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // FAP loss recovery (draft sections 6.1, 6.4 and 8): what a sender puts in each packet so that
 // a receiver that lost packets ends up with the same FAP state, and how a receiver uses it.
 //

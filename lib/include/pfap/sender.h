@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The sending side of a PFAP stream: phonemes in, packets out, with loss recovery.
 //
 // pfap::Sender owns the packetizer (how phonemes are grouped), the recovery sender (the FAP

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Speech-mark formats of TTS services and lip-sync tools, out of and into x-pfap events
 // (docs/visemes.md): Amazon Polly speech marks, Rhubarb Lip Sync TSV and JSON, TalkingHead's
 // streamAudio timing object, Azure viseme events, and ARKit blendshape frames.

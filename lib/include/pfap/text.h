@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The .pfap text format: a PFAP session a person can write and read (docs/text-format.md).
 //
 // UTF-8, one event per line, '#' starts a comment, fields separated by white space:

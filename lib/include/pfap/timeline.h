@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // Where the events of a markup stream (x-pfap buffers) go in time, as the elements that read
 // them place them: one rule for an event without a time, one for an event that goes back.
 #pragma once

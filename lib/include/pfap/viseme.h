@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
 // The viseme vocabularies avatars and TTS services speak today, and the viseme of every symbol
 // of the alphabets this library knows in each of them (docs/visemes.md has every table, its
 // source and where a row is a judgment).
