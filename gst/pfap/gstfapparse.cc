@@ -62,6 +62,7 @@
 #include "pfap/fap_file.h"
 #include "pfap/phoneme_table.h"
 #include "markupbuffer.h"
+#include "noseek.h"
 #include "ratelimit.h"
 #include "sparse.h"
 
@@ -408,26 +409,6 @@ static gboolean gst_fap_parse_sink_event(GstPad* pad, GstObject* parent, GstEven
   return gst_pad_event_default(pad, parent, event);
 }
 
-// Seeking would need the frames before the target (each frame's events are the changes
-// since the one before), so it is refused rather than passed upstream.
-static gboolean gst_fap_parse_src_event(GstPad* pad, GstObject* parent, GstEvent* event) {
-  if (GST_EVENT_TYPE(event) == GST_EVENT_SEEK) {
-    gst_event_unref(event);
-    return FALSE;
-  }
-  return gst_pad_event_default(pad, parent, event);
-}
-
-static gboolean gst_fap_parse_src_query(GstPad* pad, GstObject* parent, GstQuery* query) {
-  if (GST_QUERY_TYPE(query) == GST_QUERY_SEEKING) {
-    GstFormat format;
-    gst_query_parse_seeking(query, &format, nullptr, nullptr, nullptr);
-    gst_query_set_seeking(query, format, FALSE, -1, -1);
-    return TRUE;
-  }
-  return gst_pad_query_default(pad, parent, query);
-}
-
 // Speech events are kept, timed in ms from the speech segment's start, until both inputs end.
 static GstFlowReturn gst_fap_parse_speech_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
   GstFapParse* self = GST_FAP_PARSE(parent);
@@ -635,8 +616,7 @@ static void gst_fap_parse_init(GstFapParse* self) {
 
   self->srcpad = gst_pad_new_from_static_template(&src_template, "src");
   gst_pad_use_fixed_caps(self->srcpad);
-  gst_pad_set_event_function(self->srcpad, gst_fap_parse_src_event);
-  gst_pad_set_query_function(self->srcpad, gst_fap_parse_src_query);
+  pfap_noseek_set_src_functions(self->srcpad);
   gst_element_add_pad(GST_ELEMENT(self), self->srcpad);
 
   self->silence_symbol = kDefaultSilenceSymbol;

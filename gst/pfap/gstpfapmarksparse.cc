@@ -43,6 +43,7 @@
 
 #include "pfap/speech_marks.h"
 #include "markupbuffer.h"
+#include "noseek.h"
 #include "ratelimit.h"
 #include "sparse.h"
 
@@ -302,15 +303,6 @@ static gboolean gst_pfap_marks_parse_sink_event(GstPad* pad, GstObject* parent, 
   return gst_pad_event_default(pad, parent, event);
 }
 
-static gboolean gst_pfap_marks_parse_src_event(GstPad* pad, GstObject* parent, GstEvent* event) {
-  // Durations and flags depend on the marks before: reading starts at the start.
-  if (GST_EVENT_TYPE(event) == GST_EVENT_SEEK) {
-    gst_event_unref(event);
-    return FALSE;
-  }
-  return gst_pad_event_default(pad, parent, event);
-}
-
 static GstStateChangeReturn gst_pfap_marks_parse_change_state(GstElement* element,
                                                               GstStateChange transition) {
   if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) reset(GST_PFAP_MARKS_PARSE(element));
@@ -415,7 +407,7 @@ static void gst_pfap_marks_parse_init(GstPfapMarksParse* self) {
 
   self->srcpad = gst_pad_new_from_static_template(&src_template, "src");
   gst_pad_use_fixed_caps(self->srcpad);
-  gst_pad_set_event_function(self->srcpad, gst_pfap_marks_parse_src_event);
+  pfap_noseek_set_src_functions(self->srcpad);
   gst_element_add_pad(GST_ELEMENT(self), self->srcpad);
   reset(self);
 }

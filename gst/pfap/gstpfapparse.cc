@@ -50,6 +50,7 @@
 #include "pfap/text.h"
 #include "gstpfaptypefind.h"
 #include "markupbuffer.h"
+#include "noseek.h"
 #include "ratelimit.h"
 #include "sparse.h"
 
@@ -315,26 +316,6 @@ static gboolean gst_pfap_parse_sink_event(GstPad* pad, GstObject* parent, GstEve
   return gst_pad_event_default(pad, parent, event);
 }
 
-// Seeking would need the lines before the target (times and sentence starts depend on
-// them), so it is refused rather than passed to a source that might accept it.
-static gboolean gst_pfap_parse_src_event(GstPad* pad, GstObject* parent, GstEvent* event) {
-  if (GST_EVENT_TYPE(event) == GST_EVENT_SEEK) {
-    gst_event_unref(event);
-    return FALSE;
-  }
-  return gst_pad_event_default(pad, parent, event);
-}
-
-static gboolean gst_pfap_parse_src_query(GstPad* pad, GstObject* parent, GstQuery* query) {
-  if (GST_QUERY_TYPE(query) == GST_QUERY_SEEKING) {
-    GstFormat format;
-    gst_query_parse_seeking(query, &format, nullptr, nullptr, nullptr);
-    gst_query_set_seeking(query, format, FALSE, -1, -1);
-    return TRUE;
-  }
-  return gst_pad_query_default(pad, parent, query);
-}
-
 static GstStateChangeReturn gst_pfap_parse_change_state(GstElement* element,
                                                         GstStateChange transition) {
   GstPfapParse* self = GST_PFAP_PARSE(element);
@@ -470,8 +451,7 @@ static void gst_pfap_parse_init(GstPfapParse* self) {
 
   self->srcpad = gst_pad_new_from_static_template(&src_template, "src");
   gst_pad_use_fixed_caps(self->srcpad);
-  gst_pad_set_event_function(self->srcpad, gst_pfap_parse_src_event);
-  gst_pad_set_query_function(self->srcpad, gst_pfap_parse_src_query);
+  pfap_noseek_set_src_functions(self->srcpad);
   gst_element_add_pad(GST_ELEMENT(self), self->srcpad);
 
   self->skip_bad_lines = FALSE;
