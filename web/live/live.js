@@ -53,7 +53,7 @@ export function lipSyncErrors(envelope, frames, { silenceMs = 30, windowMs = 150
 
 export function start({ canvas, audio, form, input, status, saying }) {
   const stats = {
-    phonemes: 0, packets: 0, lost: 0, recovered: 0, complete: 0, uncertain: 0,
+    phonemes: 0, packets: 0, lost: 0, recovered: 0, complete: 0, uncertain: 0, late: 0,
     lipSyncErrorsMs: [], fapStateMatchesSender: false,
     sender: null, texts: 0, done: 0, connected: false, streamNs: 0, endNs: 0,
     envelope: [], frames: [],
@@ -86,8 +86,8 @@ export function start({ canvas, audio, form, input, status, saying }) {
 
   const show = () => {
     const s = receiver.stats;
-    Object.assign(stats, { packets: s.packets, lost: s.lost, recovered: s.recovered, complete: s.completeStates });
-    for (const key of ['phonemes', 'packets', 'lost', 'recovered', 'complete', 'uncertain']) {
+    Object.assign(stats, { packets: s.packets, lost: s.lost, recovered: s.recovered, complete: s.completeStates, late: s.late });
+    for (const key of ['phonemes', 'packets', 'lost', 'late', 'recovered', 'complete', 'uncertain']) {
       document.getElementById(key).textContent = String(stats[key]);
     }
     document.getElementById('matches').textContent = stats.sender ? (stats.fapStateMatchesSender ? 'yes' : 'no') : '-';

@@ -58,20 +58,20 @@ function startServer(args) {
   });
 }
 
-// Opens the page, waits until the server has said its text and the page's FAP state settled
-// (equal to the sender's, or the time is up); returns the page's figures.
-async function session(args, { screenshot } = {}) {
-  const server = await startServer(args);
+// Opens the page, waits until the server has said its text, the audio played it to its end,
+// and the page's FAP state settled (equal to the sender's, or the time is up); returns the
+// page's figures.
+async function openPage(url, { screenshot } = {}) {
   const page = await browser.newPage({ viewport: { width: 640, height: 720 } });
-  const console = [];
-  page.on('console', (m) => console.push(m.text()));
+  const messages = [];
+  page.on('console', (m) => messages.push(m.text()));
   try {
-    await page.goto(server.url);
+    await page.goto(url);
     if (screenshot) {
       await page.waitForFunction(() => window.pfapStats?.phonemes >= 20, null, { timeout: 20000 });
       await page.locator('body').screenshot({ path: screenshot });
     }
-    // The text said, and played to its end (its packets go ahead of the audio).
+    // Its packets go ahead of the audio: the end is when the audio has played past the last.
     await page.waitForFunction(() => window.pfapStats?.done >= 1 && window.pfapStats.streamNs > window.pfapStats.endNs + 3e8,
       null, { timeout: 30000, polling: 100 });
     await page.waitForFunction(() => window.pfapStats.fapStateMatchesSender, null, { timeout: 5000, polling: 100 })
@@ -82,21 +82,34 @@ async function session(args, { screenshot } = {}) {
       return s;
     });
   } catch (e) {
-    throw new Error(`${e.message}\nserver: ${server.log()}\npage: ${console.join('\n')}`);
+    throw new Error(`${e.message}\npage: ${messages.join('\n')}`);
   } finally {
     await page.close();
+  }
+}
+
+// Starts a server with `args`, opens `pages` pages on it at once; their figures.
+async function sessions(args, { pages = 1, screenshot } = {}) {
+  const server = await startServer(args);
+  try {
+    return await Promise.all(Array.from({ length: pages }, (_, i) => openPage(server.url, { screenshot: i === 0 ? screenshot : undefined })));
+  } catch (e) {
+    throw new Error(`${e.message}\nserver: ${server.log()}`);
+  } finally {
     server.stop();
   }
 }
 
 test('every phoneme arrives, in lip sync with the sound', async () => {
-  const s = await session([`--text=${ONSETS_TEXT}`]);
+  const [s] = await sessions([`--text=${ONSETS_TEXT}`]);
   assert.equal(s.sender.dropped, 0);
   assert.ok(s.sender.phonemes > 0);
   assert.equal(s.phonemes, s.sender.phonemes, 'every phoneme the server sent');
   assert.equal(s.packets, s.sender.packets);
   assert.equal(s.lost, 0);
-  assert.equal(s.uncertain, 0);
+  // Uncertain events only when the unordered channel delivered a packet after a later one (the
+  // stream's first complete state overtaken by its first data packet: docs/web.md).
+  assert.ok(s.uncertain === 0 || s.late > 0, `uncertain ${s.uncertain}, late ${s.late}`);
   assert.equal(s.fapStateMatchesSender, true);
   // The lip-sync figures go to docs/web.md (PFAP_LIPSYNC_OUT collects them); here only
   // sanity: most onsets found, none beyond the pairing window.
@@ -106,10 +119,20 @@ test('every phoneme arrives, in lip sync with the sound', async () => {
 });
 
 test('with a tenth of the PFAP messages dropped the FAP state is repaired', async () => {
-  const s = await session([`--text=${LOSS_TEXT}`, '--drop=0.1', '--seed=7'], {
+  const [s] = await sessions([`--text=${LOSS_TEXT}`, '--drop=0.1', '--seed=7'], {
     screenshot: process.env.PFAP_SCREENSHOT,
   });
   assert.ok(s.sender.dropped > 0, 'some messages dropped');
   assert.ok(s.lost > 0);
   assert.equal(s.fapStateMatchesSender, true, JSON.stringify(s));
+});
+
+test('three browsers at once each get their own whole session', async () => {
+  const all = await sessions(['--text=One, two, three.'], { pages: 3 });
+  for (const s of all) {
+    assert.equal(s.sender.dropped, 0);
+    assert.equal(s.phonemes, s.sender.phonemes);
+    assert.equal(s.lost, 0);
+    assert.equal(s.fapStateMatchesSender, true);
+  }
 });
