@@ -535,7 +535,8 @@ std::shared_ptr<Session> open_session(Server& server, SoupWebsocketConnection* w
                         weak(s), free_weak, GConnectFlags(0));
   g_signal_connect_data(s->webrtc, "on-ice-candidate", G_CALLBACK(on_ice_candidate), weak(s),
                         free_weak, GConnectFlags(0));
-  gst_bus_add_watch(GST_ELEMENT_BUS(s->pipeline), on_bus, weak(s));
+  gst_bus_add_watch_full(GST_ELEMENT_BUS(s->pipeline), G_PRIORITY_DEFAULT, on_bus, weak(s),
+                         [](gpointer data) { delete static_cast<std::weak_ptr<Session>*>(data); });
 
   gst_element_set_state(s->pipeline, GST_STATE_READY);
   GstStructure* options = gst_structure_new("options", "ordered", G_TYPE_BOOLEAN, FALSE,

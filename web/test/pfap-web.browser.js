@@ -61,7 +61,7 @@ function startServer(args) {
 // Opens the page, waits until the server has said its text, the audio played it to its end,
 // and the page's FAP state settled (equal to the sender's, or the time is up); returns the
 // page's figures.
-async function openPage(url, { screenshot } = {}) {
+async function openPage(url, { screenshot, next } = {}) {
   const page = await browser.newPage({ viewport: { width: 640, height: 720 } });
   const messages = [];
   page.on('console', (m) => messages.push(m.text()));
@@ -76,6 +76,15 @@ async function openPage(url, { screenshot } = {}) {
       null, { timeout: 30000, polling: 100 });
     await page.waitForFunction(() => window.pfapStats.fapStateMatchesSender, null, { timeout: 5000, polling: 100 })
       .catch(() => {});
+    if (next) {
+      // Something new to say, typed into the page's box.
+      await page.fill('#say', next);
+      await page.click('#go');
+      await page.waitForFunction(() => window.pfapStats.done >= 2 && window.pfapStats.streamNs > window.pfapStats.endNs + 3e8,
+        null, { timeout: 30000, polling: 100 });
+      await page.waitForFunction(() => window.pfapStats.fapStateMatchesSender, null, { timeout: 5000, polling: 100 })
+        .catch(() => {});
+    }
     return await page.evaluate(() => {
       const s = window.pfapStats;
       s.measureLipSync();
@@ -89,10 +98,11 @@ async function openPage(url, { screenshot } = {}) {
 }
 
 // Starts a server with `args`, opens `pages` pages on it at once; their figures.
-async function sessions(args, { pages = 1, screenshot } = {}) {
+async function sessions(args, { pages = 1, screenshot, next } = {}) {
   const server = await startServer(args);
   try {
-    return await Promise.all(Array.from({ length: pages }, (_, i) => openPage(server.url, { screenshot: i === 0 ? screenshot : undefined })));
+    return await Promise.all(Array.from({ length: pages }, (_, i) =>
+      openPage(server.url, { screenshot: i === 0 ? screenshot : undefined, next: i === 0 ? next : undefined })));
   } catch (e) {
     throw new Error(`${e.message}\nserver: ${server.log()}`);
   } finally {
@@ -127,8 +137,10 @@ test('with a tenth of the PFAP messages dropped the FAP state is repaired', asyn
   assert.equal(s.fapStateMatchesSender, true, JSON.stringify(s));
 });
 
-test('three browsers at once each get their own whole session', async () => {
-  const all = await sessions(['--text=One, two, three.'], { pages: 3 });
+test('three browsers at once each get their own whole session; one says something new', async () => {
+  const all = await sessions(['--text=One, two, three.'], { pages: 3, next: 'Four <FAP 2 1 40 0 0 300 1> five.' });
+  assert.equal(all[0].done, 2);
+  assert.equal(all[0].texts, 2);
   for (const s of all) {
     assert.equal(s.sender.dropped, 0);
     assert.equal(s.phonemes, s.sender.phonemes);
