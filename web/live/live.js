@@ -125,7 +125,9 @@ export function start({ canvas, audio, form, input, status, saying }) {
       try {
         const rtp = parseRtp(bytes);
         if (firstPfapTimestamp === null) firstPfapTimestamp = rtp.timestamp;
-        lastSequenceNumber = rtp.sequenceNumber;
+        // The newest, as the receiver sees it: a packet overtaken by later ones is not.
+        const ahead = (rtp.sequenceNumber - (lastSequenceNumber ?? rtp.sequenceNumber - 1)) & 0xffff;
+        if (ahead > 0 && ahead < 0x8000) lastSequenceNumber = rtp.sequenceNumber;
       } catch {
         // the receiver counts and warns about it
       }
