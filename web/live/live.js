@@ -101,10 +101,15 @@ export function start({ canvas, audio, form, input, status, saying }) {
     if (!sender) return;
     const state = receiver.recovery.state;
     stats.fapStateMatchesSender = sender.settled.every((v, i) => state.settled(i + 3) === v);
-    const behind = lastSequenceNumber !== sender.lastSequenceNumber;
-    if (repair && (behind || !receiver.stateWhole)) {
-      if (behind) receiver.lostUnknown();
-      setTimeout(() => send({ type: 'complete' }), 100);
+    const behind = () => lastSequenceNumber !== sender.lastSequenceNumber;
+    if (repair && (behind() || !receiver.stateWhole)) {
+      // The message may overtake the last packets (they come another way): they have a
+      // while to arrive before they count as lost.
+      setTimeout(() => {
+        if (stats.sender !== sender) return;
+        if (behind()) receiver.lostUnknown();
+        if (!receiver.stateWhole) send({ type: 'complete' });
+      }, 300);
     }
     show();
   };
@@ -161,7 +166,9 @@ export function start({ canvas, audio, form, input, status, saying }) {
       ++stats.texts;
       stats.sender = null;
       saying.textContent = `Saying: ${m.text}`;
-    } else if (m.type === 'done' || m.type === 'state') {
+    } else if (m.type === 'done' || (m.type === 'state' && stats.sender)) {
+      // The sender's state at the end of a text, then after each complete state asked for
+      // (one asked for mid-text is compared at the text's end).
       if (m.type === 'done') ++stats.done;
       stats.sender = m;
       compare({ repair: true });
