@@ -117,8 +117,8 @@ test('every phoneme arrives, in lip sync with the sound', async () => {
   assert.equal(s.phonemes, s.sender.phonemes, 'every phoneme the server sent');
   assert.equal(s.packets, s.sender.packets);
   assert.equal(s.lost, 0);
-  // Uncertain events only when the unordered channel delivered a packet after a later one (the
-  // stream's first complete state overtaken by its first data packet: docs/web.md).
+  // Uncertain events only when the unordered channel delivered a packet after a later one (as
+  // the stream's first data packet overtaking its first complete state would: docs/web.md).
   assert.ok(s.uncertain === 0 || s.late > 0, `uncertain ${s.uncertain}, late ${s.late}`);
   assert.equal(s.fapStateMatchesSender, true);
   // The lip-sync figures go to docs/web.md (PFAP_LIPSYNC_OUT collects them); here only
