@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // A receiver a hostile sender cannot silence (docs/security.md, "Floods"): a good PFAP stream
 // over UDP on 127.0.0.1 (one packet per 40 ms phoneme), and in the middle of it, within one
-// second, a flood of 20,000 of its own packets with random sequence numbers and timestamps
-// (its SSRC spoofed, or random), into the receivers docs/elements.md shows. From one second
-// after the flood on, every good packet must reach rtppfapdepay, and the heap must not grow
-// by more than 32 MiB. About 3.5 s per receiver.
+// second, a flood of 20,000 copies of its packets with random sequence numbers and random or
+// their own timestamps (its SSRC spoofed, or random), into the receivers docs/elements.md
+// shows. Each must reach EOS after the flood, its heap grow by less than 32 MiB, and decode
+// every good packet from one second after the flood on; those protected against the flood
+// (SRTP, rtpbin against other SSRCs) every good packet after it. About 3.5 s per case.
 #include <arpa/inet.h>
 #include <gst/gst.h>
 #include <gst/rtp/gstrtpbuffer.h>
