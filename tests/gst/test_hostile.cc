@@ -295,6 +295,7 @@ std::string rtpbin_receiver() {
              "port=0 name=udp ") +
          kPfapCaps + " ! rtpbin.recv_rtp_sink_1 rtpbin. ! rtppfapdepay name=depay ! fakesink sync=false";
 }
+// docs/security.md's SRTP receiver: the plain one behind srtpdec, with the test's key.
 std::string srtp_receiver() {
   return std::string(
              "udpsrc address=127.0.0.1 port=0 name=udp caps=\"application/x-srtp,media=application,"
@@ -304,6 +305,7 @@ std::string srtp_receiver() {
          "srtcp-auth=hmac-sha1-80\" ! srtpdec ! rtpjitterbuffer max-dropout-time=0 "
          "max-misorder-time=0 ! rtppfapdepay name=depay ! fakesink sync=false";
 }
+
 void report(const FloodResult& f) {
   if (g_getenv("PFAP_TEST_VERBOSE") != nullptr) {
     std::cerr << f.during_received << "/" << f.during_sent << " during the flood, "
