@@ -5,7 +5,7 @@
 #include <cmath>
 #include <numbers>
 
-namespace face {
+namespace pfap::face {
 namespace {
 
 using pfap::Viseme;
@@ -151,4 +151,4 @@ void Animator::reset() {
   end_ns_ = 0;
 }
 
-}  // namespace face
+}  // namespace pfap::face

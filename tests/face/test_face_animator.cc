@@ -9,7 +9,7 @@
 #include "pfap/fap_state.h"
 #include "pfap/phoneme_table.h"
 
-namespace face {
+namespace pfap::face {
 namespace {
 
 constexpr int64_t kMs = 1'000'000;
@@ -188,4 +188,4 @@ TEST(Animator, ResetGivesTheNeutralFace) {
 }
 
 }  // namespace
-}  // namespace face
+}  // namespace pfap::face

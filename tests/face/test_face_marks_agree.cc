@@ -22,7 +22,7 @@ namespace {
 using pfap::Blendshape;
 using pfap::Viseme;
 
-pfap::FapAmplitudes amplitudes(const face::FapValues& f) {
+pfap::FapAmplitudes amplitudes(const pfap::face::FapValues& f) {
   pfap::FapAmplitudes a{};
   for (size_t i = 0; i < a.size(); ++i) a[i] = f[i];
   return a;
@@ -40,7 +40,7 @@ TEST(MarksAgree, VisemeMouthsAreThoseOfTheAnimator) {
       if (arpabet.symbols[s].viseme == viseme) symbol = static_cast<uint8_t>(s);
     }
     ASSERT_TRUE(symbol.has_value());
-    face::Animator animator;
+    pfap::face::Animator animator;
     animator.set_alphabet(&arpabet);
     pfap::MarkupEvent event;
     event.phoneme.symbol = *symbol;
@@ -60,9 +60,9 @@ TEST(MarksAgree, ExpressionsMoveWhatPfapfaceMoves) {
   for (int e = 1; e <= 6; ++e) {
     SCOPED_TRACE("expression " + std::to_string(e));
     const int index = pfap::kFirstExpressionIndex - 1 + e;
-    face::FapValues displaced{};
+    pfap::face::FapValues displaced{};
     displaced[index] = 63;
-    face::add_expressions(displaced);
+    pfap::face::add_expressions(displaced);
     displaced[index] = 0;
     const pfap::BlendshapeWeights drawn =
         pfap::blendshape_weights(amplitudes(displaced), Viseme::kNone);
@@ -113,7 +113,7 @@ TEST(MarksAgree, ArkitFramesAreWhatTheAnimatorDraws) {
 
   std::istringstream rows(csv);
   std::getline(rows, line);  // the header
-  face::Animator animator;
+  pfap::face::Animator animator;
   animator.set_alphabet(&arpabet);
   size_t next = 0;
   int frames = 0;

@@ -11,7 +11,7 @@
 #include "pfap/markup_event.h"
 #include "pfap/phoneme_table.h"
 
-namespace face {
+namespace pfap::face {
 
 // A mouth shape as FAP displacements, the same on both sides, in FAP units.
 struct MouthShape {
@@ -86,4 +86,4 @@ class Animator {
   int64_t end_ns_ = 0;
 };
 
-}  // namespace face
+}  // namespace pfap::face

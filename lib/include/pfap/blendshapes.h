@@ -84,7 +84,7 @@ struct HeadPose {
   double roll = 0;
 };
 
-// A mouth as the FAP displacements pfapface's animator adds for a viseme (face::MouthShape,
+// A mouth as the FAP displacements pfapface's animator adds for a viseme (pfap::face::MouthShape,
 // which tests/face checks this agrees with): jaw (FAP 3), upper mid lip down (4; 8, 9 by 0.7),
 // lower mid lip up (5; 10, 11 by 0.7), corners out (6, 7, 53, 54), corners up (12, 13, 59,
 // 60), lips pushed (16, 17).
