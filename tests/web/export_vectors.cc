@@ -34,6 +34,7 @@
 #include "face/animator.h"
 #include "face/model.h"
 #include "face/renderer.h"
+#include "pfap/blendshapes.h"
 #include "pfap/fap_state.h"
 #include "pfap/packetizer.h"
 #include "pfap/payload.h"
@@ -538,7 +539,7 @@ int export_render(const char* dir) {
   state("neutral", {});
   for (int v = 1; v <= 14; ++v) {
     pfap::face::FapValues f{};
-    const pfap::face::MouthShape m = pfap::face::viseme_shape(static_cast<pfap::Viseme>(v));
+    const pfap::VisemeMouth m = pfap::viseme_mouth(static_cast<pfap::Viseme>(v));
     f[3] = m.open_jaw;
     f[4] = m.lower_t_midlip;
     f[5] = m.raise_b_midlip;
