@@ -50,6 +50,7 @@
 #include <vector>
 
 #include "aligner.h"
+#include "recognizer.h"
 #include "pfap/markup.h"
 #include "markupbuffer.h"
 #include "ratelimit.h"
@@ -87,6 +88,8 @@ struct Stream {
   std::array<guint64, 5> problems{};  // per pfap::align::Problem, for pfap_warn_at
   guint64 bad_bookmarks = 0;
   std::set<std::string> warned_phonemes;  // inexact mnemonics already warned about
+  pfap::align::Recognizer recognizer;     // the text-free mode's; its model loads when used
+  std::array<guint64, 4> recognition_problems{};  // per pfap::align::RecognitionProblem
 
   std::mutex lock;  // guards what follows, shared with the text pad's thread
   std::condition_variable text_changed;
@@ -163,6 +166,66 @@ static void warn_problem(GstPfapAlign* self, pfap::align::Problem problem, GstCl
        pfap::align::kPoorMatchCost, s.problems[static_cast<size_t>(problem)]));
 }
 
+// Pushes `phonemes`, whose starts count from sample `from` of the audio kept, on `pfap`.
+static GstFlowReturn push_phonemes(GstPfapAlign* self,
+                                   const std::vector<pfap::tts::SpokenPhoneme>& phonemes,
+                                   size_t from) {
+  Stream& s = *self->stream;
+  GstFlowReturn ret = GST_FLOW_OK;
+  for (const pfap::tts::SpokenPhoneme& p : phonemes) {
+    if (ret != GST_FLOW_OK) break;
+    GstBuffer* buffer = pfap_buffer_new(p.event);
+    if (buffer == nullptr) {
+      // align() and recognize() keep every value in range: a bug.
+      GST_ELEMENT_ERROR(self, STREAM, FAILED, (nullptr), ("a phoneme x-pfap cannot hold"));
+      return GST_FLOW_ERROR;
+    }
+    const GstClockTime start = s.first + gst_util_uint64_scale(from + p.start, GST_SECOND, s.rate);
+    const GstClockTime end =
+        s.first + gst_util_uint64_scale(from + p.start + p.n_samples, GST_SECOND, s.rate);
+    GST_BUFFER_PTS(buffer) = start;
+    GST_BUFFER_DURATION(buffer) = end - start;
+    if (s.pfap_discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
+    s.pfap_discont = false;
+    ret = gst_flow_combiner_update_pad_flow(self->flow_combiner, self->pfappad,
+                                            gst_pad_push(self->pfappad, buffer));
+  }
+  return ret;
+}
+
+// Without a text: the phonemes of all the audio kept recognized from it alone (the
+// `recognition` build), or one pause with a warning where the build cannot.
+static GstFlowReturn recognize_kept(GstPfapAlign* self) {
+  Stream& s = *self->stream;
+  if (!pfap::align::recognition_available()) {
+    GST_ELEMENT_WARNING(self, STREAM, DECODE,
+                        ("No text for the audio, and this build cannot recognize phonemes "
+                         "without it: the audio is one pause"),
+                        ("set the text property or link text_sink; the text-free mode needs "
+                         "pocketsphinx (meson feature `recognition`)"));
+    pfap::align::Recognition pause;
+    std::string unused;
+    s.recognizer.recognize(s.samples, s.rate, pause, unused);
+    return push_phonemes(self, pause.phonemes, 0);
+  }
+  GST_INFO_OBJECT(self, "no text: recognizing %zu samples", s.samples.size());
+  pfap::align::Recognition recognition;
+  std::string error;
+  if (!s.recognizer.recognize(s.samples, s.rate, recognition, error)) {
+    GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));
+    return GST_FLOW_ERROR;
+  }
+  const auto problem = static_cast<size_t>(recognition.problem);
+  if (recognition.problem != pfap::align::RecognitionProblem::kNone &&
+      pfap_warn_at(++s.recognition_problems[problem])) {
+    GST_ELEMENT_WARNING(self, STREAM, DECODE,
+                        ("Audio at %" GST_TIME_FORMAT " without text: %s", GST_TIME_ARGS(s.first),
+                         pfap::align::problem_text(recognition.problem)),
+                        ("%" G_GUINT64_FORMAT " so far", s.recognition_problems[problem]));
+  }
+  return push_phonemes(self, recognition.phonemes, 0);
+}
+
 // Aligns `bytes` to samples [from, to) and pushes its phonemes on `pfap`. `is_text`: false
 // for the audio before the first utterance, whose empty text is no problem.
 static GstFlowReturn align_utterance(GstPfapAlign* self, const std::string& bytes, size_t from,
@@ -213,26 +276,7 @@ static GstFlowReturn align_utterance(GstPfapAlign* self, const std::string& byte
                         ("sent as %s", sent_as.c_str()));
   }
 
-  GstFlowReturn ret = GST_FLOW_OK;
-  for (const pfap::tts::SpokenPhoneme& p : alignment.phonemes) {
-    if (ret != GST_FLOW_OK) break;
-    GstBuffer* buffer = pfap_buffer_new(p.event);
-    if (buffer == nullptr) {
-      // align() keeps every value in range: a bug.
-      GST_ELEMENT_ERROR(self, STREAM, FAILED, (nullptr), ("a phoneme x-pfap cannot hold"));
-      return GST_FLOW_ERROR;
-    }
-    const GstClockTime start = s.first + gst_util_uint64_scale(from + p.start, GST_SECOND, s.rate);
-    const GstClockTime end =
-        s.first + gst_util_uint64_scale(from + p.start + p.n_samples, GST_SECOND, s.rate);
-    GST_BUFFER_PTS(buffer) = start;
-    GST_BUFFER_DURATION(buffer) = end - start;
-    if (s.pfap_discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
-    s.pfap_discont = false;
-    ret = gst_flow_combiner_update_pad_flow(self->flow_combiner, self->pfappad,
-                                            gst_pad_push(self->pfappad, buffer));
-  }
-  return ret;
+  return push_phonemes(self, alignment.phonemes, from);
 }
 
 // Aligns the audio kept so far with its texts and pushes the phonemes, then forgets both. At
@@ -289,14 +333,11 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
   }
   std::stable_sort(utterances.begin(), utterances.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
-  if (utterances.empty()) {
-    GST_ELEMENT_WARNING(self, STREAM, DECODE, ("No text for the audio: it is one pause"),
-                        ("set the text property or link text_sink"));
-  }
-
   GstFlowReturn ret = GST_FLOW_OK;
-  if (utterances.empty() || utterances.front().first > 0) {
-    ret = align_utterance(self, "", 0, utterances.empty() ? n : utterances.front().first, false);
+  if (utterances.empty()) {
+    ret = recognize_kept(self);
+  } else if (utterances.front().first > 0) {
+    ret = align_utterance(self, "", 0, utterances.front().first, false);
   }
   for (size_t i = 0; i < utterances.size() && ret == GST_FLOW_OK; ++i) {
     const size_t to = i + 1 < utterances.size() ? utterances[i + 1].first : n;
@@ -491,6 +532,7 @@ static GstStateChangeReturn gst_pfap_align_change_state(GstElement* element,
     reset(self);
     s.rate = 0;
     s.problems = {};
+    s.recognition_problems = {};
     s.bad_bookmarks = 0;
     s.warned_phonemes.clear();
     unsigned rate = 0;
