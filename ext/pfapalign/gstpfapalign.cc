@@ -25,9 +25,14 @@
  * the one before (so a file read in blocks is one utterance); the first starts at the audio's
  * start. Audio before the first utterance is a pause.
  *
+ * Without a text (no #GstPfapAlign:text, `text_sink` not linked or given nothing), the
+ * phonemes are recognized from the audio alone: pocketsphinx's all-phone search with its US
+ * English model, whose visemes are right on most 10 ms frames (docs/align.md). Built only with
+ * pocketsphinx (meson feature `recognition`); without it, a warning and one pause.
+ *
  * The phonemes come when the audio ends (EOS, a new segment or sample rate), after the text
  * pad's EOS: this element is for recordings, not live sources (docs/align.md says what is not
- * done). Silence, noise, a text that does not match, an empty text, bad bookmarks and
+ * done). Silence, noise, a text that does not match, an empty text or none, bad bookmarks and
  * unsupported rates each give a warning (rate-limited), and the stream goes on: an utterance
  * that cannot be aligned is one pause carrying its bookmarks.
  *
@@ -35,6 +40,9 @@
  * |[
  * gst-launch-1.0 filesrc location=speech.wav ! wavparse ! audioconvert ! audioresample ! pfapalign text="Hello world." name=a a.src ! fakesink a.pfap ! pfaptextenc ! filesink location=speech.pfap
  * ]| A WAV and its text to a .pfap file.
+ * |[
+ * gst-launch-1.0 filesrc location=speech.wav ! wavparse ! audioconvert ! audioresample ! audio/x-raw,rate=16000 ! pfapalign name=a a.src ! queue ! fakesink a.pfap ! queue ! pfaptextenc ! filesink location=speech.pfap
+ * ]| A WAV without its text: the phonemes recognized.
  */
 // clang-format on
 #include "gstpfapalign.h"
@@ -645,8 +653,9 @@ static void gst_pfap_align_class_init(GstPfapAlignClass* klass) {
   gst_element_class_add_static_pad_template(element_class, &pfap_template);
   gst_element_class_set_static_metadata(
       element_class, "PFAP forced alignment", "Filter/Analyzer/Audio",
-      "Aligns the phonemes of a text to a recording of it: the audio unchanged, and its "
-      "phonemes with bookmarks' facial animation parameters (PFAP) as application/x-pfap",
+      "Aligns the phonemes of a text to a recording of it, or recognizes them without the text: "
+      "the audio unchanged, and its phonemes with bookmarks' facial animation parameters (PFAP) "
+      "as application/x-pfap",
       "gst-pfap developers");
 
   element_class->change_state = gst_pfap_align_change_state;

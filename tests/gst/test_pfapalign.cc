@@ -360,7 +360,7 @@ size_t file_size(const std::string& path) {
 
 TEST(PfapAlignDocumented, EveryCommandRuns) {
   const std::vector<std::string> commands = documented_commands();
-  ASSERT_EQ(commands.size(), 3u);
+  ASSERT_EQ(commands.size(), 4u);
   const pfap::testing::TempDir dir;
   const std::string text =
       "Please call Stella. Ask her to bring these things with her from the store.";
@@ -397,6 +397,11 @@ TEST(PfapAlignDocumented, EveryCommandRuns) {
   EXPECT_EQ(symbols(read("speech.pfap")), symbols(from_property));
   ASSERT_EQ(run_line(commands[2], dir), "") << commands[2];
   EXPECT_GT(file_size(dir.file("face.webm")), 20000u);
+  ASSERT_EQ(run_line(commands[3], dir), "") << commands[3];
+  const std::string without_text = read("speech.pfap");
+  // Recognized phonemes, or one pause where the build cannot recognize.
+  EXPECT_GT(std::count(without_text.begin(), without_text.end(), '\n'),
+            pfap::align::recognition_available() ? 30 : 0);
 }
 
 }  // namespace
