@@ -96,12 +96,12 @@ TEST(VisemeFrames, EachFrameShowsThePhonemeAtItsMiddle) {
   EXPECT_TRUE(viseme_frames({}, 0.03) == std::vector<Viseme>(3, Viseme::kNone));
 }
 
-// Measured: 45.0 % against 18.5 % for the commonest viseme (docs/align.md); the bounds leave
+// Measured: 51.3 % against 16.1 % for the commonest viseme (docs/align.md); the bounds leave
 // room for other builds of the libraries.
-constexpr double kAgreementBound = 0.38;
+constexpr double kAgreementBound = 0.40;
 
 // espeak-ng sentences in a voice and rate unlike the default, recognized without their text,
-// at espeak-ng's 22050 Hz and resampled to 16 kHz: the share of 10 ms frames showing the
+// at espeak-ng's 22050 Hz (and one resampled to 16 kHz): the share of 10 ms frames showing the
 // viseme of espeak-ng's own phoneme times, against the share of the commonest viseme.
 TEST(Recognizer, SyntheticSentencesAgreeOnVisemesWellAboveTheBaseline) {
   Recognizer recognizer;
@@ -115,7 +115,10 @@ TEST(Recognizer, SyntheticSentencesAgreeOnVisemesWellAboveTheBaseline) {
     const tts::Speech s = say(text, {"en-us", 150, 40, 100});
     const double seconds = static_cast<double>(s.samples.size()) / s.sample_rate;
     const std::vector<Viseme> want = viseme_frames(timed(s.phonemes, s.sample_rate), seconds);
-    for (const unsigned rate : {s.sample_rate, 16000u}) {
+    // The first also at 16 kHz, the model's own rate: the front end takes both.
+    std::vector<unsigned> rates{s.sample_rate};
+    if (text == sentences[0]) rates.push_back(16000);
+    for (const unsigned rate : rates) {
       const std::vector<int16_t> audio =
           rate == s.sample_rate ? s.samples : resample(s.samples, s.sample_rate, rate);
       const Recognition r = recognized(recognizer, audio, rate);
