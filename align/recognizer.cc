@@ -12,8 +12,8 @@
 #include "pfap/phoneme_table.h"
 
 #if PFAP_HAVE_POCKETSPHINX
-#include <sphinxbase/err.h>
 #include <pocketsphinx.h>
+#include <sphinxbase/err.h>
 #endif
 
 namespace pfap::align {
@@ -59,9 +59,9 @@ ps_decoder_t* new_decoder(unsigned rate, std::string& error) {
   const std::string samprate = std::to_string(rate);
   const std::string nfft = std::to_string(fft_size(rate));
   cmd_ln_t* config = cmd_ln_init(nullptr, ps_args(), TRUE, "-hmm", hmm.c_str(), "-allphone",
-                                 phone_lm.c_str(), "-backtrace", "yes", "-beam", "1e-15",
-                                 "-pbeam", "1e-15", "-lw", "2.0", "-samprate", samprate.c_str(),
-                                 "-nfft", nfft.c_str(), "-remove_silence", "no", nullptr);
+                                 phone_lm.c_str(), "-backtrace", "yes", "-beam", "1e-15", "-pbeam",
+                                 "1e-15", "-lw", "2.0", "-samprate", samprate.c_str(), "-nfft",
+                                 nfft.c_str(), "-remove_silence", "no", nullptr);
   ps_decoder_t* ps = config != nullptr ? ps_init(config) : nullptr;
   if (config != nullptr) cmd_ln_free_r(config);  // the decoder keeps its own reference
   if (ps == nullptr) {

@@ -16,21 +16,21 @@
 // PFAP_ALIGN_EVAL_VOICE picks the espeak-ng voice (default "en").
 #include <algorithm>
 #include <array>
-#include <optional>
 #include <chrono>
-#include <ctime>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "aligner.h"
+#include "pfap/phoneme_table.h"
 #include "recognizer.h"
 #include "viseme_frames.h"
-#include "pfap/phoneme_table.h"
 
 namespace {
 
@@ -134,7 +134,8 @@ uint8_t festival_symbol(const std::string& name) {
   for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   const std::optional<uint8_t> symbol =
       pfap::find_symbol(*pfap::find_alphabet(pfap::kArpabetAlphabet), upper);
-  if (!symbol) std::fprintf(stderr, "Festival phone %s: not in x-pfap-arpabet, a pause\n", name.c_str());
+  if (!symbol)
+    std::fprintf(stderr, "Festival phone %s: not in x-pfap-arpabet, a pause\n", name.c_str());
   return symbol.value_or(0);
 }
 
@@ -283,8 +284,10 @@ int main(int argc, char** argv) {
       recognized_share = pfap::align::viseme_agreement(visemes, truth_visemes);
       if (std::getenv("PFAP_ALIGN_EVAL_VERBOSE") != nullptr) {
         for (const pfap::tts::SpokenPhoneme& p : recognition.phonemes) {
-          std::printf(" %s@%zu", std::string(pfap::find_phoneme(arpabet, p.event.phoneme.symbol)->name).c_str(),
-                      p.start * 1000 / rate);
+          std::printf(
+              " %s@%zu",
+              std::string(pfap::find_phoneme(arpabet, p.event.phoneme.symbol)->name).c_str(),
+              p.start * 1000 / rate);
         }
         std::printf("\n");
       }
@@ -330,10 +333,11 @@ int main(int argc, char** argv) {
               static_cast<size_t>(commonest_speech - speech_count.begin()));
   if (recognize) {
     // The processor time too: on a shared machine the wall clock measures the others' load.
-    std::printf("real-time factor without text: %.3f (%.2f s to recognize %.1f s; %.2f s of "
-                "processor time, %.3f)\n",
-                recognize_seconds / audio_seconds, recognize_seconds, audio_seconds,
-                recognize_cpu_seconds, recognize_cpu_seconds / audio_seconds);
+    std::printf(
+        "real-time factor without text: %.3f (%.2f s to recognize %.1f s; %.2f s of "
+        "processor time, %.3f)\n",
+        recognize_seconds / audio_seconds, recognize_seconds, audio_seconds, recognize_cpu_seconds,
+        recognize_cpu_seconds / audio_seconds);
   } else {
     std::printf("without text: this build has no recognizer (-Drecognition)\n");
   }

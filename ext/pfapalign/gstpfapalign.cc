@@ -58,10 +58,10 @@
 #include <vector>
 
 #include "aligner.h"
-#include "recognizer.h"
-#include "pfap/markup.h"
 #include "markupbuffer.h"
+#include "pfap/markup.h"
 #include "ratelimit.h"
+#include "recognizer.h"
 #include "sparse.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapalign_debug);
@@ -95,8 +95,8 @@ struct Stream {
   bool pfap_discont = true;
   std::array<guint64, 5> problems{};  // per pfap::align::Problem, for pfap_warn_at
   guint64 bad_bookmarks = 0;
-  std::set<std::string> warned_phonemes;  // inexact mnemonics already warned about
-  pfap::align::Recognizer recognizer;     // the text-free mode's; its model loads when used
+  std::set<std::string> warned_phonemes;          // inexact mnemonics already warned about
+  pfap::align::Recognizer recognizer;             // the text-free mode's; its model loads when used
   std::array<guint64, 4> recognition_problems{};  // per pfap::align::RecognitionProblem
 
   std::mutex lock;  // guards what follows, shared with the text pad's thread

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "markupbuffer.h"
-#include "recognizer.h"
 #include "pipeline.h"
+#include "recognizer.h"
 #include "speech.h"
 #include "temp_dir.h"
 
