@@ -144,6 +144,7 @@ bool Recognizer::recognize(std::span<const int16_t> audio, unsigned rate, Recogn
     ps = new_decoder(rate, error);
     if (ps == nullptr) {
       decoders_->by_rate.erase(rate);
+      pause_over(audio.size(), rate, out);
       return false;
     }
   }

@@ -53,9 +53,9 @@ class Recognizer {
   Recognizer& operator=(const Recognizer&) = delete;
 
   // Recognizes `audio` (mono, `rate` Hz, kMinRate..kMaxRate: the acoustic front end takes the
-  // rate as it is, over the model's 130..6800 Hz band). False with `error` when the model
-  // cannot be loaded or the build has no recognizer; every audio input gives phonemes, with
-  // `problem` saying what was wrong.
+  // rate as it is, over the model's 130..6800 Hz band). False with `error`, and `out` one
+  // pause, when the model cannot be loaded or the build has no recognizer; every audio input
+  // gives phonemes, with `problem` saying what was wrong.
   bool recognize(std::span<const int16_t> audio, unsigned rate, Recognition& out,
                  std::string& error);
 

@@ -205,31 +205,27 @@ static GstFlowReturn push_phonemes(GstPfapAlign* self,
 // `recognition` build), or one pause with a warning where the build cannot.
 static GstFlowReturn recognize_kept(GstPfapAlign* self) {
   Stream& s = *self->stream;
-  if (!pfap::align::recognition_available()) {
+  GST_INFO_OBJECT(self, "no text: recognizing %zu samples", s.samples.size());
+  pfap::align::Recognition recognition;
+  std::string error;
+  if (!s.recognizer.recognize(s.samples, s.rate, recognition, error)) {
+    if (pfap::align::recognition_available()) {  // the model is missing
+      GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));
+      return GST_FLOW_ERROR;
+    }
     GST_ELEMENT_WARNING(self, STREAM, DECODE,
                         ("No text for the audio, and this build cannot recognize phonemes "
                          "without it: the audio is one pause"),
                         ("set the text property or link text_sink; the text-free mode needs "
                          "pocketsphinx (meson feature `recognition`)"));
-    pfap::align::Recognition pause;
-    std::string unused;
-    s.recognizer.recognize(s.samples, s.rate, pause, unused);
-    return push_phonemes(self, pause.phonemes, 0);
-  }
-  GST_INFO_OBJECT(self, "no text: recognizing %zu samples", s.samples.size());
-  pfap::align::Recognition recognition;
-  std::string error;
-  if (!s.recognizer.recognize(s.samples, s.rate, recognition, error)) {
-    GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));
-    return GST_FLOW_ERROR;
-  }
-  const auto problem = static_cast<size_t>(recognition.problem);
-  if (recognition.problem != pfap::align::RecognitionProblem::kNone &&
-      pfap_warn_at(++s.recognition_problems[problem])) {
-    GST_ELEMENT_WARNING(self, STREAM, DECODE,
-                        ("Audio at %" GST_TIME_FORMAT " without text: %s", GST_TIME_ARGS(s.first),
-                         pfap::align::problem_text(recognition.problem)),
-                        ("%" G_GUINT64_FORMAT " so far", s.recognition_problems[problem]));
+  } else if (recognition.problem != pfap::align::RecognitionProblem::kNone) {
+    const auto problem = static_cast<size_t>(recognition.problem);
+    if (pfap_warn_at(++s.recognition_problems[problem])) {
+      GST_ELEMENT_WARNING(self, STREAM, DECODE,
+                          ("Audio at %" GST_TIME_FORMAT " without text: %s", GST_TIME_ARGS(s.first),
+                           pfap::align::problem_text(recognition.problem)),
+                          ("%" G_GUINT64_FORMAT " so far", s.recognition_problems[problem]));
+    }
   }
   return push_phonemes(self, recognition.phonemes, 0);
 }
