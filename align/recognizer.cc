@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <mutex>
 
 #include "aligner.h"  // kSpeechLevelDb
@@ -86,6 +87,33 @@ std::vector<Phone> decode(ps_decoder_t* ps, std::span<const int16_t> audio) {
   }
   return phones;
 }
+
+// The process's decoder for one rate, and the lock of its turns.
+struct SharedDecoder {
+  std::mutex lock;
+  ps_decoder_t* ps = nullptr;
+};
+
+// The decoder for `rate`, made at the first call for it and kept for the process (never
+// freed, so never destroyed under a thread still using it at exit); nullptr with `error`
+// when the model cannot be loaded.
+SharedDecoder* shared_decoder(unsigned rate, std::string& error) {
+  static std::mutex lock;
+  static auto& decoders = *new std::map<unsigned, std::unique_ptr<SharedDecoder>>;
+  std::lock_guard<std::mutex> guard(lock);
+  std::unique_ptr<SharedDecoder>& decoder = decoders[rate];
+  if (decoder != nullptr) return decoder.get();
+  // pocketsphinx logs every setting and result to stderr; its log is one per process.
+  err_set_logfp(nullptr);
+  ps_decoder_t* ps = new_decoder(rate, error);
+  if (ps == nullptr) {
+    decoders.erase(rate);
+    return nullptr;
+  }
+  decoder = std::make_unique<SharedDecoder>();
+  decoder->ps = ps;
+  return decoder.get();
+}
 #endif
 
 }  // namespace
@@ -112,17 +140,10 @@ const char* problem_text(RecognitionProblem p) {
 }
 
 #if PFAP_HAVE_POCKETSPHINX
-struct Recognizer::Decoders {
-  std::map<unsigned, ps_decoder_t*> by_rate;
-  ~Decoders() {
-    for (auto& [rate, ps] : by_rate) ps_free(ps);
-  }
-};
-
 bool recognition_available() { return true; }
 
-bool Recognizer::recognize(std::span<const int16_t> audio, unsigned rate, Recognition& out,
-                           std::string& error) {
+bool recognize(std::span<const int16_t> audio, unsigned rate, Recognition& out,
+               std::string& error) {
   out = Recognition{};
   if (rate < kMinRate || rate > kMaxRate) {
     out.problem = RecognitionProblem::kBadRate;
@@ -136,19 +157,16 @@ bool Recognizer::recognize(std::span<const int16_t> audio, unsigned rate, Recogn
     pause_over(audio.size(), rate, out);
     return true;
   }
-  ps_decoder_t*& ps = decoders_->by_rate[rate];
-  if (ps == nullptr) {
-    // pocketsphinx logs every setting and result to stderr; its log is one per process.
-    static std::once_flag quiet;
-    std::call_once(quiet, [] { err_set_logfp(nullptr); });
-    ps = new_decoder(rate, error);
-    if (ps == nullptr) {
-      decoders_->by_rate.erase(rate);
-      pause_over(audio.size(), rate, out);
-      return false;
-    }
+  SharedDecoder* decoder = shared_decoder(rate, error);
+  if (decoder == nullptr) {
+    pause_over(audio.size(), rate, out);
+    return false;
   }
-  const std::vector<Phone> phones = decode(ps, audio);
+  std::vector<Phone> phones;
+  {
+    std::lock_guard<std::mutex> turn(decoder->lock);
+    phones = decode(decoder->ps, audio);
+  }
   if (std::none_of(phones.begin(), phones.end(), [](const Phone& p) { return p.symbol != 0; })) {
     out.problem = RecognitionProblem::kNothingHeard;
     pause_over(audio.size(), rate, out);
@@ -181,20 +199,15 @@ bool Recognizer::recognize(std::span<const int16_t> audio, unsigned rate, Recogn
   return true;
 }
 #else
-struct Recognizer::Decoders {};
-
 bool recognition_available() { return false; }
 
-bool Recognizer::recognize(std::span<const int16_t> audio, unsigned rate, Recognition& out,
-                           std::string& error) {
+bool recognize(std::span<const int16_t> audio, unsigned rate, Recognition& out,
+               std::string& error) {
   out = Recognition{};
   pause_over(audio.size(), rate, out);
   error = "this build has no phoneme recognizer (pocketsphinx; meson feature `recognition`)";
   return false;
 }
 #endif
-
-Recognizer::Recognizer() : decoders_(std::make_unique<Decoders>()) {}
-Recognizer::~Recognizer() = default;
 
 }  // namespace pfap::align

@@ -7,7 +7,6 @@
 #pragma once
 
 #include <cstdint>
-#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -43,25 +42,13 @@ struct Recognition {
 // Whether this build has the recognizer (pocketsphinx found at build time).
 bool recognition_available();
 
-// One pocketsphinx decoder per sample rate, made at the first audio of that rate: not
-// thread-safe, one per stream.
-class Recognizer {
- public:
-  Recognizer();
-  ~Recognizer();
-  Recognizer(const Recognizer&) = delete;
-  Recognizer& operator=(const Recognizer&) = delete;
-
-  // Recognizes `audio` (mono, `rate` Hz, kMinRate..kMaxRate: the acoustic front end takes the
-  // rate as it is, over the model's 130..6800 Hz band). False with `error`, and `out` one
-  // pause, when the model cannot be loaded or the build has no recognizer; every audio input
-  // gives phonemes, with `problem` saying what was wrong.
-  bool recognize(std::span<const int16_t> audio, unsigned rate, Recognition& out,
-                 std::string& error);
-
- private:
-  struct Decoders;
-  std::unique_ptr<Decoders> decoders_;
-};
+// Recognizes `audio` (mono, `rate` Hz, kMinRate..kMaxRate: the acoustic front end takes the
+// rate as it is, over the model's 130..6800 Hz band). False with `error`, and `out` one pause,
+// when the model cannot be loaded or the build has no recognizer; every audio input gives
+// phonemes, with `problem` saying what was wrong. Thread-safe: one pocketsphinx decoder per
+// sample rate serves the whole process, made at the first audio of that rate and kept (the
+// model loads in 0.3 s, and pocketsphinx 5prealpha leaks part of each decoder it frees); two
+// threads recognizing at one rate take turns.
+bool recognize(std::span<const int16_t> audio, unsigned rate, Recognition& out, std::string& error);
 
 }  // namespace pfap::align

@@ -191,7 +191,6 @@ int main(int argc, char** argv) {
   std::vector<double> aligned_errors, equal_errors, scaled_errors, costs;
   size_t matched_total = 0, truth_total = 0;
   double audio_seconds = 0, align_seconds = 0, recognize_seconds = 0, recognize_cpu_seconds = 0;
-  pfap::align::Recognizer recognizer;
   const bool recognize = pfap::align::recognition_available();
   Agreement recognized_agreement, aligned_agreement;
   std::vector<pfap::Viseme> truth_frames;  // every sentence's, for the baseline
@@ -271,7 +270,7 @@ int main(int argc, char** argv) {
       pfap::align::Recognition recognition;
       const auto r0 = std::chrono::steady_clock::now();
       const std::clock_t c0 = std::clock();
-      if (!recognizer.recognize(samples, rate, recognition, error)) {
+      if (!pfap::align::recognize(samples, rate, recognition, error)) {
         std::fprintf(stderr, "%s\n", error.c_str());
         return 1;
       }

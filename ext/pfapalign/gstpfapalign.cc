@@ -96,7 +96,6 @@ struct Stream {
   std::array<guint64, 5> problems{};  // per pfap::align::Problem, for pfap_warn_at
   guint64 bad_bookmarks = 0;
   std::set<std::string> warned_phonemes;          // inexact mnemonics already warned about
-  pfap::align::Recognizer recognizer;             // the text-free mode's; its model loads when used
   std::array<guint64, 4> recognition_problems{};  // per pfap::align::RecognitionProblem
 
   std::mutex lock;  // guards what follows, shared with the text pad's thread
@@ -208,7 +207,7 @@ static GstFlowReturn recognize_kept(GstPfapAlign* self) {
   GST_INFO_OBJECT(self, "no text: recognizing %zu samples", s.samples.size());
   pfap::align::Recognition recognition;
   std::string error;
-  if (!s.recognizer.recognize(s.samples, s.rate, recognition, error)) {
+  if (!pfap::align::recognize(s.samples, s.rate, recognition, error)) {
     if (pfap::align::recognition_available()) {  // the model is missing
       GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));
       return GST_FLOW_ERROR;

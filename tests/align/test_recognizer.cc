@@ -47,10 +47,10 @@ std::vector<int16_t> resample(const std::vector<int16_t>& in, unsigned from, uns
   return out;
 }
 
-Recognition recognized(Recognizer& r, const std::vector<int16_t>& audio, unsigned rate) {
+Recognition recognized(const std::vector<int16_t>& audio, unsigned rate) {
   Recognition out;
   std::string error;
-  EXPECT_TRUE(r.recognize(audio, rate, out, error)) << error;
+  EXPECT_TRUE(recognize(audio, rate, out, error)) << error;
   return out;
 }
 
@@ -104,7 +104,6 @@ constexpr double kAgreementBound = 0.40;
 // at espeak-ng's 22050 Hz (and one resampled to 16 kHz): the share of 10 ms frames showing the
 // viseme of espeak-ng's own phoneme times, against the share of the commonest viseme.
 TEST(Recognizer, SyntheticSentencesAgreeOnVisemesWellAboveTheBaseline) {
-  Recognizer recognizer;
   const std::array<const char*, 3> sentences{
       "Please call Stella and ask her to bring these things with her from the store.",
       "The birch canoe slid on the smooth planks.",
@@ -121,7 +120,7 @@ TEST(Recognizer, SyntheticSentencesAgreeOnVisemesWellAboveTheBaseline) {
     for (const unsigned rate : rates) {
       const std::vector<int16_t> audio =
           rate == s.sample_rate ? s.samples : resample(s.samples, s.sample_rate, rate);
-      const Recognition r = recognized(recognizer, audio, rate);
+      const Recognition r = recognized(audio, rate);
       EXPECT_EQ(r.problem, RecognitionProblem::kNone);
       expect_tiles(r, audio.size(), rate);
       const std::vector<Viseme> frames = viseme_frames(timed(r.phonemes, rate), seconds);
@@ -144,13 +143,12 @@ TEST(Recognizer, SyntheticSentencesAgreeOnVisemesWellAboveTheBaseline) {
 }
 
 TEST(Recognizer, SilenceNoiseAndBadRatesAreOnePause) {
-  Recognizer recognizer;
   const std::vector<int16_t> silence(16000, 0);
-  Recognition r = recognized(recognizer, silence, 16000);
+  Recognition r = recognized(silence, 16000);
   EXPECT_EQ(r.problem, RecognitionProblem::kNoSpeech);
   expect_one_pause(r, silence.size(), 16000);
 
-  r = recognized(recognizer, {}, 16000);
+  r = recognized({}, 16000);
   EXPECT_EQ(r.problem, RecognitionProblem::kNoSpeech);
   EXPECT_EQ(r.phonemes.size(), 1u);
 
@@ -160,13 +158,13 @@ TEST(Recognizer, SilenceNoiseAndBadRatesAreOnePause) {
     x = x * 1664525 + 1013904223;
     v = static_cast<int16_t>(static_cast<int>((x >> 16) % 16000) - 8000);
   }
-  r = recognized(recognizer, noise, 16000);
+  r = recognized(noise, 16000);
   EXPECT_EQ(r.problem, RecognitionProblem::kNothingHeard);
   expect_one_pause(r, noise.size(), 16000);
 
   const tts::Speech s = say("Hello there.", {});
   for (const unsigned rate : {8000u, 96000u}) {
-    r = recognized(recognizer, s.samples, rate);
+    r = recognized(s.samples, rate);
     EXPECT_EQ(r.problem, RecognitionProblem::kBadRate);
     expect_one_pause(r, s.samples.size(), rate);
   }
