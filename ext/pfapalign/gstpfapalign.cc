@@ -25,9 +25,14 @@
  * the one before (so a file read in blocks is one utterance); the first starts at the audio's
  * start. Audio before the first utterance is a pause.
  *
+ * Without a text (no #GstPfapAlign:text, `text_sink` not linked or given nothing), the
+ * phonemes are recognized from the audio alone: pocketsphinx's all-phone search with its US
+ * English model, whose visemes are right on most 10 ms frames (docs/align.md). Built only with
+ * pocketsphinx (meson feature `recognition`); without it, a warning and one pause.
+ *
  * The phonemes come when the audio ends (EOS, a new segment or sample rate), after the text
  * pad's EOS: this element is for recordings, not live sources (docs/align.md says what is not
- * done). Silence, noise, a text that does not match, an empty text, bad bookmarks and
+ * done). Silence, noise, a text that does not match, an empty text or none, bad bookmarks and
  * unsupported rates each give a warning (rate-limited), and the stream goes on: an utterance
  * that cannot be aligned is one pause carrying its bookmarks.
  *
@@ -35,6 +40,9 @@
  * |[
  * gst-launch-1.0 filesrc location=speech.wav ! wavparse ! audioconvert ! audioresample ! pfapalign text="Hello world." name=a a.src ! fakesink a.pfap ! pfaptextenc ! filesink location=speech.pfap
  * ]| A WAV and its text to a .pfap file.
+ * |[
+ * gst-launch-1.0 filesrc location=speech.wav ! wavparse ! audioconvert ! audioresample ! audio/x-raw,rate=16000 ! pfapalign name=a a.src ! queue ! fakesink a.pfap ! queue ! pfaptextenc ! filesink location=speech.pfap
+ * ]| A WAV without its text: the phonemes recognized.
  */
 // clang-format on
 #include "gstpfapalign.h"
@@ -50,9 +58,10 @@
 #include <vector>
 
 #include "aligner.h"
-#include "pfap/markup.h"
 #include "markupbuffer.h"
+#include "pfap/markup.h"
 #include "ratelimit.h"
+#include "recognizer.h"
 #include "sparse.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapalign_debug);
@@ -86,7 +95,8 @@ struct Stream {
   bool pfap_discont = true;
   std::array<guint64, 5> problems{};  // per pfap::align::Problem, for pfap_warn_at
   guint64 bad_bookmarks = 0;
-  std::set<std::string> warned_phonemes;  // inexact mnemonics already warned about
+  std::set<std::string> warned_phonemes;          // inexact mnemonics already warned about
+  std::array<guint64, 4> recognition_problems{};  // per pfap::align::RecognitionProblem
 
   std::mutex lock;  // guards what follows, shared with the text pad's thread
   std::condition_variable text_changed;
@@ -163,6 +173,62 @@ static void warn_problem(GstPfapAlign* self, pfap::align::Problem problem, GstCl
        pfap::align::kPoorMatchCost, s.problems[static_cast<size_t>(problem)]));
 }
 
+// Pushes `phonemes`, whose starts count from sample `from` of the audio kept, on `pfap`.
+static GstFlowReturn push_phonemes(GstPfapAlign* self,
+                                   const std::vector<pfap::tts::SpokenPhoneme>& phonemes,
+                                   size_t from) {
+  Stream& s = *self->stream;
+  GstFlowReturn ret = GST_FLOW_OK;
+  for (const pfap::tts::SpokenPhoneme& p : phonemes) {
+    if (ret != GST_FLOW_OK) break;
+    GstBuffer* buffer = pfap_buffer_new(p.event);
+    if (buffer == nullptr) {
+      // align() and recognize() keep every value in range: a bug.
+      GST_ELEMENT_ERROR(self, STREAM, FAILED, (nullptr), ("a phoneme x-pfap cannot hold"));
+      return GST_FLOW_ERROR;
+    }
+    const GstClockTime start = s.first + gst_util_uint64_scale(from + p.start, GST_SECOND, s.rate);
+    const GstClockTime end =
+        s.first + gst_util_uint64_scale(from + p.start + p.n_samples, GST_SECOND, s.rate);
+    GST_BUFFER_PTS(buffer) = start;
+    GST_BUFFER_DURATION(buffer) = end - start;
+    if (s.pfap_discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
+    s.pfap_discont = false;
+    ret = gst_flow_combiner_update_pad_flow(self->flow_combiner, self->pfappad,
+                                            gst_pad_push(self->pfappad, buffer));
+  }
+  return ret;
+}
+
+// Without a text: the phonemes of all the audio kept recognized from it alone (the
+// `recognition` build), or one pause with a warning where the build cannot.
+static GstFlowReturn recognize_kept(GstPfapAlign* self) {
+  Stream& s = *self->stream;
+  GST_INFO_OBJECT(self, "no text: recognizing %zu samples", s.samples.size());
+  pfap::align::Recognition recognition;
+  std::string error;
+  if (!pfap::align::recognize(s.samples, s.rate, recognition, error)) {
+    if (pfap::align::recognition_available()) {  // the model is missing
+      GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));
+      return GST_FLOW_ERROR;
+    }
+    GST_ELEMENT_WARNING(self, STREAM, DECODE,
+                        ("No text for the audio, and this build cannot recognize phonemes "
+                         "without it: the audio is one pause"),
+                        ("set the text property or link text_sink; the text-free mode needs "
+                         "pocketsphinx (meson feature `recognition`)"));
+  } else if (recognition.problem != pfap::align::RecognitionProblem::kNone) {
+    const auto problem = static_cast<size_t>(recognition.problem);
+    if (pfap_warn_at(++s.recognition_problems[problem])) {
+      GST_ELEMENT_WARNING(self, STREAM, DECODE,
+                          ("Audio at %" GST_TIME_FORMAT " without text: %s", GST_TIME_ARGS(s.first),
+                           pfap::align::problem_text(recognition.problem)),
+                          ("%" G_GUINT64_FORMAT " so far", s.recognition_problems[problem]));
+    }
+  }
+  return push_phonemes(self, recognition.phonemes, 0);
+}
+
 // Aligns `bytes` to samples [from, to) and pushes its phonemes on `pfap`. `is_text`: false
 // for the audio before the first utterance, whose empty text is no problem.
 static GstFlowReturn align_utterance(GstPfapAlign* self, const std::string& bytes, size_t from,
@@ -213,26 +279,7 @@ static GstFlowReturn align_utterance(GstPfapAlign* self, const std::string& byte
                         ("sent as %s", sent_as.c_str()));
   }
 
-  GstFlowReturn ret = GST_FLOW_OK;
-  for (const pfap::tts::SpokenPhoneme& p : alignment.phonemes) {
-    if (ret != GST_FLOW_OK) break;
-    GstBuffer* buffer = pfap_buffer_new(p.event);
-    if (buffer == nullptr) {
-      // align() keeps every value in range: a bug.
-      GST_ELEMENT_ERROR(self, STREAM, FAILED, (nullptr), ("a phoneme x-pfap cannot hold"));
-      return GST_FLOW_ERROR;
-    }
-    const GstClockTime start = s.first + gst_util_uint64_scale(from + p.start, GST_SECOND, s.rate);
-    const GstClockTime end =
-        s.first + gst_util_uint64_scale(from + p.start + p.n_samples, GST_SECOND, s.rate);
-    GST_BUFFER_PTS(buffer) = start;
-    GST_BUFFER_DURATION(buffer) = end - start;
-    if (s.pfap_discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
-    s.pfap_discont = false;
-    ret = gst_flow_combiner_update_pad_flow(self->flow_combiner, self->pfappad,
-                                            gst_pad_push(self->pfappad, buffer));
-  }
-  return ret;
+  return push_phonemes(self, alignment.phonemes, from);
 }
 
 // Aligns the audio kept so far with its texts and pushes the phonemes, then forgets both. At
@@ -289,14 +336,11 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
   }
   std::stable_sort(utterances.begin(), utterances.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
-  if (utterances.empty()) {
-    GST_ELEMENT_WARNING(self, STREAM, DECODE, ("No text for the audio: it is one pause"),
-                        ("set the text property or link text_sink"));
-  }
-
   GstFlowReturn ret = GST_FLOW_OK;
-  if (utterances.empty() || utterances.front().first > 0) {
-    ret = align_utterance(self, "", 0, utterances.empty() ? n : utterances.front().first, false);
+  if (utterances.empty()) {
+    ret = recognize_kept(self);
+  } else if (utterances.front().first > 0) {
+    ret = align_utterance(self, "", 0, utterances.front().first, false);
   }
   for (size_t i = 0; i < utterances.size() && ret == GST_FLOW_OK; ++i) {
     const size_t to = i + 1 < utterances.size() ? utterances[i + 1].first : n;
@@ -491,6 +535,7 @@ static GstStateChangeReturn gst_pfap_align_change_state(GstElement* element,
     reset(self);
     s.rate = 0;
     s.problems = {};
+    s.recognition_problems = {};
     s.bad_bookmarks = 0;
     s.warned_phonemes.clear();
     unsigned rate = 0;
@@ -603,8 +648,9 @@ static void gst_pfap_align_class_init(GstPfapAlignClass* klass) {
   gst_element_class_add_static_pad_template(element_class, &pfap_template);
   gst_element_class_set_static_metadata(
       element_class, "PFAP forced alignment", "Filter/Analyzer/Audio",
-      "Aligns the phonemes of a text to a recording of it: the audio unchanged, and its "
-      "phonemes with bookmarks' facial animation parameters (PFAP) as application/x-pfap",
+      "Aligns the phonemes of a text to a recording of it, or recognizes them without the text: "
+      "the audio unchanged, and its phonemes with bookmarks' facial animation parameters (PFAP) "
+      "as application/x-pfap",
       "gst-pfap developers");
 
   element_class->change_state = gst_pfap_align_change_state;
