@@ -25,6 +25,8 @@
 #include <cstring>
 #include <string>
 
+#include "launch_value.h"
+
 namespace {
 
 constexpr const char* kDefaultText =
@@ -105,16 +107,6 @@ int parse_options(int argc, char** argv, Options& options) {
     }
   }
   return 0;
-}
-
-// A launch description's string value, double-quoted with its quotes and backslashes escaped.
-std::string quoted(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
 }
 
 std::string sender_description(const Options& o) {

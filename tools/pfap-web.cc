@@ -33,6 +33,7 @@
 #include <random>
 #include <string>
 
+#include "launch_value.h"
 #include "pfap/model.h"
 #include "pfap/payload.h"
 #include "pfap/recovery.h"
@@ -336,16 +337,6 @@ GstPadProbeReturn on_sink_gap(GstPad*, GstPadProbeInfo* info, gpointer data) {
   }
   if (std::shared_ptr<Session> session = session_of(data)) post(session, speaker_done);
   return GST_PAD_PROBE_OK;
-}
-
-// A launch description's string value, double-quoted with its quotes and backslashes escaped.
-std::string quoted(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
 }
 
 // Starts saying `text` now, or after the text being said.
