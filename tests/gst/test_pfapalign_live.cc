@@ -176,16 +176,24 @@ TEST(PfapAlignLive, DeclaresItsLatencyAndKeepsThePhonemesInSyncWithinIt) {
   // Each left within the bound of the audio it describes: before the EOS, no phoneme starts
   // more than kBound before the end of the audio taken so far.
   size_t early = 0;
+  GstClockTime most_behind = 0, most_late = 0;
   for (const Pushed& e : got) {
     if (e.audio_end < next) {
       ++early;
       EXPECT_LE(e.audio_end, e.pts + kBound) << "phoneme at " << e.pts;
+      most_behind = std::max(most_behind, e.audio_end - e.pts);
+      most_late = std::max(most_late, e.running > e.pts ? e.running - e.pts : 0);
     }
     // And by the clock, so that sinks waiting the declared latency have it: with a second to
     // spare for a loaded machine (the stream-time bound above is the exact one).
     EXPECT_LE(e.running, e.pts + kDeclared + GST_SECOND) << "phoneme at " << e.pts;
   }
   EXPECT_GT(early, got.size() / 2) << "most phonemes leave before the audio ends";
+  std::printf("live pipeline: a phoneme's start at most %.0f ms before the audio's end, pushed "
+              "at most %.0f ms after its start by the clock (declared %.0f ms)\n",
+              static_cast<double>(most_behind) / GST_MSECOND,
+              static_cast<double>(most_late) / GST_MSECOND,
+              static_cast<double>(kDeclared) / GST_MSECOND);
 
   // In sync with the audio they describe: the phonemes (pieces of one merged) where espeak-ng
   // put them in the recording.
