@@ -13,6 +13,8 @@ namespace {
 // The recording's features are computed over the audio since the settled point and up to this
 // much before it: enough speech for the MFCCs' normalization, a bounded cost per step.
 constexpr unsigned kContextMs = 1000;
+// The audio before the context is dropped once there is this much of it.
+constexpr unsigned kTrimMs = 2000;
 // Quieter than this, the recording's loudest frame so far is not taken for speech: the level
 // dimension is measured below this, so that the silence before someone speaks stays a pause.
 constexpr float kMinLoudestDb = kSpeechLevelDb + 20;
@@ -120,8 +122,8 @@ bool StreamingAligner::start(const tts::Utterance& utterance, const tts::VoiceSe
 void StreamingAligner::push(std::span<const int16_t> samples,
                             std::vector<tts::SpokenPhoneme>& out) {
   rec_.insert(rec_.end(), samples.begin(), samples.end());
-  if (rec_.size() - last_step_ < samples_of(kStepMs, rate_)) return;
-  last_step_ = rec_.size();
+  if (this->samples() - last_step_ < samples_of(kStepMs, rate_)) return;
+  last_step_ = this->samples();
   step(false, out);
 }
 
@@ -130,14 +132,14 @@ void StreamingAligner::finish(std::vector<tts::SpokenPhoneme>& out) {
 }
 
 void StreamingAligner::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
-  const size_t n = rec_.size();
+  const size_t n = samples();
   const size_t lookahead = samples_of(kLookaheadMs, rate_);
   const size_t horizon = at_end ? n : n - std::min(n, lookahead);
 
   if (problem_ == Problem::kNone && rec_settled_ < n) {
     const size_t context = samples_of(kContextMs, rate_);
     const size_t w0 = std::min(rec_settled_, n - std::min(n, context));
-    Features rec = mfcc(std::span(rec_).subspan(w0), rate_);
+    Features rec = mfcc(std::span(rec_).subspan(w0 - rec_first_), rate_);
     // The level below the loudest frame of the utterance so far, not of this window.
     loudest_db_ =
         std::max(loudest_db_, *std::max_element(rec.level_db.begin(), rec.level_db.end()));
@@ -193,6 +195,13 @@ void StreamingAligner::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
   if (at_end) {
     while (next_ < syn_.phonemes.size()) emit(n, true, out);
   }
+  // The audio the next steps need: the context before the settled point, which covers
+  // emit()'s half window. The rest goes, a block of kTrimMs at a time.
+  const size_t keep_from = rec_settled_ - std::min(rec_settled_, samples_of(kContextMs, rate_));
+  if (keep_from >= rec_first_ + samples_of(kTrimMs, rate_)) {
+    rec_.erase(rec_.begin(), rec_.begin() + static_cast<std::ptrdiff_t>(keep_from - rec_first_));
+    rec_first_ = keep_from;
+  }
 }
 
 void StreamingAligner::emit(size_t to, bool whole, std::vector<tts::SpokenPhoneme>& out) {
@@ -208,10 +217,12 @@ void StreamingAligner::emit(size_t to, bool whole, std::vector<tts::SpokenPhonem
   // f0 on the piece, YIN's windows centred in it.
   const size_t half_window = 512;
   const size_t a = rec_settled_ - std::min(rec_settled_, half_window);
-  const size_t b = std::min(rec_.size(), to + half_window);
+  const size_t b = std::min(samples(), to + half_window);
   const size_t bounds[] = {rec_settled_ - a, to - a};
   const double hz =
-      to > rec_settled_ ? tts::segment_f0(std::span(rec_).subspan(a, b - a), rate_, bounds)[0] : 0;
+      to > rec_settled_
+          ? tts::segment_f0(std::span(rec_).subspan(a - rec_first_, b - a), rate_, bounds)[0]
+          : 0;
   e.phoneme.f0 = f0_code(static_cast<unsigned>(std::lround(hz)));
   tts::add_phoneme(e, rec_settled_, to, rate_, out);
   rec_settled_ = to;

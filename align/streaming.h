@@ -52,8 +52,8 @@ class StreamingAligner {
 
   Problem problem() const { return problem_; }
   const std::vector<tts::Speech::Inexact>& inexact() const { return syn_.inexact; }
-  size_t samples() const { return rec_.size(); }   // pushed so far
-  size_t settled() const { return rec_settled_; }  // given out so far
+  size_t samples() const { return rec_first_ + rec_.size(); }  // pushed so far
+  size_t settled() const { return rec_settled_; }              // given out so far
 
  private:
   void step(bool at_end, std::vector<tts::SpokenPhoneme>& out);
@@ -64,13 +64,14 @@ class StreamingAligner {
   Problem problem_ = Problem::kNone;
   tts::Speech syn_;  // padded with silence at its start, as align() does
   Features synf_;
-  std::vector<int16_t> rec_;
+  std::vector<int16_t> rec_;  // the utterance's audio from sample rec_first_ (what is needed)
+  size_t rec_first_ = 0;
   float loudest_db_ = -100;    // the utterance's loudest frame so far
-  size_t rec_settled_ = 0;     // samples of rec_ given out
+  size_t rec_settled_ = 0;     // samples of the utterance given out
   size_t syn_settled_ = 0;     // the sample of syn_ matched with rec_settled_
   size_t next_ = 0;            // the phoneme of syn_ going on at rec_settled_
   bool next_started_ = false;  // a piece of it has been given out
-  size_t last_step_ = 0;       // rec_.size() at the last step
+  size_t last_step_ = 0;       // samples() at the last step
 };
 
 }  // namespace pfap::align
