@@ -3,6 +3,7 @@
 // time, 20 ms a buffer, as a microphone would; and the documented line, RTP audio in, audio
 // and phonemes out over RTP. The "recording" is espeak-ng's at another rate and pitch, whose
 // phoneme times are known.
+#include <gst/check/gstharness.h>
 #include <gst/gst.h>
 #include <gtest/gtest.h>
 
@@ -188,11 +189,11 @@ TEST(PfapAlignLive, DeclaresItsLatencyAndKeepsThePhonemesInSyncWithinIt) {
   EXPECT_GT(early, got.size() / 2) << "most phonemes leave before the audio ends";
   // By the clock it depends on the machine keeping up (not at -O0 with sanitizers on a busy
   // machine): printed, not checked.
-  std::printf("live pipeline: a phoneme's start at most %.0f ms before the audio's end, pushed "
-              "at most %.0f ms after its start by the clock (declared %.0f ms)\n",
-              static_cast<double>(most_behind) / GST_MSECOND,
-              static_cast<double>(most_late) / GST_MSECOND,
-              static_cast<double>(kDeclared) / GST_MSECOND);
+  std::printf(
+      "live pipeline: a phoneme's start at most %.0f ms before the audio's end, pushed "
+      "at most %.0f ms after its start by the clock (declared %.0f ms)\n",
+      static_cast<double>(most_behind) / GST_MSECOND, static_cast<double>(most_late) / GST_MSECOND,
+      static_cast<double>(kDeclared) / GST_MSECOND);
 
   // In sync with the audio they describe: the phonemes (pieces of one merged) where espeak-ng
   // put them in the recording.
@@ -218,6 +219,84 @@ TEST(PfapAlignLive, DeclaresItsLatencyAndKeepsThePhonemesInSyncWithinIt) {
   std::printf("live pipeline: %zu phonemes pushed, %zu boundaries, median error %.1f ms\n",
               got.size(), errors.size(), median);
   EXPECT_LT(median, 30);
+}
+
+// Utterances on text_sink, live: each starts at its PTS, the phonemes of the first come while
+// the audio still flows, and the audio passes unchanged.
+TEST(PfapAlignLive, UtterancesOnTheTextPadStartAtTheirPts) {
+  const pfap::tts::Speech a = say("Good morning.", 140, 30);
+  const pfap::tts::Speech b = say("See you tomorrow.", 140, 30);
+  const unsigned rate = a.sample_rate;
+  std::vector<int16_t> audio = a.samples;
+  audio.resize(audio.size() + rate / 2, 0);  // half a second of silence
+  const size_t b_start = audio.size();
+  audio.insert(audio.end(), b.samples.begin(), b.samples.end());
+  const GstClockTime b_time = gst_util_uint64_scale(b_start, GST_SECOND, rate);
+
+  // live is read when the element goes to PAUSED, which the first harness does.
+  GstElement* element = gst_element_factory_make("pfapalign", nullptr);
+  ASSERT_NE(element, nullptr);
+  g_object_set(element, "live", TRUE, nullptr);
+  GstHarness* h = gst_harness_new_with_element(element, "sink", "src");
+  gst_object_unref(element);
+  GstHarness* pfap = gst_harness_new_with_element(h->element, nullptr, "pfap");
+  GstHarness* t = gst_harness_new_with_element(h->element, "text_sink", nullptr);
+  gst_harness_set_src_caps_str(h, ("audio/x-raw, format=(string)S16LE, layout=(string)"
+                                   "interleaved, channels=(int)1, rate=(int)" +
+                                   std::to_string(rate))
+                                      .c_str());
+  gst_harness_set_src_caps_str(t, "text/x-raw, format=(string)utf8");
+  for (const auto& [pts, text] :
+       {std::pair<GstClockTime, std::string>{0, "Good morning."}, {b_time, "See you tomorrow."}}) {
+    GstBuffer* buffer = gst_buffer_new_memdup(text.data(), text.size());
+    GST_BUFFER_PTS(buffer) = pts;
+    ASSERT_EQ(gst_harness_push(t, buffer), GST_FLOW_OK);
+  }
+  std::vector<int16_t> passed;
+  std::vector<std::pair<GstClockTime, pfap::MarkupEvent>> events;
+  size_t before_end = 0;
+  const size_t block = rate / 50;
+  for (size_t i = 0; i < audio.size(); i += block) {
+    const size_t n = std::min(block, audio.size() - i);
+    GstBuffer* buffer = gst_buffer_new_memdup(audio.data() + i, n * 2);
+    GST_BUFFER_PTS(buffer) = gst_util_uint64_scale(i, GST_SECOND, rate);
+    GST_BUFFER_DURATION(buffer) =
+        gst_util_uint64_scale(i + n, GST_SECOND, rate) - GST_BUFFER_PTS(buffer);
+    ASSERT_EQ(gst_harness_push(h, buffer), GST_FLOW_OK);
+    GstBuffer* out = gst_harness_pull(h);
+    GstMapInfo map;
+    ASSERT_TRUE(gst_buffer_map(out, &map, GST_MAP_READ));
+    const auto* samples = reinterpret_cast<const int16_t*>(map.data);
+    passed.insert(passed.end(), samples, samples + map.size / 2);
+    gst_buffer_unmap(out, &map);
+    gst_buffer_unref(out);
+    while (GstBuffer* e = gst_harness_try_pull(pfap)) {
+      pfap::MarkupEvent event;
+      EXPECT_TRUE(pfap_buffer_read(e, event));
+      events.emplace_back(GST_BUFFER_PTS(e), event);
+      gst_buffer_unref(e);
+    }
+    if (i + n < b_start) before_end = events.size();
+  }
+  gst_harness_push_event(t, gst_event_new_eos());
+  gst_harness_push_event(h, gst_event_new_eos());
+  while (GstBuffer* e = gst_harness_try_pull(pfap)) {
+    pfap::MarkupEvent event;
+    EXPECT_TRUE(pfap_buffer_read(e, event));
+    events.emplace_back(GST_BUFFER_PTS(e), event);
+    gst_buffer_unref(e);
+  }
+  EXPECT_EQ(passed, audio);
+  // The first utterance's phonemes, all but the last pause, before the second's audio.
+  EXPECT_GE(before_end + 1, a.phonemes.size());
+  const auto second =
+      std::find_if(events.begin(), events.end(), [&](const auto& e) { return e.first >= b_time; });
+  ASSERT_NE(second, events.end());
+  EXPECT_EQ(second->first, b_time);
+  EXPECT_TRUE(second->second.sentence_start);
+  gst_harness_teardown(t);
+  gst_harness_teardown(pfap);
+  gst_harness_teardown(h);
 }
 
 // The live line of docs/elements.md's pfapalign section, its ports made free ones.
