@@ -819,9 +819,10 @@ static void gst_pfap_align_class_init(GstPfapAlignClass* klass) {
   /**
    * GstPfapAlign:live:
    *
-   * Aligns as the audio comes, for live sources: each phoneme goes out at most 350 ms after
-   * the audio it describes has come, and the LATENCY query says 400 ms more than upstream's
-   * (docs/align.md, "Live"). Off: the phonemes come when the audio ends, aligned on it whole.
+   * Aligns as the audio comes, for live sources: each phoneme goes out by the time 350 ms
+   * (and one upstream buffer) more than its start has come, and the LATENCY query says
+   * 400 ms more than upstream's (docs/align.md, "Live"). Off: the phonemes come when the
+   * audio ends, aligned on it whole. Read when the element goes to PAUSED.
    */
   g_object_class_install_property(
       gobject_class, PROP_LIVE,
