@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "boundaries.h"
 #include "dtw.h"
 #include "f0.h"
 #include "mfcc.h"
@@ -78,6 +79,7 @@ bool align(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
   tts::Speech syn;
   if (!tts::speak(utterance, voice, syn, error)) return false;
   out.inexact = syn.inexact;
+  to_phonetic_boundaries(syn);
 
   if (rate < kMinRate || rate > kMaxRate) {
     out.problem = Problem::kBadRate;
@@ -111,11 +113,17 @@ bool align(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
     out.problem = Problem::kPoorMatch;
   }
 
+  std::vector<double> starts;
+  for (size_t k = 1; k < syn.phonemes.size(); ++k) {
+    starts.push_back(map_boundary(syn.phonemes[k].start + pad, synf, rec, w));
+  }
+  snap_to_silence(syn.phonemes, audio, rate, starts);
+
   // Each phoneme's start on the recording, no earlier than the one before.
   std::vector<size_t> bounds;
   bounds.push_back(0);
   for (size_t k = 1; k < syn.phonemes.size(); ++k) {
-    const double at = map_boundary(syn.phonemes[k].start + pad, synf, rec, w);
+    const double at = starts[k - 1];
     const size_t s =
         static_cast<size_t>(std::clamp(std::lround(at), 0L, static_cast<long>(audio.size())));
     bounds.push_back(std::max(s, bounds.back()));

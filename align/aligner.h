@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Forced alignment of a text to a recording of it: the text is spoken by espeak-ng (tts/,
 // with its phonemes' times, stress, word starts and bookmarks), both are turned into MFCC
-// frames, dynamic time warping matches the frames, and each synthetic phoneme boundary is
-// moved to the recording's time it matches. f0 is measured on the recording. The method and
-// its measured accuracy: docs/align.md.
+// frames, dynamic time warping matches the frames, and each synthetic phoneme boundary (in
+// phonetic convention, boundaries.h) is moved to the recording's time it matches, those next
+// to a pause onto the recording's edge of silence. f0 is measured on the recording. The
+// method and its measured accuracy: docs/align.md.
 #pragma once
 
 #include <cstddef>

@@ -5,25 +5,34 @@
 // The phoneme sequences of the two synthesizers are matched by edit distance, and the
 // boundary error is measured at the start of each phoneme both have in the same place.
 // Prints each sentence and then the median and 90th percentile error of the alignment and of
-// two baselines, the share of phonemes matched and the real-time factor. docs/align.md.
+// two baselines, the share of phonemes matched and the real-time factor. Then, where the build
+// has the recognizer (align/recognizer.h), the text-free mode: the share of 10 ms frames whose
+// viseme is Festival's, beside the alignment's with the text and the baseline of one viseme
+// throughout (the commonest, chosen knowing the truth), and its real-time factor.
+// docs/align.md.
 //
 //   pfap-align-eval DIR NAME...      (tools/align-eval-festival makes DIR and runs this)
 // With PFAP_ALIGN_EVAL_VERBOSE set it prints both phoneme sequences with their starts in ms;
 // PFAP_ALIGN_EVAL_VOICE picks the espeak-ng voice (default "en"); with PFAP_ALIGN_EVAL_LIVE
 // set it aligns as pfapalign live=true does (align/streaming.h, the audio in 20 ms blocks).
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "aligner.h"
 #include "pfap/phoneme_table.h"
+#include "recognizer.h"
 #include "streaming.h"
+#include "viseme_frames.h"
 
 namespace {
 
@@ -119,6 +128,50 @@ std::vector<double> matched_errors(const std::vector<Phone>& got, const std::vec
   return errors;
 }
 
+// Festival's phone (its radio phone set, lower case) as an x-pfap-arpabet symbol: the same
+// names but "ax" (schwa, ARPAbet's unstressed AH) and "pau".
+uint8_t festival_symbol(const std::string& name) {
+  if (name == "pau" || name == "h#" || name == "brth") return 0;
+  std::string upper = name == "ax" ? "AH" : name;
+  for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  const std::optional<uint8_t> symbol =
+      pfap::find_symbol(*pfap::find_alphabet(pfap::kArpabetAlphabet), upper);
+  if (!symbol)
+    std::fprintf(stderr, "Festival phone %s: not in x-pfap-arpabet, a pause\n", name.c_str());
+  return symbol.value_or(0);
+}
+
+std::vector<pfap::align::TimedSymbol> timed(const std::vector<pfap::tts::SpokenPhoneme>& phonemes,
+                                            unsigned rate) {
+  std::vector<pfap::align::TimedSymbol> out;
+  for (const pfap::tts::SpokenPhoneme& p : phonemes) {
+    out.push_back({static_cast<double>(p.start) / rate, p.event.phoneme.symbol});
+  }
+  return out;
+}
+
+// Frames on which `got` shows `truth`'s viseme, added to `same`, over all (`frames`) and over
+// those where the truth is not a pause (`speech_same` of `speech_frames`).
+struct Agreement {
+  size_t same = 0, frames = 0, speech_same = 0, speech_frames = 0;
+  void add(const std::vector<pfap::Viseme>& got, const std::vector<pfap::Viseme>& truth) {
+    for (size_t f = 0; f < std::min(got.size(), truth.size()); ++f) {
+      const bool agree = got[f] == truth[f];
+      same += agree;
+      ++frames;
+      if (truth[f] != pfap::Viseme::kNone) {
+        speech_same += agree;
+        ++speech_frames;
+      }
+    }
+  }
+  void print(const char* what) const {
+    std::printf("%-36s %5.1f %% of frames, %5.1f %% of speech frames\n", what,
+                100.0 * static_cast<double>(same) / std::max<size_t>(frames, 1),
+                100.0 * static_cast<double>(speech_same) / std::max<size_t>(speech_frames, 1));
+  }
+};
+
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
@@ -163,7 +216,10 @@ int main(int argc, char** argv) {
   const pfap::PhonemeAlphabet& arpabet = *pfap::find_alphabet(pfap::kArpabetAlphabet);
   std::vector<double> aligned_errors, equal_errors, scaled_errors, costs;
   size_t matched_total = 0, truth_total = 0;
-  double audio_seconds = 0, align_seconds = 0;
+  double audio_seconds = 0, align_seconds = 0, recognize_seconds = 0, recognize_cpu_seconds = 0;
+  const bool recognize = pfap::align::recognition_available();
+  Agreement recognized_agreement, aligned_agreement;
+  std::vector<pfap::Viseme> truth_frames;  // every sentence's, for the baseline
   for (int a = 2; a < argc; ++a) {
     const std::string base = dir + "/" + argv[a];
     std::vector<int16_t> samples;
@@ -229,11 +285,46 @@ int main(int argc, char** argv) {
     matched_total += matched;
     truth_total += truth.size();
     costs.push_back(alignment.relative_cost);
+
+    std::vector<pfap::align::TimedSymbol> truth_symbols;
+    for (const Phone& p : truth) truth_symbols.push_back({p.start, festival_symbol(p.name)});
+    const std::vector<pfap::Viseme> truth_visemes =
+        pfap::align::viseme_frames(truth_symbols, duration);
+    truth_frames.insert(truth_frames.end(), truth_visemes.begin(), truth_visemes.end());
+    aligned_agreement.add(pfap::align::viseme_frames(timed(alignment.phonemes, rate), duration),
+                          truth_visemes);
+    double recognized_share = 0;
+    if (recognize) {
+      pfap::align::Recognition recognition;
+      const auto r0 = std::chrono::steady_clock::now();
+      const std::clock_t c0 = std::clock();
+      if (!pfap::align::recognize(samples, rate, recognition, error)) {
+        std::fprintf(stderr, "%s\n", error.c_str());
+        return 1;
+      }
+      recognize_seconds +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+      recognize_cpu_seconds += static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
+      const std::vector<pfap::Viseme> visemes =
+          pfap::align::viseme_frames(timed(recognition.phonemes, rate), duration);
+      recognized_agreement.add(visemes, truth_visemes);
+      recognized_share = pfap::align::viseme_agreement(visemes, truth_visemes);
+      if (std::getenv("PFAP_ALIGN_EVAL_VERBOSE") != nullptr) {
+        for (const pfap::tts::SpokenPhoneme& p : recognition.phonemes) {
+          std::printf(
+              " %s@%zu",
+              std::string(pfap::find_phoneme(arpabet, p.event.phoneme.symbol)->name).c_str(),
+              p.start * 1000 / rate);
+        }
+        std::printf("\n");
+      }
+    }
     std::printf(
-        "%s: %.2f s, %zu of %zu phonemes matched, median %.1f ms, p90 %.1f ms, cost %.2f%s\n",
+        "%s: %.2f s, %zu of %zu phonemes matched, median %.1f ms, p90 %.1f ms, cost %.2f%s; "
+        "without text %.0f %% of viseme frames\n",
         argv[a], duration, matched, truth.size(), percentile(e, 0.5) * 1000,
         percentile(e, 0.9) * 1000, alignment.relative_cost,
-        alignment.problem == pfap::align::Problem::kNone ? "" : " (poor)");
+        alignment.problem == pfap::align::Problem::kNone ? "" : " (poor)", recognized_share * 100);
   }
   std::printf("\n%d sentences, %.1f s of audio, %zu boundaries (%zu of %zu phonemes matched)\n",
               argc - 2, audio_seconds, aligned_errors.size(), matched_total, truth_total);
@@ -247,5 +338,35 @@ int main(int argc, char** argv) {
               percentile(costs, 0.5), percentile(costs, 1));
   std::printf("real-time factor: %.3f (%.2f s to align %.1f s, with espeak-ng's synthesis)\n",
               align_seconds / audio_seconds, align_seconds, audio_seconds);
+
+  // The baseline: the viseme most frames show, throughout, over all frames and over speech.
+  std::array<size_t, 15> count{}, speech_count{};
+  for (pfap::Viseme v : truth_frames) {
+    ++count[static_cast<size_t>(v)];
+    if (v != pfap::Viseme::kNone) ++speech_count[static_cast<size_t>(v)];
+  }
+  const size_t speech_total = truth_frames.size() - count[0];
+  std::printf("\nviseme agreement per 10 ms frame (%zu frames, %zu of them speech):\n",
+              truth_frames.size(), speech_total);
+  if (recognize) recognized_agreement.print("without text (pocketsphinx phones)");
+  aligned_agreement.print("with text (pfapalign)");
+  const auto commonest = std::max_element(count.begin(), count.end());
+  const auto commonest_speech = std::max_element(speech_count.begin(), speech_count.end());
+  std::printf("%-36s %5.1f %% of frames (viseme %zu), %5.1f %% of speech frames (viseme %zu)\n",
+              "baseline: one viseme throughout",
+              100.0 * static_cast<double>(*commonest) / std::max<size_t>(truth_frames.size(), 1),
+              static_cast<size_t>(commonest - count.begin()),
+              100.0 * static_cast<double>(*commonest_speech) / std::max<size_t>(speech_total, 1),
+              static_cast<size_t>(commonest_speech - speech_count.begin()));
+  if (recognize) {
+    // The processor time too: on a shared machine the wall clock measures the others' load.
+    std::printf(
+        "real-time factor without text: %.3f (%.2f s to recognize %.1f s; %.2f s of "
+        "processor time, %.3f)\n",
+        recognize_seconds / audio_seconds, recognize_seconds, audio_seconds, recognize_cpu_seconds,
+        recognize_cpu_seconds / audio_seconds);
+  } else {
+    std::printf("without text: this build has no recognizer (-Drecognition)\n");
+  }
   return 0;
 }

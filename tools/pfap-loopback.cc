@@ -4,7 +4,8 @@
 //
 //   sender:   filesrc location=FILE ! pfapparse ! rtppfappay ! udpsink host=127.0.0.1 port=P
 //   receiver: udpsrc address=127.0.0.1 port=P do-timestamp=false caps=application/x-rtp,...
-//             ! rtpjitterbuffer mode=none ! rtppfapdepay ! pfaptextenc ! fdsink fd=1
+//             ! rtpjitterbuffer mode=none max-dropout-time=0 max-misorder-time=0
+//             ! rtppfapdepay ! pfaptextenc ! fdsink fd=1
 //
 // The receiver binds port 0 (the system picks a free port) and the sender is started on the
 // port it got. Standard output gets the received session in canonical form, with times
@@ -300,7 +301,8 @@ int main(int argc, char** argv) {
   const std::string receiver_description =
       std::string("udpsrc name=udpsrc address=127.0.0.1 port=0 do-timestamp=false caps=\"") +
       kRtpCaps +
-      "\" ! rtpjitterbuffer mode=none ! rtppfapdepay name=depay ! pfaptextenc ! "
+      "\" ! rtpjitterbuffer mode=none max-dropout-time=0 max-misorder-time=0 "
+      "! rtppfapdepay name=depay ! pfaptextenc ! "
       "fdsink fd=1 sync=false";
   lb.receiver = launch(receiver_description.c_str(), "receiver");
   lb.sender = launch(

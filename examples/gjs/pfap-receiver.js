@@ -3,7 +3,10 @@
 // Prints the phonemes of a PFAP RTP stream received on UDP, in JavaScript (gjs): the same
 // GstPfap-1.0 API as examples/python/pfap-receiver.py, through GObject-Introspection.
 //
-//   udpsrc ! rtpjitterbuffer ! rtppfapdepay ! appsink
+//   udpsrc ! rtpjitterbuffer max-dropout-time=0 max-misorder-time=0 ! rtppfapdepay ! appsink
+//
+// (the jitterbuffer's windows fixed, so that a flood of spoofed packets cannot stall it:
+// docs/security.md, "Floods").
 //
 // Usage: pfap-receiver.js [--port PORT] [--idle-exit SECONDS]
 // From a build tree, set GI_TYPELIB_PATH, LD_LIBRARY_PATH and GST_PLUGIN_PATH (docs/apps.md).
@@ -51,7 +54,8 @@ function main(argv) {
     Gst.init(null);
     const pipeline = Gst.parse_launch(
         'udpsrc name=src address=127.0.0.1 caps="application/x-rtp,media=application,' +
-        'encoding-name=PFAP,clock-rate=44100" ! rtpjitterbuffer ! rtppfapdepay ! ' +
+        'encoding-name=PFAP,clock-rate=44100" ! rtpjitterbuffer max-dropout-time=0 ' +
+        'max-misorder-time=0 ! rtppfapdepay ! ' +
         `appsink name=sink caps=${GstPfap.CAPS} sync=false`);
     pipeline.get_by_name('src').port = args.port;
     const sink = pipeline.get_by_name('sink');

@@ -62,7 +62,8 @@ def main():
     else:
         pipeline = Gst.parse_launch(
             "udpsrc name=src caps=\"application/x-rtp,media=application,encoding-name=PFAP,"
-            "clock-rate=44100\" ! rtpjitterbuffer ! rtppfapdepay ! appsink name=sink sync=true")
+            "clock-rate=44100\" ! rtpjitterbuffer max-dropout-time=0 max-misorder-time=0 "
+            "! rtppfapdepay ! appsink name=sink sync=true")
         pipeline.get_by_name("src").set_property("port", args.port)
     sink = pipeline.get_by_name("sink")
     state = GstPfap.FapState.new()

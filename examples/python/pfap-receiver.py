@@ -2,8 +2,10 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """Prints the phonemes and FAPs of a PFAP RTP stream received on UDP.
 
-    udpsrc ! rtpjitterbuffer ! rtppfapdepay ! appsink
+    udpsrc ! rtpjitterbuffer max-dropout-time=0 max-misorder-time=0 ! rtppfapdepay ! appsink
 
+(the jitterbuffer's windows fixed, so that a flood of spoofed packets cannot stall it:
+docs/security.md, "Floods").
 Each application/x-pfap buffer from appsink is read with GstPfap.Event (libgstpfap through
 GObject-Introspection), phoneme symbols named with the stream's alphabet. Send it something:
 
@@ -65,7 +67,8 @@ def main():
 
     Gst.init(None)
     pipeline = Gst.parse_launch(
-        "udpsrc name=src ! rtpjitterbuffer ! rtppfapdepay ! "
+        "udpsrc name=src ! rtpjitterbuffer max-dropout-time=0 max-misorder-time=0 "
+        "! rtppfapdepay ! "
         "appsink name=sink caps=%s sync=false" % GstPfap.CAPS)
     src = pipeline.get_by_name("src")
     src.set_property("address", args.address)

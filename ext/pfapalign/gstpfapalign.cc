@@ -25,9 +25,15 @@
  * the one before (so a file read in blocks is one utterance); the first starts at the audio's
  * start. Audio before the first utterance is a pause.
  *
+ * Without a text (no #GstPfapAlign:text, `text_sink` not linked or given nothing), the
+ * phonemes are recognized from the audio alone: pocketsphinx's all-phone search with its US
+ * English model, whose visemes are right on most 10 ms frames (docs/align.md). Built only with
+ * pocketsphinx (meson feature `recognition`); without it, a warning and one pause.
+ *
  * The phonemes come when the audio ends (EOS, a new segment or sample rate), after the text
  * pad's EOS; with #GstPfapAlign:live, for live sources, as the audio comes, each within the
- * latency the element declares (docs/align.md, "Live"). Silence, noise, a text that does not match, an empty text, bad bookmarks and
+ * latency the element declares (docs/align.md, "Live"). Silence, noise, a text that does not
+ * match, an empty text or none, bad bookmarks and
  * unsupported rates each give a warning (rate-limited), and the stream goes on: an utterance
  * that cannot be aligned is one pause carrying its bookmarks.
  *
@@ -35,6 +41,9 @@
  * |[
  * gst-launch-1.0 filesrc location=speech.wav ! wavparse ! audioconvert ! audioresample ! pfapalign text="Hello world." name=a a.src ! fakesink a.pfap ! pfaptextenc ! filesink location=speech.pfap
  * ]| A WAV and its text to a .pfap file.
+ * |[
+ * gst-launch-1.0 filesrc location=speech.wav ! wavparse ! audioconvert ! audioresample ! audio/x-raw,rate=16000 ! pfapalign name=a a.src ! queue ! fakesink a.pfap ! queue ! pfaptextenc ! filesink location=speech.pfap
+ * ]| A WAV without its text: the phonemes recognized.
  * |[
  * gst-launch-1.0 rtpbin name=r udpsrc address=127.0.0.1 port=5004 caps="application/x-rtp,media=audio,clock-rate=16000,encoding-name=L16,channels=1,payload=96" ! rtpjitterbuffer latency=50 ! rtpL16depay ! audioconvert ! audio/x-raw,format=S16LE ! pfapalign live=true text="Hello world." name=a a.src ! queue ! audioconvert ! rtpL16pay pt=96 ! r.send_rtp_sink_0 r.send_rtp_src_0 ! udpsink host=127.0.0.1 port=5000 r.send_rtcp_src_0 ! udpsink host=127.0.0.1 port=5001 sync=false async=false a.pfap ! queue ! rtppfappay pt=97 ! r.send_rtp_sink_1 r.send_rtp_src_1 ! udpsink host=127.0.0.1 port=5002 r.send_rtcp_src_1 ! udpsink host=127.0.0.1 port=5003 sync=false async=false
  * ]| Live RTP audio in; the audio and its phonemes out as two RTP sessions, in sync by RTCP.
@@ -56,6 +65,7 @@
 #include "markupbuffer.h"
 #include "pfap/markup.h"
 #include "ratelimit.h"
+#include "recognizer.h"
 #include "sparse.h"
 #include "streaming.h"
 
@@ -91,7 +101,8 @@ struct Stream {
   bool pfap_discont = true;
   std::array<guint64, 5> problems{};  // per pfap::align::Problem, for pfap_warn_at
   guint64 bad_bookmarks = 0;
-  std::set<std::string> warned_phonemes;  // inexact mnemonics already warned about
+  std::set<std::string> warned_phonemes;          // inexact mnemonics already warned about
+  std::array<guint64, 4> recognition_problems{};  // per pfap::align::RecognitionProblem
 
   // Live: upstream is live, and the phonemes go out as the audio comes (live_* below).
   bool live = false;
@@ -179,6 +190,62 @@ static void warn_problem(GstPfapAlign* self, pfap::align::Problem problem, GstCl
        pfap::align::kPoorMatchCost, s.problems[static_cast<size_t>(problem)]));
 }
 
+// Pushes `phonemes`, whose starts count from sample `from` of the audio kept, on `pfap`.
+static GstFlowReturn push_phonemes(GstPfapAlign* self,
+                                   const std::vector<pfap::tts::SpokenPhoneme>& phonemes,
+                                   size_t from) {
+  Stream& s = *self->stream;
+  GstFlowReturn ret = GST_FLOW_OK;
+  for (const pfap::tts::SpokenPhoneme& p : phonemes) {
+    if (ret != GST_FLOW_OK) break;
+    GstBuffer* buffer = pfap_buffer_new(p.event);
+    if (buffer == nullptr) {
+      // align() and recognize() keep every value in range: a bug.
+      GST_ELEMENT_ERROR(self, STREAM, FAILED, (nullptr), ("a phoneme x-pfap cannot hold"));
+      return GST_FLOW_ERROR;
+    }
+    const GstClockTime start = s.first + gst_util_uint64_scale(from + p.start, GST_SECOND, s.rate);
+    const GstClockTime end =
+        s.first + gst_util_uint64_scale(from + p.start + p.n_samples, GST_SECOND, s.rate);
+    GST_BUFFER_PTS(buffer) = start;
+    GST_BUFFER_DURATION(buffer) = end - start;
+    if (s.pfap_discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
+    s.pfap_discont = false;
+    ret = gst_flow_combiner_update_pad_flow(self->flow_combiner, self->pfappad,
+                                            gst_pad_push(self->pfappad, buffer));
+  }
+  return ret;
+}
+
+// Without a text: the phonemes of all the audio kept recognized from it alone (the
+// `recognition` build), or one pause with a warning where the build cannot.
+static GstFlowReturn recognize_kept(GstPfapAlign* self) {
+  Stream& s = *self->stream;
+  GST_INFO_OBJECT(self, "no text: recognizing %zu samples", s.samples.size());
+  pfap::align::Recognition recognition;
+  std::string error;
+  if (!pfap::align::recognize(s.samples, s.rate, recognition, error)) {
+    if (pfap::align::recognition_available()) {  // the model is missing
+      GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));
+      return GST_FLOW_ERROR;
+    }
+    GST_ELEMENT_WARNING(self, STREAM, DECODE,
+                        ("No text for the audio, and this build cannot recognize phonemes "
+                         "without it: the audio is one pause"),
+                        ("set the text property or link text_sink; the text-free mode needs "
+                         "pocketsphinx (meson feature `recognition`)"));
+  } else if (recognition.problem != pfap::align::RecognitionProblem::kNone) {
+    const auto problem = static_cast<size_t>(recognition.problem);
+    if (pfap_warn_at(++s.recognition_problems[problem])) {
+      GST_ELEMENT_WARNING(self, STREAM, DECODE,
+                          ("Audio at %" GST_TIME_FORMAT " without text: %s", GST_TIME_ARGS(s.first),
+                           pfap::align::problem_text(recognition.problem)),
+                          ("%" G_GUINT64_FORMAT " so far", s.recognition_problems[problem]));
+    }
+  }
+  return push_phonemes(self, recognition.phonemes, 0);
+}
+
 // The utterance of the text `bytes` starting at `at`, bad UTF-8 and bookmarks warned about.
 static pfap::tts::Utterance parse_text(GstPfapAlign* self, const std::string& bytes,
                                        GstClockTime at) {
@@ -226,27 +293,6 @@ static void warn_inexact(GstPfapAlign* self, const std::vector<pfap::tts::Speech
   }
 }
 
-// Pushes `phoneme` (its samples counted from `from`, a sample of the segment from `first`).
-static GstFlowReturn push_phoneme(GstPfapAlign* self, const pfap::tts::SpokenPhoneme& p,
-                                  size_t from) {
-  Stream& s = *self->stream;
-  GstBuffer* buffer = pfap_buffer_new(p.event);
-  if (buffer == nullptr) {
-    // align() keeps every value in range: a bug.
-    GST_ELEMENT_ERROR(self, STREAM, FAILED, (nullptr), ("a phoneme x-pfap cannot hold"));
-    return GST_FLOW_ERROR;
-  }
-  const GstClockTime start = s.first + gst_util_uint64_scale(from + p.start, GST_SECOND, s.rate);
-  const GstClockTime end =
-      s.first + gst_util_uint64_scale(from + p.start + p.n_samples, GST_SECOND, s.rate);
-  GST_BUFFER_PTS(buffer) = start;
-  GST_BUFFER_DURATION(buffer) = end - start;
-  if (s.pfap_discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
-  s.pfap_discont = false;
-  return gst_flow_combiner_update_pad_flow(self->flow_combiner, self->pfappad,
-                                           gst_pad_push(self->pfappad, buffer));
-}
-
 // Aligns `bytes` to samples [from, to) and pushes its phonemes on `pfap`. `is_text`: false
 // for the audio before the first utterance, whose empty text is no problem.
 static GstFlowReturn align_utterance(GstPfapAlign* self, const std::string& bytes, size_t from,
@@ -269,11 +315,7 @@ static GstFlowReturn align_utterance(GstPfapAlign* self, const std::string& byte
   if (is_text) warn_problem(self, alignment.problem, at, alignment.relative_cost);
   warn_inexact(self, alignment.inexact, voice);
 
-  GstFlowReturn ret = GST_FLOW_OK;
-  for (size_t k = 0; k < alignment.phonemes.size() && ret == GST_FLOW_OK; ++k) {
-    ret = push_phoneme(self, alignment.phonemes[k], from);
-  }
-  return ret;
+  return push_phonemes(self, alignment.phonemes, from);
 }
 
 // The sample, counted from `first`, where a text at `running_time` starts; 0 before the audio.
@@ -334,14 +376,11 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
   }
   std::stable_sort(utterances.begin(), utterances.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
-  if (utterances.empty()) {
-    GST_ELEMENT_WARNING(self, STREAM, DECODE, ("No text for the audio: it is one pause"),
-                        ("set the text property or link text_sink"));
-  }
-
   GstFlowReturn ret = GST_FLOW_OK;
-  if (utterances.empty() || utterances.front().first > 0) {
-    ret = align_utterance(self, "", 0, utterances.empty() ? n : utterances.front().first, false);
+  if (utterances.empty()) {
+    ret = recognize_kept(self);
+  } else if (utterances.front().first > 0) {
+    ret = align_utterance(self, "", 0, utterances.front().first, false);
   }
   for (size_t i = 0; i < utterances.size() && ret == GST_FLOW_OK; ++i) {
     const size_t to = i + 1 < utterances.size() ? utterances[i + 1].first : n;
@@ -359,11 +398,7 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
 
 static GstFlowReturn live_push(GstPfapAlign* self,
                                const std::vector<pfap::tts::SpokenPhoneme>& phonemes) {
-  GstFlowReturn ret = GST_FLOW_OK;
-  for (size_t k = 0; k < phonemes.size() && ret == GST_FLOW_OK; ++k) {
-    ret = push_phoneme(self, phonemes[k], self->stream->utterance_from);
-  }
-  return ret;
+  return push_phonemes(self, phonemes, self->stream->utterance_from);
 }
 
 // Ends the open utterance at the audio so far and pushes its last phonemes.
@@ -453,7 +488,8 @@ static GstFlowReturn live_chain(GstPfapAlign* self, GstBuffer* buffer) {
     const bool from_pad = gst_pad_is_linked(self->textpad);
     if (!from_pad && !has_property) {
       GST_ELEMENT_WARNING(self, STREAM, DECODE, ("No text for the audio: it is one pause"),
-                          ("set the text property or link text_sink"));
+                          ("set the text property or link text_sink; recognition without the "
+                           "text is not live"));
     }
     ret = live_start_utterance(self, from_pad ? "" : property, !from_pad && has_property);
   }
@@ -702,6 +738,7 @@ static GstStateChangeReturn gst_pfap_align_change_state(GstElement* element,
     reset(self);
     s.rate = 0;
     s.problems = {};
+    s.recognition_problems = {};
     s.bad_bookmarks = 0;
     s.warned_phonemes.clear();
     GST_OBJECT_LOCK(self);
@@ -837,8 +874,9 @@ static void gst_pfap_align_class_init(GstPfapAlignClass* klass) {
   gst_element_class_add_static_pad_template(element_class, &pfap_template);
   gst_element_class_set_static_metadata(
       element_class, "PFAP forced alignment", "Filter/Analyzer/Audio",
-      "Aligns the phonemes of a text to a recording of it: the audio unchanged, and its "
-      "phonemes with bookmarks' facial animation parameters (PFAP) as application/x-pfap",
+      "Aligns the phonemes of a text to a recording of it, or recognizes them without the text: "
+      "the audio unchanged, and its phonemes with bookmarks' facial animation parameters (PFAP) "
+      "as application/x-pfap",
       "gst-pfap developers");
 
   element_class->change_state = gst_pfap_align_change_state;

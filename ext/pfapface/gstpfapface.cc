@@ -55,8 +55,8 @@
 
 #include "face/animator.h"
 #include "face/renderer.h"
-#include "pfap/phoneme_table.h"
 #include "markupbuffer.h"
+#include "pfap/phoneme_table.h"
 #include "pfap/timeline.h"
 #include "warning.h"
 
@@ -69,7 +69,7 @@ constexpr int kDefaultWidth = 640;
 constexpr int kDefaultHeight = 480;
 constexpr int kDefaultFpsN = 25;
 constexpr int kDefaultFpsD = 1;
-constexpr face::Style kDefaultStyle = face::Style::kCartoon;
+constexpr pfap::face::Style kDefaultStyle = pfap::face::Style::kCartoon;
 constexpr gboolean kDefaultDebugOverlay = FALSE;
 // A face at rest for this long draws no more frames until its next markup: one GAP event
 // covers the rest (docs/face.md, "Long silences"), so that a far-off event costs one event,
@@ -79,14 +79,14 @@ constexpr int64_t kMaxRestNs = 10 * GST_SECOND;
 // What the streaming thread keeps between frames. GObject runs no C++ constructors, so it
 // lives behind a pointer made in init and deleted in finalize.
 struct Stream {
-  face::Animator animator;
+  pfap::face::Animator animator;
   GstVideoInfo info{};
   bool negotiated = false;
-  uint64_t frame = 0;          // the next frame's number since the output segment's start
-  int64_t covered_until = -1;  // running time up to which a GAP said no markup comes
-  bool warned_mouth = false;   // the warning for phonemes without a mouth shape was posted
-  bool untimed_input = false;  // a segment not in TIME came: an error was posted
-  pfap::MarkupEvent event;     // reused, so that steady streaming does not allocate
+  uint64_t frame = 0;            // the next frame's number since the output segment's start
+  int64_t covered_until = -1;    // running time up to which a GAP said no markup comes
+  bool warned_mouth = false;     // the warning for phonemes without a mouth shape was posted
+  bool untimed_input = false;    // a segment not in TIME came: an error was posted
+  pfap::MarkupEvent event;       // reused, so that steady streaming does not allocate
   pfap::EventTimeline timeline;  // the input events' running times
   uint64_t malformed = 0;        // input buffers dropped, for the warning's rate limit
 };
@@ -100,7 +100,7 @@ struct _GstPfapFace {
   // Properties, under the object lock.
   int width;
   int height;
-  face::Style style;
+  pfap::face::Style style;
   gboolean debug_overlay;
 };
 
@@ -109,8 +109,8 @@ enum { PROP_0, PROP_WIDTH, PROP_HEIGHT, PROP_STYLE, PROP_DEBUG_OVERLAY };
 GType gst_pfap_face_style_get_type() {
   static gsize type = 0;
   static const GEnumValue values[] = {
-      {static_cast<gint>(face::Style::kCartoon), "Flat colours: skin, hair, lips", "cartoon"},
-      {static_cast<gint>(face::Style::kLine), "Black lines on white, like a sketch", "line"},
+      {static_cast<gint>(pfap::face::Style::kCartoon), "Flat colours: skin, hair, lips", "cartoon"},
+      {static_cast<gint>(pfap::face::Style::kLine), "Black lines on white, like a sketch", "line"},
       {0, nullptr, nullptr},
   };
   if (g_once_init_enter(&type)) {
@@ -206,18 +206,18 @@ static GstFlowReturn push_frame(GstPfapFace* self, GstClockTime pts, GstClockTim
                                 int64_t at) {
   Stream& s = *self->stream;
   GST_OBJECT_LOCK(self);
-  const face::Style style = self->style;
+  const pfap::face::Style style = self->style;
   const bool overlay = self->debug_overlay;
   GST_OBJECT_UNLOCK(self);
 
   GstBuffer* out = gst_buffer_new_allocate(nullptr, GST_VIDEO_INFO_SIZE(&s.info), nullptr);
   GstMapInfo map;
   gst_buffer_map(out, &map, GST_MAP_WRITE);
-  const face::Frame frame{map.data, GST_VIDEO_INFO_WIDTH(&s.info), GST_VIDEO_INFO_HEIGHT(&s.info),
-                          GST_VIDEO_INFO_PLANE_STRIDE(&s.info, 0),
-                          GST_VIDEO_INFO_HAS_ALPHA(&s.info) != FALSE};
-  face::render(s.animator.pose(at), style, overlay ? s.animator.describe(at) : std::string(),
-               frame);
+  const pfap::face::Frame frame{
+      map.data, GST_VIDEO_INFO_WIDTH(&s.info), GST_VIDEO_INFO_HEIGHT(&s.info),
+      GST_VIDEO_INFO_PLANE_STRIDE(&s.info, 0), GST_VIDEO_INFO_HAS_ALPHA(&s.info) != FALSE};
+  pfap::face::render(s.animator.pose(at), style, overlay ? s.animator.describe(at) : std::string(),
+                     frame);
   gst_buffer_unmap(out, &map);
   GST_BUFFER_PTS(out) = pts;
   GST_BUFFER_DURATION(out) = next - pts;
@@ -319,8 +319,8 @@ static GstFlowReturn gst_pfap_face_aggregate(GstAggregator* agg, gboolean timeou
     }
 
     if (known) {
-      const uint64_t rest_end = rest_until_frame(self, segment, at,
-                                                 later_input ? next_input : s.covered_until);
+      const uint64_t rest_end =
+          rest_until_frame(self, segment, at, later_input ? next_input : s.covered_until);
       if (rest_end > 0) {
         skip_to_frame(self, segment, rest_end);
         continue;
@@ -427,7 +427,7 @@ static void gst_pfap_face_set_property(GObject* object, guint prop_id, const GVa
       self->height = g_value_get_int(value);
       break;
     case PROP_STYLE:
-      self->style = static_cast<face::Style>(g_value_get_enum(value));
+      self->style = static_cast<pfap::face::Style>(g_value_get_enum(value));
       break;
     case PROP_DEBUG_OVERLAY:
       self->debug_overlay = g_value_get_boolean(value);

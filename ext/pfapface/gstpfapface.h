@@ -9,7 +9,7 @@ G_BEGIN_DECLS
 #define GST_TYPE_PFAP_FACE (gst_pfap_face_get_type())
 G_DECLARE_FINAL_TYPE(GstPfapFace, gst_pfap_face, GST, PFAP_FACE, GstAggregator)
 
-// The values of GstPfapFace:style, face::Style's looks.
+// The values of GstPfapFace:style, pfap::face::Style's looks.
 #define GST_TYPE_PFAP_FACE_STYLE (gst_pfap_face_style_get_type())
 GType gst_pfap_face_style_get_type(void);
 

@@ -6,7 +6,7 @@
 #include <numbers>
 #include <vector>
 
-namespace face {
+namespace pfap::face {
 namespace {
 
 // The neutral face, in face units (see model.h for the axes).
@@ -309,4 +309,4 @@ FacePose pose_from_faps(const FapValues& f) {
   return pose;
 }
 
-}  // namespace face
+}  // namespace pfap::face

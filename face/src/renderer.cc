@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-namespace face {
+namespace pfap::face {
 namespace {
 
 struct Rgb {
@@ -326,4 +326,4 @@ void render(const FacePose& pose, Style style, std::string_view overlay, const F
   cairo_surface_destroy(surface);
 }
 
-}  // namespace face
+}  // namespace pfap::face

@@ -62,9 +62,7 @@
 #include "pfap/fap_file.h"
 #include "pfap/phoneme_table.h"
 #include "markupbuffer.h"
-#include "noseek.h"
 #include "ratelimit.h"
-#include "sparse.h"
 
 GST_DEBUG_CATEGORY_STATIC(fapparse_debug);
 #define GST_CAT_DEFAULT fapparse_debug
@@ -83,9 +81,7 @@ struct Stream {
   std::optional<pfap::FapFileMarkup> markup;  // once the header is read
   pfap::NotCarried reported;                  // what was already warned about
   std::string tail;                           // the start of a line whose end has not come yet
-  bool need_events = true;                    // stream-start, caps or segment still to send
-  bool discont = true;
-  bool failed = false;  // an error was posted: the rest is dropped
+  bool failed = false;                        // an error was posted: the rest is dropped
   std::vector<pfap::TextEvent> events;
   std::string file;  // the upstream location, for messages; empty when unknown
 };
@@ -111,9 +107,7 @@ constexpr size_t kMaxSpeechEvents = 100'000;
 }  // namespace
 
 struct _GstFapParse {
-  GstElement parent;
-  GstPad* sinkpad;
-  GstPad* srcpad;
+  GstPfapBaseParse parent;
   GstPad* speechpad;     // the request pad, or NULL
   guint silence_symbol;  // under the object lock
   gchar* alphabet;       // under the object lock; NULL when unset
@@ -132,11 +126,12 @@ static GstStaticPadTemplate speech_template = GST_STATIC_PAD_TEMPLATE(
 static GstStaticPadTemplate src_template =
     GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
 
-G_DEFINE_TYPE(GstFapParse, gst_fap_parse, GST_TYPE_ELEMENT)
+G_DEFINE_TYPE(GstFapParse, gst_fap_parse, GST_TYPE_PFAP_BASE_PARSE)
 GST_ELEMENT_REGISTER_DEFINE(fapparse, "fapparse", GST_RANK_NONE, GST_TYPE_FAP_PARSE)
 
 // Back to the start of a file (READY to PAUSED, FLUSH_STOP).
-static void reset(GstFapParse* self) {
+static void gst_fap_parse_reset(GstPfapBaseParse* parse) {
+  GstFapParse* self = GST_FAP_PARSE(parse);
   *self->stream = Stream{};
   g_mutex_lock(&self->merge_lock);
   *self->merge = Merge{};
@@ -156,7 +151,8 @@ static const std::string& file_name(GstFapParse* self) {
   if (!s.file.empty()) return s.file;
   GstQuery* query = gst_query_new_uri();
   gchar* uri = nullptr;
-  if (gst_pad_peer_query(self->sinkpad, query)) gst_query_parse_uri(query, &uri);
+  GstPad* sinkpad = gst_pfap_base_parse_sinkpad(GST_PFAP_BASE_PARSE(self));
+  if (gst_pad_peer_query(sinkpad, query)) gst_query_parse_uri(query, &uri);
   gst_query_unref(query);
   gchar* path = uri != nullptr ? g_filename_from_uri(uri, nullptr, nullptr) : nullptr;
   s.file = path != nullptr ? path : uri != nullptr ? uri : "the FAP file";
@@ -165,36 +161,21 @@ static const std::string& file_name(GstFapParse* self) {
   return s.file;
 }
 
-static void send_events(GstFapParse* self) {
-  Stream& s = *self->stream;
-  if (!s.need_events) return;
-  s.need_events = false;
-  if (GstEvent* start = gst_pad_get_sticky_event(self->srcpad, GST_EVENT_STREAM_START, 0)) {
-    gst_event_unref(start);
-  } else {
-    gchar* id = gst_pad_create_stream_id(self->srcpad, GST_ELEMENT(self), nullptr);
-    gst_pad_push_event(self->srcpad, pfap_make_sparse(gst_event_new_stream_start(id)));
-    g_free(id);
+static GstCaps* gst_fap_parse_output_caps(GstPfapBaseParse* parse) {
+  GstFapParse* self = GST_FAP_PARSE(parse);
+  GstCaps* caps = gst_static_pad_template_get_caps(&src_template);
+  // Merged, the phonemes are mostly the speech's: its alphabet, when it names one.
+  g_mutex_lock(&self->merge_lock);
+  std::string alphabet = self->merge->alphabet;
+  g_mutex_unlock(&self->merge_lock);
+  GST_OBJECT_LOCK(self);
+  if (alphabet.empty() && self->alphabet != nullptr) alphabet = self->alphabet;
+  GST_OBJECT_UNLOCK(self);
+  if (!alphabet.empty()) {
+    caps = gst_caps_make_writable(caps);
+    gst_caps_set_simple(caps, "alphabet", G_TYPE_STRING, alphabet.c_str(), nullptr);
   }
-  if (!gst_pad_has_current_caps(self->srcpad)) {
-    GstCaps* caps = gst_static_pad_template_get_caps(&src_template);
-    // Merged, the phonemes are mostly the speech's: its alphabet, when it names one.
-    g_mutex_lock(&self->merge_lock);
-    std::string alphabet = self->merge->alphabet;
-    g_mutex_unlock(&self->merge_lock);
-    GST_OBJECT_LOCK(self);
-    if (alphabet.empty() && self->alphabet != nullptr) alphabet = self->alphabet;
-    GST_OBJECT_UNLOCK(self);
-    if (!alphabet.empty()) {
-      caps = gst_caps_make_writable(caps);
-      gst_caps_set_simple(caps, "alphabet", G_TYPE_STRING, alphabet.c_str(), nullptr);
-    }
-    gst_pad_push_event(self->srcpad, gst_event_new_caps(caps));
-    gst_caps_unref(caps);
-  }
-  GstSegment segment;
-  gst_segment_init(&segment, GST_FORMAT_TIME);
-  gst_pad_push_event(self->srcpad, gst_event_new_segment(&segment));
+  return caps;
 }
 
 static GstFlowReturn bad_file(GstFapParse* self, const pfap::FapFileResult& result) {
@@ -241,26 +222,12 @@ static void report_not_carried(GstFapParse* self, const pfap::FapFrame& frame) {
   s.reported = now;
 }
 
-// Pushes events, the silence symbol set on the phonemes the file made.
+// Pushes events; the output starts with the first frame, even one that gives none.
 static GstFlowReturn push_events(GstFapParse* self, const std::vector<pfap::TextEvent>& events) {
-  Stream& s = *self->stream;
-  send_events(self);
+  GstPfapBaseParse* parse = GST_PFAP_BASE_PARSE(self);
+  gst_pfap_base_parse_start_output(parse);
   for (const pfap::TextEvent& event : events) {
-    GstBuffer* buffer = pfap_buffer_new(event.event);
-    if (buffer == nullptr) {
-      // The reader keeps values within range and the markup 40 FAPs per phoneme: a bug.
-      GST_ELEMENT_ERROR(
-          self, STREAM, FAILED, (nullptr),
-          ("the event at %" G_GINT64_FORMAT " ms is one x-pfap cannot hold", event.time_ms));
-      return GST_FLOW_ERROR;
-    }
-    GST_BUFFER_PTS(buffer) = event.time_ms * GST_MSECOND;
-    if (event.event.kind == PFAP_EVENT_PHONEME) {
-      GST_BUFFER_DURATION(buffer) = event.event.phoneme.duration_ms * GST_MSECOND;
-    }
-    if (s.discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
-    s.discont = false;
-    const GstFlowReturn ret = gst_pad_push(self->srcpad, buffer);
+    const GstFlowReturn ret = gst_pfap_base_parse_push(parse, event);
     if (ret != GST_FLOW_OK) return ret;
   }
   return GST_FLOW_OK;
@@ -305,7 +272,7 @@ static bool end_of_input(GstFapParse* self, bool file) {
   GST_DEBUG_OBJECT(self, "merging %zu file events with %zu speech events", file_events.size(),
                    speech.size());
   push_events(self, pfap::merge_with_speech(speech, file_events, symbol));
-  gst_pad_push_event(self->srcpad, gst_event_new_eos());
+  gst_pad_push_event(gst_pfap_base_parse_srcpad(GST_PFAP_BASE_PARSE(self)), gst_event_new_eos());
   return true;
 }
 
@@ -319,8 +286,10 @@ static GstFlowReturn read_line(GstFapParse* self, std::string_view line) {
 }
 
 // Splits `data` into lines, completing the tail kept from the chunks before.
-static GstFlowReturn read_chunk(GstFapParse* self, std::string_view data) {
+static GstFlowReturn gst_fap_parse_read_chunk(GstPfapBaseParse* parse, std::string_view data) {
+  GstFapParse* self = GST_FAP_PARSE(parse);
   Stream& s = *self->stream;
+  if (s.failed) return GST_FLOW_ERROR;
   while (!data.empty()) {
     const size_t end = data.find('\n');
     const std::string_view piece = data.substr(0, end);
@@ -346,67 +315,27 @@ static GstFlowReturn read_chunk(GstFapParse* self, std::string_view data) {
   return GST_FLOW_OK;
 }
 
-static GstFlowReturn gst_fap_parse_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
-  GstFapParse* self = GST_FAP_PARSE(parent);
-  if (self->stream->failed) {
-    gst_buffer_unref(buffer);
-    return GST_FLOW_ERROR;
-  }
-  GstMapInfo map;
-  if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) {
-    gst_buffer_unref(buffer);
-    GST_ELEMENT_ERROR(self, RESOURCE, READ, (nullptr), ("cannot map the input buffer"));
-    return GST_FLOW_ERROR;
-  }
-  const GstFlowReturn ret = read_chunk(self, {reinterpret_cast<const char*>(map.data), map.size});
-  gst_buffer_unmap(buffer, &map);
-  gst_buffer_unref(buffer);
-  return ret;
-}
-
-static gboolean gst_fap_parse_sink_event(GstPad* pad, GstObject* parent, GstEvent* event) {
-  GstFapParse* self = GST_FAP_PARSE(parent);
+// At EOS: the last line may have no line end; then the file must be whole. Merging, EOS goes
+// once the speech has ended too.
+static GstFlowReturn gst_fap_parse_finish(GstPfapBaseParse* parse) {
+  GstFapParse* self = GST_FAP_PARSE(parse);
   Stream& s = *self->stream;
-  switch (GST_EVENT_TYPE(event)) {
-    case GST_EVENT_STREAM_START:
-      return gst_pad_push_event(self->srcpad, pfap_make_sparse(event));
-    // The file's bytes say nothing about the output's caps and times.
-    case GST_EVENT_CAPS:
-    case GST_EVENT_SEGMENT:
-    case GST_EVENT_GAP:
-      gst_event_unref(event);
-      return TRUE;
-    case GST_EVENT_EOS: {
-      if (s.failed) break;
-      // The last line may have no line end; then the file must be whole.
-      GstFlowReturn ret = GST_FLOW_OK;
-      if (!s.tail.empty()) {
-        ret = read_line(self, s.tail);
-        s.tail.clear();
-      }
-      if (ret == GST_FLOW_OK) {
-        const pfap::FapFileResult result = s.reader.finish();
-        if (!result.ok()) ret = bad_file(self, result);
-      }
-      if (ret == GST_FLOW_ERROR) {
-        gst_event_unref(event);
-        return FALSE;
-      }
-      if (merging(self)) {
-        gst_event_unref(event);
-        end_of_input(self, true);
-        return TRUE;
-      }
-      send_events(self);
-      break;
-    }
-    case GST_EVENT_FLUSH_STOP:
-      reset(self);
-      break;
-    default:
-      break;
+  if (s.failed) return GST_FLOW_OK;
+  GstFlowReturn ret = GST_FLOW_OK;
+  if (!s.tail.empty()) {
+    ret = read_line(self, s.tail);
+    s.tail.clear();
   }
-  return gst_pad_event_default(pad, parent, event);
+  if (ret == GST_FLOW_OK) {
+    const pfap::FapFileResult result = s.reader.finish();
+    if (!result.ok()) ret = bad_file(self, result);
+  }
+  if (ret == GST_FLOW_ERROR) return ret;
+  if (merging(self)) {
+    end_of_input(self, true);
+    return GST_PFAP_BASE_PARSE_FLOW_EOS_HELD;
+  }
+  return GST_FLOW_OK;
 }
 
 // Speech events are kept, timed in ms from the speech segment's start, until both inputs end.
@@ -505,12 +434,6 @@ static void gst_fap_parse_release_pad(GstElement* element, GstPad* pad) {
   gst_element_remove_pad(element, pad);
 }
 
-static GstStateChangeReturn gst_fap_parse_change_state(GstElement* element,
-                                                       GstStateChange transition) {
-  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) reset(GST_FAP_PARSE(element));
-  return GST_ELEMENT_CLASS(gst_fap_parse_parent_class)->change_state(element, transition);
-}
-
 static void gst_fap_parse_set_property(GObject* object, guint prop_id, const GValue* value,
                                        GParamSpec* pspec) {
   GstFapParse* self = GST_FAP_PARSE(object);
@@ -559,6 +482,7 @@ static void gst_fap_parse_finalize(GObject* object) {
 static void gst_fap_parse_class_init(GstFapParseClass* klass) {
   GObjectClass* gobject_class = G_OBJECT_CLASS(klass);
   GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
+  GstPfapBaseParseClass* parse_class = GST_PFAP_BASE_PARSE_CLASS(klass);
 
   GST_DEBUG_CATEGORY_INIT(fapparse_debug, "fapparse", 0, "MPEG-4 FAP file parser");
 
@@ -603,22 +527,15 @@ static void gst_fap_parse_class_init(GstFapParseClass* klass) {
       "Reads MPEG-4 facial animation parameter (.fap) files as application/x-pfap events",
       "gst-pfap developers");
 
-  element_class->change_state = gst_fap_parse_change_state;
+  parse_class->read_chunk = gst_fap_parse_read_chunk;
+  parse_class->finish = gst_fap_parse_finish;
+  parse_class->reset = gst_fap_parse_reset;
+  parse_class->output_caps = gst_fap_parse_output_caps;
   element_class->request_new_pad = gst_fap_parse_request_new_pad;
   element_class->release_pad = gst_fap_parse_release_pad;
 }
 
 static void gst_fap_parse_init(GstFapParse* self) {
-  self->sinkpad = gst_pad_new_from_static_template(&sink_template, "sink");
-  gst_pad_set_chain_function(self->sinkpad, gst_fap_parse_chain);
-  gst_pad_set_event_function(self->sinkpad, gst_fap_parse_sink_event);
-  gst_element_add_pad(GST_ELEMENT(self), self->sinkpad);
-
-  self->srcpad = gst_pad_new_from_static_template(&src_template, "src");
-  gst_pad_use_fixed_caps(self->srcpad);
-  pfap_noseek_set_src_functions(self->srcpad);
-  gst_element_add_pad(GST_ELEMENT(self), self->srcpad);
-
   self->silence_symbol = kDefaultSilenceSymbol;
   self->alphabet = g_strdup(kDefaultAlphabet);
   self->stream = new Stream{};

@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 #pragma once
 
-#include <gst/gst.h>
+#include "baseparse.h"
 
 G_BEGIN_DECLS
 
 #define GST_TYPE_FAP_PARSE (gst_fap_parse_get_type())
-G_DECLARE_FINAL_TYPE(GstFapParse, gst_fap_parse, GST, FAP_PARSE, GstElement)
+G_DECLARE_FINAL_TYPE(GstFapParse, gst_fap_parse, GST, FAP_PARSE, GstPfapBaseParse)
 
 GST_ELEMENT_REGISTER_DECLARE(fapparse);
 

@@ -25,8 +25,10 @@
  *
  * The header line holds the number of frames, so the file is written in one buffer at EOS;
  * up to #GstPfapFapEnc:max-frames frames are kept (a warning says when later events are not
- * written). A malformed buffer is dropped with a warning and the stream goes on. A flush, or
- * going from READY to PAUSED, starts a new file.
+ * written). A malformed buffer is dropped with a warning and the stream goes on. An event
+ * without a PTS starts where the previous one ended; one earlier than the one before it is
+ * taken at that one's time, with a warning at the 1st, 2nd, 4th, 8th, ... such event. A
+ * flush, or going from READY to PAUSED, starts a new file.
  *
  * ## Example pipelines
  * |[
@@ -46,9 +48,7 @@
 
 #include "pfap/fap_animation.h"
 #include "pfap/fap_file.h"
-#include "markupbuffer.h"
 #include "ratelimit.h"
-#include "warning.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapfapenc_debug);
 #define GST_CAT_DEFAULT pfapfapenc_debug
@@ -63,23 +63,16 @@ constexpr const char* kDefaultName = "gst-pfap";
 // What the streaming thread keeps between buffers. GObject runs no C++ constructors, so it
 // lives behind a pointer made in init and deleted in finalize.
 struct Stream {
-  Stream() { gst_segment_init(&segment, GST_FORMAT_TIME); }
-
-  GstSegment segment;
   std::optional<pfap::FapRecorder> recorder;  // made at the first event, with the properties
   std::optional<int64_t> origin_ns;           // the first segment's start: frame 0
-  int64_t end_ns = 0;                         // where the last phoneme ends
-  uint64_t malformed = 0;
-  uint64_t over_limit = 0;  // events after max-frames
-  pfap::MarkupEvent event;  // reused for every buffer
+  int64_t end_ns = 0;                         // where the last phoneme ends, from frame 0
+  uint64_t over_limit = 0;                    // events after max-frames
 };
 
 }  // namespace
 
 struct _GstPfapFapEnc {
-  GstElement parent;
-  GstPad* sinkpad;
-  GstPad* srcpad;
+  GstPfapBaseEnc parent;
   gdouble frame_rate;  // under the object lock
   gchar* name;         // under the object lock
   guint max_frames;    // under the object lock
@@ -92,39 +85,33 @@ static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
 static GstStaticPadTemplate src_template =
     GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS("text/plain"));
 
-G_DEFINE_TYPE(GstPfapFapEnc, gst_pfap_fap_enc, GST_TYPE_ELEMENT)
+G_DEFINE_TYPE(GstPfapFapEnc, gst_pfap_fap_enc, GST_TYPE_PFAP_BASE_ENC)
 GST_ELEMENT_REGISTER_DEFINE(pfapfapenc, "pfapfapenc", GST_RANK_NONE, GST_TYPE_PFAP_FAP_ENC)
 
 // A new file (FLUSH_STOP, READY to PAUSED).
-static void reset(GstPfapFapEnc* self) { *self->stream = Stream{}; }
+static void gst_pfap_fap_enc_reset(GstPfapBaseEnc* enc) {
+  *GST_PFAP_FAP_ENC(enc)->stream = Stream{};
+}
 
-static GstFlowReturn gst_pfap_fap_enc_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
-  GstPfapFapEnc* self = GST_PFAP_FAP_ENC(parent);
+static GstFlowReturn gst_pfap_fap_enc_handle_event(GstPfapBaseEnc* enc, GstBuffer* buffer,
+                                                   const pfap::MarkupEvent& event) {
+  GstPfapFapEnc* self = GST_PFAP_FAP_ENC(enc);
   Stream& s = *self->stream;
-  if (!pfap_buffer_read(buffer, s.event)) {
-    PFAP_WARN_MALFORMED_EVENT(self, buffer, ++s.malformed);
-    gst_buffer_unref(buffer);
-    return GST_FLOW_OK;
-  }
   if (!s.recorder) {
     GST_OBJECT_LOCK(self);
     s.recorder.emplace(self->frame_rate, self->max_frames);
     GST_OBJECT_UNLOCK(self);
   }
-  // Phonemes follow one another: an event without a time is where the one before ended.
-  const GstClockTime running =
-      gst_segment_to_running_time(&s.segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
-  int64_t time_ns = GST_CLOCK_TIME_IS_VALID(running) ? static_cast<int64_t>(running)
-                                                     : (s.origin_ns ? *s.origin_ns + s.end_ns : 0);
-  if (!s.origin_ns) s.origin_ns = time_ns;  // no segment came: the first event's time
-  time_ns = std::max<int64_t>(time_ns - *s.origin_ns, 0);
-  gst_buffer_unref(buffer);
+  // Placed as every writer places events: the recorder's times never go back.
+  const int64_t running = gst_pfap_base_enc_place(enc, GST_BUFFER_PTS(buffer), event);
+  if (!s.origin_ns) s.origin_ns = running;  // no segment came: the first event's time
+  // An event before frame 0 acts at frame 0.
+  const int64_t time_ns = std::max<int64_t>(running - *s.origin_ns, 0);
 
   // The recorder adds the frames of transitions still running at the end.
   const int64_t end =
-      time_ns +
-      (s.event.kind == PFAP_EVENT_PHONEME ? s.event.phoneme.duration_ms : 0) * pfap::kNsPerMs;
-  if (!s.recorder->apply(s.event, time_ns)) {
+      time_ns + (event.kind == PFAP_EVENT_PHONEME ? event.phoneme.duration_ms : 0) * pfap::kNsPerMs;
+  if (!s.recorder->apply(event, time_ns)) {
     if (pfap_warn_at(++s.over_limit)) {
       GST_ELEMENT_WARNING(
           self, STREAM, ENCODE,
@@ -138,17 +125,20 @@ static GstFlowReturn gst_pfap_fap_enc_chain(GstPad*, GstObject* parent, GstBuffe
 }
 
 // Writes the file at EOS: its header needs the number of frames.
-static GstFlowReturn write_file(GstPfapFapEnc* self) {
+// An error is posted by the push; EOS goes on for the sink to finish what it has.
+static void gst_pfap_fap_enc_finish(GstPfapBaseEnc* enc) {
+  GstPfapFapEnc* self = GST_PFAP_FAP_ENC(enc);
   Stream& s = *self->stream;
-  if (!gst_pad_has_current_caps(self->srcpad)) {
+  GstPad* srcpad = gst_pfap_base_enc_srcpad(enc);
+  if (!gst_pad_has_current_caps(srcpad)) {
     GstCaps* caps = gst_static_pad_template_get_caps(&src_template);
-    gst_pad_set_caps(self->srcpad, caps);
+    gst_pad_set_caps(srcpad, caps);
     gst_caps_unref(caps);
   }
   if (!s.recorder) {
     GST_ELEMENT_WARNING(self, STREAM, ENCODE, ("No PFAP events: no FAP file written."),
                         ("a FAP file has at least one frame"));
-    return GST_FLOW_OK;
+    return;
   }
   if (!s.recorder->finish(s.end_ns) && pfap_warn_at(++s.over_limit)) {
     GST_ELEMENT_WARNING(
@@ -170,59 +160,31 @@ static GstFlowReturn write_file(GstPfapFapEnc* self) {
         (nullptr));
   }
   GST_DEBUG_OBJECT(self, "%u frames, %zu bytes", s.recorder->frames(), text.size());
-  return gst_pad_push(self->srcpad, gst_buffer_new_memdup(text.data(), text.size()));
+  gst_pad_push(srcpad, gst_buffer_new_memdup(text.data(), text.size()));
 }
 
-static gboolean gst_pfap_fap_enc_sink_event(GstPad* pad, GstObject* parent, GstEvent* event) {
-  GstPfapFapEnc* self = GST_PFAP_FAP_ENC(parent);
-  switch (GST_EVENT_TYPE(event)) {
-    case GST_EVENT_CAPS: {
-      gst_event_unref(event);
-      GstCaps* caps = gst_static_pad_template_get_caps(&src_template);
-      const gboolean ok = gst_pad_set_caps(self->srcpad, caps);
-      gst_caps_unref(caps);
-      return ok;
-    }
-    case GST_EVENT_SEGMENT: {
-      GstSegment segment;
-      gst_event_copy_segment(event, &segment);
-      gst_event_unref(event);
-      if (segment.format != GST_FORMAT_TIME) {
-        GST_ELEMENT_ERROR(
-            self, STREAM, FORMAT, (nullptr),
-            ("%s segment: x-pfap streams have TIME segments", gst_format_get_name(segment.format)));
-        return FALSE;
-      }
-      self->stream->segment = segment;
-      if (!self->stream->origin_ns) {
-        self->stream->origin_ns = static_cast<int64_t>(
-            gst_segment_to_running_time(&segment, GST_FORMAT_TIME, segment.start));
-      }
-      // The file is bytes from its start.
-      GstSegment bytes;
-      gst_segment_init(&bytes, GST_FORMAT_BYTES);
-      return gst_pad_push_event(self->srcpad, gst_event_new_segment(&bytes));
-    }
-    case GST_EVENT_GAP:
-      gst_event_unref(event);
-      return TRUE;
-    case GST_EVENT_EOS:
-      // An error is posted by the push; EOS goes on for the sink to finish what it has.
-      write_file(self);
-      break;
-    case GST_EVENT_FLUSH_STOP:
-      reset(self);
-      break;
-    default:
-      break;
+// The file is bytes from its start; frame 0 is the first segment's start.
+static GstEvent* gst_pfap_fap_enc_output_segment(GstPfapBaseEnc* enc, GstEvent* event) {
+  Stream& s = *GST_PFAP_FAP_ENC(enc)->stream;
+  const GstSegment* segment = nullptr;
+  gst_event_parse_segment(event, &segment);
+  if (!s.origin_ns) {
+    s.origin_ns =
+        static_cast<int64_t>(gst_segment_to_running_time(segment, GST_FORMAT_TIME, segment->start));
   }
-  return gst_pad_event_default(pad, parent, event);
+  gst_event_unref(event);
+  GstSegment bytes;
+  gst_segment_init(&bytes, GST_FORMAT_BYTES);
+  return gst_event_new_segment(&bytes);
 }
 
-static GstStateChangeReturn gst_pfap_fap_enc_change_state(GstElement* element,
-                                                          GstStateChange transition) {
-  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) reset(GST_PFAP_FAP_ENC(element));
-  return GST_ELEMENT_CLASS(gst_pfap_fap_enc_parent_class)->change_state(element, transition);
+// Gaps are times, which the file's bytes have not.
+static gboolean gst_pfap_fap_enc_sink_event(GstPfapBaseEnc* enc, GstEvent* event) {
+  if (GST_EVENT_TYPE(event) == GST_EVENT_GAP) {
+    gst_event_unref(event);
+    return TRUE;
+  }
+  return GST_PFAP_BASE_ENC_CLASS(gst_pfap_fap_enc_parent_class)->sink_event(enc, event);
 }
 
 static void gst_pfap_fap_enc_set_property(GObject* object, guint prop_id, const GValue* value,
@@ -277,6 +239,7 @@ static void gst_pfap_fap_enc_finalize(GObject* object) {
 static void gst_pfap_fap_enc_class_init(GstPfapFapEncClass* klass) {
   GObjectClass* gobject_class = G_OBJECT_CLASS(klass);
   GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
+  GstPfapBaseEncClass* enc_class = GST_PFAP_BASE_ENC_CLASS(klass);
 
   GST_DEBUG_CATEGORY_INIT(pfapfapenc_debug, "pfapfapenc", 0, "MPEG-4 FAP file writer");
 
@@ -330,7 +293,11 @@ static void gst_pfap_fap_enc_class_init(GstPfapFapEncClass* klass) {
       "Writes the facial animation of a PFAP stream as an MPEG-4 FAP (.fap) file",
       "gst-pfap developers");
 
-  element_class->change_state = gst_pfap_fap_enc_change_state;
+  enc_class->handle_event = gst_pfap_fap_enc_handle_event;
+  enc_class->output_segment = gst_pfap_fap_enc_output_segment;
+  enc_class->finish = gst_pfap_fap_enc_finish;
+  enc_class->reset = gst_pfap_fap_enc_reset;
+  enc_class->sink_event = gst_pfap_fap_enc_sink_event;
 }
 
 static void gst_pfap_fap_enc_init(GstPfapFapEnc* self) {
@@ -338,11 +305,4 @@ static void gst_pfap_fap_enc_init(GstPfapFapEnc* self) {
   self->frame_rate = kDefaultFrameRate;
   self->name = g_strdup(kDefaultName);
   self->max_frames = pfap::kMaxFapFileFrames;
-  self->sinkpad = gst_pad_new_from_static_template(&sink_template, "sink");
-  gst_pad_set_chain_function(self->sinkpad, gst_pfap_fap_enc_chain);
-  gst_pad_set_event_function(self->sinkpad, gst_pfap_fap_enc_sink_event);
-  gst_element_add_pad(GST_ELEMENT(self), self->sinkpad);
-  self->srcpad = gst_pad_new_from_static_template(&src_template, "src");
-  gst_pad_use_fixed_caps(self->srcpad);
-  gst_element_add_pad(GST_ELEMENT(self), self->srcpad);
 }

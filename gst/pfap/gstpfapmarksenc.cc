@@ -43,11 +43,7 @@
 
 #include "pfap/model.h"
 #include "pfap/speech_marks.h"
-#include "pfap/timeline.h"
-#include "markupbuffer.h"
 #include "ratelimit.h"
-#include "runningtime.h"
-#include "warning.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapmarksenc_debug);
 #define GST_CAT_DEFAULT pfapmarksenc_debug
@@ -62,17 +58,11 @@ constexpr int kDefaultFrameRate = 30;
 // What the streaming thread keeps between buffers, made at READY to PAUSED from the
 // properties. GObject runs no C++ constructors, so it lives behind a pointer.
 struct Stream {
-  Stream(pfap::MarksFormat format, int frame_rate) : writer(format, frame_rate) {
-    gst_segment_init(&segment, GST_FORMAT_TIME);
-  }
+  Stream(pfap::MarksFormat format, int frame_rate) : writer(format, frame_rate) {}
 
   pfap::MarksWriter writer;
-  GstSegment segment;
   std::optional<int64_t> origin_ns;  // the first event's running time: time 0
-  pfap::EventTimeline timeline;      // the events' running times
-  pfap::MarkupEvent event;
-  uint64_t malformed = 0;
-  uint64_t unknown_warned = 0;  // unknown phonemes already counted in a warning
+  uint64_t unknown_warned = 0;       // unknown phonemes already counted in a warning
   uint64_t unknown_warnings = 0;
   GstFlowReturn flow = GST_FLOW_OK;
 };
@@ -80,9 +70,7 @@ struct Stream {
 }  // namespace
 
 struct _GstPfapMarksEnc {
-  GstElement parent;
-  GstPad* sinkpad;
-  GstPad* srcpad;
+  GstPfapBaseEnc parent;
   pfap::MarksFormat format;  // under the object lock
   int frame_rate;            // under the object lock
   Stream* stream;
@@ -94,7 +82,7 @@ static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
 static GstStaticPadTemplate src_template = GST_STATIC_PAD_TEMPLATE(
     "src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS("text/x-raw, format = (string) utf8"));
 
-G_DEFINE_TYPE(GstPfapMarksEnc, gst_pfap_marks_enc, GST_TYPE_ELEMENT)
+G_DEFINE_TYPE(GstPfapMarksEnc, gst_pfap_marks_enc, GST_TYPE_PFAP_BASE_ENC)
 GST_ELEMENT_REGISTER_DEFINE(pfapmarksenc, "pfapmarksenc", GST_RANK_NONE,
                             GST_TYPE_PFAP_MARKS_ENC)
 
@@ -120,7 +108,8 @@ static GType gst_pfap_marks_format_get_type() {
 }
 
 // A new stream from the properties (READY to PAUSED, FLUSH_STOP).
-static void reset(GstPfapMarksEnc* self) {
+static void gst_pfap_marks_enc_reset(GstPfapBaseEnc* enc) {
+  GstPfapMarksEnc* self = GST_PFAP_MARKS_ENC(enc);
   GST_OBJECT_LOCK(self);
   const pfap::MarksFormat format = self->format;
   const int frame_rate = self->frame_rate;
@@ -128,7 +117,7 @@ static void reset(GstPfapMarksEnc* self) {
   const pfap::PhonemeAlphabet* alphabet = nullptr;
   if (self->stream != nullptr) {
     // The alphabet comes with the caps, which stay across a flush.
-    GstCaps* caps = gst_pad_get_current_caps(self->sinkpad);
+    GstCaps* caps = gst_pad_get_current_caps(gst_pfap_base_enc_sinkpad(enc));
     if (caps != nullptr) {
       const gchar* name = gst_structure_get_string(gst_caps_get_structure(caps, 0), "alphabet");
       alphabet = name != nullptr ? pfap::find_alphabet(name) : nullptr;
@@ -144,41 +133,20 @@ static pfap::MarksWriter::Sink make_sink(GstPfapMarksEnc* self) {
   return [self](std::string_view text) {
     if (text.empty()) return true;
     GstBuffer* out = gst_buffer_new_memdup(text.data(), text.size());
-    self->stream->flow = gst_pad_push(self->srcpad, out);
+    self->stream->flow = gst_pad_push(gst_pfap_base_enc_srcpad(GST_PFAP_BASE_ENC(self)), out);
     return self->stream->flow == GST_FLOW_OK;
   };
 }
 
-// The event's time from the stream's first event, never earlier than the one before.
-static int64_t event_time(GstPfapMarksEnc* self, GstClockTime pts) {
+static GstFlowReturn gst_pfap_marks_enc_handle_event(GstPfapBaseEnc* enc, GstBuffer* buffer,
+                                                     const pfap::MarkupEvent& event) {
+  GstPfapMarksEnc* self = GST_PFAP_MARKS_ENC(enc);
   Stream& s = *self->stream;
-  // A first event without a PTS is where the segment begins, whose running time is base.
-  int64_t time =
-      s.timeline.start(pfap_running_time(s.segment, pts), static_cast<int64_t>(s.segment.base));
-  if (!s.origin_ns) s.origin_ns = time;
-  if (s.timeline.earlier(time)) {
-    PFAP_WARN_EARLIER_EVENT(self, "written", time, s.timeline.previous_ns(),
-                            s.timeline.earlier_count());
-    time = s.timeline.previous_ns();
-  }
-  s.timeline.add(time, s.event.kind == PFAP_EVENT_PHONEME
-                           ? s.event.phoneme.duration_ms * pfap::kNsPerMs
-                           : 0);
-  return time - *s.origin_ns;
-}
-
-static GstFlowReturn gst_pfap_marks_enc_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
-  GstPfapMarksEnc* self = GST_PFAP_MARKS_ENC(parent);
-  Stream& s = *self->stream;
-  if (!pfap_buffer_read(buffer, s.event)) {
-    PFAP_WARN_MALFORMED_EVENT(self, buffer, ++s.malformed);
-    gst_buffer_unref(buffer);
-    return GST_FLOW_OK;
-  }
-  const int64_t time = event_time(self, GST_BUFFER_PTS(buffer));
-  gst_buffer_unref(buffer);
+  // Times from the stream's first event.
+  const int64_t running = gst_pfap_base_enc_place(enc, GST_BUFFER_PTS(buffer), event);
+  if (!s.origin_ns) s.origin_ns = running;
   s.flow = GST_FLOW_OK;
-  if (!s.writer.add(s.event, time, make_sink(self))) {
+  if (!s.writer.add(event, running - *s.origin_ns, make_sink(self))) {
     if (s.writer.overflow()) {
       GST_ELEMENT_ERROR(self, STREAM, FAILED,
                         ("More than %zu phonemes for one Rhubarb JSON document.",
@@ -201,54 +169,20 @@ static GstFlowReturn gst_pfap_marks_enc_chain(GstPad*, GstObject* parent, GstBuf
   return s.flow;
 }
 
-static gboolean gst_pfap_marks_enc_sink_event(GstPad* pad, GstObject* parent, GstEvent* event) {
-  GstPfapMarksEnc* self = GST_PFAP_MARKS_ENC(parent);
-  switch (GST_EVENT_TYPE(event)) {
-    case GST_EVENT_CAPS: {
-      GstCaps* caps;
-      gst_event_parse_caps(event, &caps);
-      const gchar* name = gst_structure_get_string(gst_caps_get_structure(caps, 0), "alphabet");
-      const pfap::PhonemeAlphabet* alphabet = name ? pfap::find_alphabet(name) : nullptr;
-      GST_INFO_OBJECT(self, "alphabet %s%s", name ? name : "(none)",
-                      name && !alphabet ? " (unknown)" : "");
-      self->stream->writer.set_alphabet(alphabet);
-      gst_event_unref(event);
-      GstCaps* out = gst_static_pad_template_get_caps(&src_template);
-      const gboolean ok = gst_pad_set_caps(self->srcpad, out);
-      gst_caps_unref(out);
-      return ok;
-    }
-    case GST_EVENT_SEGMENT: {
-      GstSegment segment;
-      gst_event_copy_segment(event, &segment);
-      if (segment.format != GST_FORMAT_TIME) {
-        GST_ELEMENT_ERROR(
-            self, STREAM, FORMAT, (nullptr),
-            ("%s segment: x-pfap streams have TIME segments", gst_format_get_name(segment.format)));
-        gst_event_unref(event);
-        return FALSE;
-      }
-      self->stream->segment = segment;
-      break;
-    }
-    case GST_EVENT_EOS:
-      // What is held (the last utterance, the Rhubarb document, the last frames) goes first.
-      self->stream->flow = GST_FLOW_OK;
-      self->stream->writer.finish(make_sink(self));
-      break;
-    case GST_EVENT_FLUSH_STOP:
-      reset(self);
-      break;
-    default:
-      break;
-  }
-  return gst_pad_event_default(pad, parent, event);
+static void gst_pfap_marks_enc_set_caps(GstPfapBaseEnc* enc, GstCaps* caps) {
+  GstPfapMarksEnc* self = GST_PFAP_MARKS_ENC(enc);
+  const gchar* name = gst_structure_get_string(gst_caps_get_structure(caps, 0), "alphabet");
+  const pfap::PhonemeAlphabet* alphabet = name ? pfap::find_alphabet(name) : nullptr;
+  GST_INFO_OBJECT(self, "alphabet %s%s", name ? name : "(none)",
+                  name && !alphabet ? " (unknown)" : "");
+  self->stream->writer.set_alphabet(alphabet);
 }
 
-static GstStateChangeReturn gst_pfap_marks_enc_change_state(GstElement* element,
-                                                            GstStateChange transition) {
-  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) reset(GST_PFAP_MARKS_ENC(element));
-  return GST_ELEMENT_CLASS(gst_pfap_marks_enc_parent_class)->change_state(element, transition);
+// What is held (the last utterance, the Rhubarb document, the last frames) goes before EOS.
+static void gst_pfap_marks_enc_finish(GstPfapBaseEnc* enc) {
+  GstPfapMarksEnc* self = GST_PFAP_MARKS_ENC(enc);
+  self->stream->flow = GST_FLOW_OK;
+  self->stream->writer.finish(make_sink(self));
 }
 
 static void gst_pfap_marks_enc_set_property(GObject* object, guint prop_id, const GValue* value,
@@ -295,6 +229,7 @@ static void gst_pfap_marks_enc_finalize(GObject* object) {
 static void gst_pfap_marks_enc_class_init(GstPfapMarksEncClass* klass) {
   GObjectClass* gobject_class = G_OBJECT_CLASS(klass);
   GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
+  GstPfapBaseEncClass* enc_class = GST_PFAP_BASE_ENC_CLASS(klass);
 
   GST_DEBUG_CATEGORY_INIT(pfapmarksenc_debug, "pfapmarksenc", 0, "PFAP speech-mark writer");
 
@@ -332,7 +267,10 @@ static void gst_pfap_marks_enc_class_init(GstPfapMarksEncClass* klass) {
       "Rhubarb mouth cues, TalkingHead timing, Azure viseme events or ARKit blendshapes",
       "gst-pfap developers");
 
-  element_class->change_state = gst_pfap_marks_enc_change_state;
+  enc_class->handle_event = gst_pfap_marks_enc_handle_event;
+  enc_class->set_caps = gst_pfap_marks_enc_set_caps;
+  enc_class->finish = gst_pfap_marks_enc_finish;
+  enc_class->reset = gst_pfap_marks_enc_reset;
   gst_type_mark_as_plugin_api(GST_TYPE_PFAP_MARKS_FORMAT, static_cast<GstPluginAPIFlags>(0));
 }
 
@@ -340,12 +278,5 @@ static void gst_pfap_marks_enc_init(GstPfapMarksEnc* self) {
   self->format = kDefaultFormat;
   self->frame_rate = kDefaultFrameRate;
   self->stream = nullptr;
-  self->sinkpad = gst_pad_new_from_static_template(&sink_template, "sink");
-  gst_pad_set_chain_function(self->sinkpad, gst_pfap_marks_enc_chain);
-  gst_pad_set_event_function(self->sinkpad, gst_pfap_marks_enc_sink_event);
-  gst_element_add_pad(GST_ELEMENT(self), self->sinkpad);
-  self->srcpad = gst_pad_new_from_static_template(&src_template, "src");
-  gst_pad_use_fixed_caps(self->srcpad);
-  gst_element_add_pad(GST_ELEMENT(self), self->srcpad);
-  reset(self);
+  gst_pfap_marks_enc_reset(GST_PFAP_BASE_ENC(self));
 }

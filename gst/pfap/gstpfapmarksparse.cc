@@ -43,9 +43,7 @@
 
 #include "pfap/speech_marks.h"
 #include "markupbuffer.h"
-#include "noseek.h"
 #include "ratelimit.h"
-#include "sparse.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapmarksparse_debug);
 #define GST_CAT_DEFAULT pfapmarksparse_debug
@@ -62,13 +60,11 @@ struct Stream {
   explicit Stream(pfap::MarksInput input) : reader(input) {}
 
   pfap::MarksReader reader;
-  std::string tail;             // a line whose end has not come yet, or a whole JSON document
-  uint64_t line = 1;            // the line being read, from 1
-  bool skipping = false;        // dropping the rest of an over-long line
-  bool started = false;         // the first non-blank byte has been seen
-  bool document = false;        // Rhubarb JSON: the input is kept whole until EOS
-  bool need_events = true;
-  bool discont = true;
+  std::string tail;       // a line whose end has not come yet, or a whole JSON document
+  uint64_t line = 1;      // the line being read, from 1
+  bool skipping = false;  // dropping the rest of an over-long line
+  bool started = false;   // the first non-blank byte has been seen
+  bool document = false;  // Rhubarb JSON: the input is kept whole until EOS
   uint64_t bad_lines = 0;
   std::vector<pfap::TextEvent> events;
 };
@@ -76,9 +72,7 @@ struct Stream {
 }  // namespace
 
 struct _GstPfapMarksParse {
-  GstElement parent;
-  GstPad* sinkpad;
-  GstPad* srcpad;
+  GstPfapBaseParse parent;
   pfap::MarksInput format;  // under the object lock
   gboolean skip_bad_lines;  // under the object lock
   Stream* stream;
@@ -91,7 +85,7 @@ static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
 static GstStaticPadTemplate src_template =
     GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
 
-G_DEFINE_TYPE(GstPfapMarksParse, gst_pfap_marks_parse, GST_TYPE_ELEMENT)
+G_DEFINE_TYPE(GstPfapMarksParse, gst_pfap_marks_parse, GST_TYPE_PFAP_BASE_PARSE)
 GST_ELEMENT_REGISTER_DEFINE(pfapmarksparse, "pfapmarksparse", GST_RANK_NONE,
                             GST_TYPE_PFAP_MARKS_PARSE)
 
@@ -111,7 +105,8 @@ static GType gst_pfap_marks_input_get_type() {
 }
 
 // A new stream from the properties (READY to PAUSED, FLUSH_STOP).
-static void reset(GstPfapMarksParse* self) {
+static void gst_pfap_marks_parse_reset(GstPfapBaseParse* parse) {
+  GstPfapMarksParse* self = GST_PFAP_MARKS_PARSE(parse);
   GST_OBJECT_LOCK(self);
   const pfap::MarksInput format = self->format;
   GST_OBJECT_UNLOCK(self);
@@ -119,45 +114,19 @@ static void reset(GstPfapMarksParse* self) {
   self->stream = new Stream(format);
 }
 
-static void send_events(GstPfapMarksParse* self) {
-  Stream& s = *self->stream;
-  if (!s.need_events) return;
-  s.need_events = false;
-  if (GstEvent* start = gst_pad_get_sticky_event(self->srcpad, GST_EVENT_STREAM_START, 0)) {
-    gst_event_unref(start);
-  } else {
-    gchar* id = gst_pad_create_stream_id(self->srcpad, GST_ELEMENT(self), nullptr);
-    gst_pad_push_event(self->srcpad, pfap_make_sparse(gst_event_new_stream_start(id)));
-    g_free(id);
-  }
+static GstCaps* gst_pfap_marks_parse_output_caps(GstPfapBaseParse* parse) {
   GstCaps* caps = gst_caps_make_writable(gst_static_pad_template_get_caps(&src_template));
-  const std::string alphabet(s.reader.alphabet());
+  const std::string alphabet(GST_PFAP_MARKS_PARSE(parse)->stream->reader.alphabet());
   gst_caps_set_simple(caps, "alphabet", G_TYPE_STRING, alphabet.c_str(), nullptr);
-  gst_pad_push_event(self->srcpad, gst_event_new_caps(caps));
-  gst_caps_unref(caps);
-  GstSegment segment;
-  gst_segment_init(&segment, GST_FORMAT_TIME);
-  gst_pad_push_event(self->srcpad, gst_event_new_segment(&segment));
+  return caps;
 }
 
 static GstFlowReturn push_events(GstPfapMarksParse* self) {
   Stream& s = *self->stream;
   GstFlowReturn ret = GST_FLOW_OK;
   for (const pfap::TextEvent& event : s.events) {
+    ret = gst_pfap_base_parse_push(GST_PFAP_BASE_PARSE(self), event);
     if (ret != GST_FLOW_OK) break;
-    GstBuffer* buffer = pfap_buffer_new(event.event);
-    if (buffer == nullptr) {
-      // The reader gives values within range: a bug.
-      GST_ELEMENT_ERROR(self, STREAM, FAILED, (nullptr), ("an event x-pfap cannot hold"));
-      ret = GST_FLOW_ERROR;
-      break;
-    }
-    GST_BUFFER_PTS(buffer) = event.time_ms * GST_MSECOND;
-    GST_BUFFER_DURATION(buffer) = event.event.phoneme.duration_ms * GST_MSECOND;
-    if (s.discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
-    s.discont = false;
-    send_events(self);
-    ret = gst_pad_push(self->srcpad, buffer);
   }
   s.events.clear();
   return ret;
@@ -202,7 +171,9 @@ static GstFlowReturn read_line(GstPfapMarksParse* self, std::string_view line) {
   return push_events(self);
 }
 
-static GstFlowReturn read_chunk(GstPfapMarksParse* self, std::string_view data) {
+static GstFlowReturn gst_pfap_marks_parse_read_chunk(GstPfapBaseParse* parse,
+                                                     std::string_view data) {
+  GstPfapMarksParse* self = GST_PFAP_MARKS_PARSE(parse);
   Stream& s = *self->stream;
   if (!s.started) {
     const size_t first = data.find_first_not_of(" \t\r\n");
@@ -245,7 +216,8 @@ static GstFlowReturn read_chunk(GstPfapMarksParse* self, std::string_view data) 
 }
 
 // At EOS: the last line, or the whole Rhubarb document, then the last viseme.
-static GstFlowReturn finish(GstPfapMarksParse* self) {
+static GstFlowReturn gst_pfap_marks_parse_finish(GstPfapBaseParse* parse) {
+  GstPfapMarksParse* self = GST_PFAP_MARKS_PARSE(parse);
   Stream& s = *self->stream;
   GstFlowReturn ret = GST_FLOW_OK;
   if (s.document) {
@@ -261,52 +233,6 @@ static GstFlowReturn finish(GstPfapMarksParse* self) {
   }
   s.tail.clear();
   return ret;
-}
-
-static GstFlowReturn gst_pfap_marks_parse_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
-  GstPfapMarksParse* self = GST_PFAP_MARKS_PARSE(parent);
-  GstMapInfo map;
-  if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) {
-    gst_buffer_unref(buffer);
-    GST_ELEMENT_ERROR(self, RESOURCE, READ, (nullptr), ("cannot map the input buffer"));
-    return GST_FLOW_ERROR;
-  }
-  const GstFlowReturn ret = read_chunk(self, {reinterpret_cast<const char*>(map.data), map.size});
-  gst_buffer_unmap(buffer, &map);
-  gst_buffer_unref(buffer);
-  return ret;
-}
-
-static gboolean gst_pfap_marks_parse_sink_event(GstPad* pad, GstObject* parent, GstEvent* event) {
-  GstPfapMarksParse* self = GST_PFAP_MARKS_PARSE(parent);
-  switch (GST_EVENT_TYPE(event)) {
-    case GST_EVENT_STREAM_START:
-      return gst_pad_push_event(self->srcpad, pfap_make_sparse(event));
-    case GST_EVENT_CAPS:
-    case GST_EVENT_SEGMENT:
-    case GST_EVENT_GAP:
-      gst_event_unref(event);
-      return TRUE;
-    case GST_EVENT_EOS:
-      if (finish(self) == GST_FLOW_ERROR) {
-        gst_event_unref(event);
-        return FALSE;
-      }
-      send_events(self);
-      break;
-    case GST_EVENT_FLUSH_STOP:
-      reset(self);
-      break;
-    default:
-      break;
-  }
-  return gst_pad_event_default(pad, parent, event);
-}
-
-static GstStateChangeReturn gst_pfap_marks_parse_change_state(GstElement* element,
-                                                              GstStateChange transition) {
-  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) reset(GST_PFAP_MARKS_PARSE(element));
-  return GST_ELEMENT_CLASS(gst_pfap_marks_parse_parent_class)->change_state(element, transition);
 }
 
 static void gst_pfap_marks_parse_set_property(GObject* object, guint prop_id,
@@ -353,6 +279,7 @@ static void gst_pfap_marks_parse_finalize(GObject* object) {
 static void gst_pfap_marks_parse_class_init(GstPfapMarksParseClass* klass) {
   GObjectClass* gobject_class = G_OBJECT_CLASS(klass);
   GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
+  GstPfapBaseParseClass* parse_class = GST_PFAP_BASE_PARSE_CLASS(klass);
 
   GST_DEBUG_CATEGORY_INIT(pfapmarksparse_debug, "pfapmarksparse", 0, "PFAP speech-mark reader");
 
@@ -392,7 +319,10 @@ static void gst_pfap_marks_parse_class_init(GstPfapMarksParseClass* klass) {
       "application/x-pfap viseme events",
       "gst-pfap developers");
 
-  element_class->change_state = gst_pfap_marks_parse_change_state;
+  parse_class->read_chunk = gst_pfap_marks_parse_read_chunk;
+  parse_class->finish = gst_pfap_marks_parse_finish;
+  parse_class->reset = gst_pfap_marks_parse_reset;
+  parse_class->output_caps = gst_pfap_marks_parse_output_caps;
   gst_type_mark_as_plugin_api(GST_TYPE_PFAP_MARKS_INPUT, static_cast<GstPluginAPIFlags>(0));
 }
 
@@ -400,14 +330,5 @@ static void gst_pfap_marks_parse_init(GstPfapMarksParse* self) {
   self->format = kDefaultFormat;
   self->skip_bad_lines = FALSE;
   self->stream = nullptr;
-  self->sinkpad = gst_pad_new_from_static_template(&sink_template, "sink");
-  gst_pad_set_chain_function(self->sinkpad, gst_pfap_marks_parse_chain);
-  gst_pad_set_event_function(self->sinkpad, gst_pfap_marks_parse_sink_event);
-  gst_element_add_pad(GST_ELEMENT(self), self->sinkpad);
-
-  self->srcpad = gst_pad_new_from_static_template(&src_template, "src");
-  gst_pad_use_fixed_caps(self->srcpad);
-  pfap_noseek_set_src_functions(self->srcpad);
-  gst_element_add_pad(GST_ELEMENT(self), self->srcpad);
-  reset(self);
+  gst_pfap_marks_parse_reset(GST_PFAP_BASE_PARSE(self));
 }

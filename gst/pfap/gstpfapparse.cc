@@ -50,9 +50,7 @@
 #include "pfap/text.h"
 #include "gstpfaptypefind.h"
 #include "markupbuffer.h"
-#include "noseek.h"
 #include "ratelimit.h"
-#include "sparse.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapparse_debug);
 #define GST_CAT_DEFAULT pfapparse_debug
@@ -69,19 +67,15 @@ enum { PROP_0, PROP_SKIP_BAD_LINES, PROP_ALPHABET, PROP_BAD_LINES };
 // lives behind a pointer made in init and deleted in finalize.
 struct Stream {
   pfap::TextReader reader;
-  std::string tail;         // the start of a line whose end has not come yet
-  uint64_t line = 1;        // the number of the line being read, from 1
-  bool skipping = false;    // dropping the rest of an over-long line
-  bool need_events = true;  // stream-start, caps or segment still to send
-  bool discont = true;
+  std::string tail;       // the start of a line whose end has not come yet
+  uint64_t line = 1;      // the number of the line being read, from 1
+  bool skipping = false;  // dropping the rest of an over-long line
 };
 
 }  // namespace
 
 struct _GstPfapParse {
-  GstElement parent;
-  GstPad* sinkpad;
-  GstPad* srcpad;
+  GstPfapBaseParse parent;
   gboolean skip_bad_lines;  // under the object lock
   guint64 bad_lines;        // under the object lock: skipped since READY to PAUSED
   gchar* alphabet;          // under the object lock; NULL when unset
@@ -98,48 +92,25 @@ static GstStaticPadTemplate sink_template =
 static GstStaticPadTemplate src_template =
     GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
 
-G_DEFINE_TYPE(GstPfapParse, gst_pfap_parse, GST_TYPE_ELEMENT)
+G_DEFINE_TYPE(GstPfapParse, gst_pfap_parse, GST_TYPE_PFAP_BASE_PARSE)
 // A rank, so that decodebin plugs it for text/x-pfap (gst-play-1.0 file.pfap).
 GST_ELEMENT_REGISTER_DEFINE(pfapparse, "pfapparse", GST_RANK_SECONDARY, GST_TYPE_PFAP_PARSE)
 
 // Back to the start of a stream (READY to PAUSED, FLUSH_STOP).
-static void reset(GstPfapParse* self) {
-  Stream& s = *self->stream;
-  s.reader.reset();
-  s.tail.clear();
-  s.line = 1;
-  s.skipping = false;
-  s.need_events = true;
-  s.discont = true;
+static void gst_pfap_parse_reset(GstPfapBaseParse* parse) {
+  *GST_PFAP_PARSE(parse)->stream = Stream{};
 }
 
-// The sticky events a buffer or EOS needs before it: upstream's stream-start was forwarded
-// if there was one; caps stay across a flush, the segment does not.
-static void send_events(GstPfapParse* self) {
-  Stream& s = *self->stream;
-  if (!s.need_events) return;
-  s.need_events = false;
-  if (GstEvent* start = gst_pad_get_sticky_event(self->srcpad, GST_EVENT_STREAM_START, 0)) {
-    gst_event_unref(start);
-  } else {
-    gchar* id = gst_pad_create_stream_id(self->srcpad, GST_ELEMENT(self), nullptr);
-    gst_pad_push_event(self->srcpad, pfap_make_sparse(gst_event_new_stream_start(id)));
-    g_free(id);
+static GstCaps* gst_pfap_parse_output_caps(GstPfapBaseParse* parse) {
+  GstPfapParse* self = GST_PFAP_PARSE(parse);
+  GstCaps* caps = gst_static_pad_template_get_caps(&src_template);
+  GST_OBJECT_LOCK(self);
+  if (self->alphabet != nullptr) {
+    caps = gst_caps_make_writable(caps);
+    gst_caps_set_simple(caps, "alphabet", G_TYPE_STRING, self->alphabet, nullptr);
   }
-  if (!gst_pad_has_current_caps(self->srcpad)) {
-    GstCaps* caps = gst_static_pad_template_get_caps(&src_template);
-    GST_OBJECT_LOCK(self);
-    if (self->alphabet != nullptr) {
-      caps = gst_caps_make_writable(caps);
-      gst_caps_set_simple(caps, "alphabet", G_TYPE_STRING, self->alphabet, nullptr);
-    }
-    GST_OBJECT_UNLOCK(self);
-    gst_pad_push_event(self->srcpad, gst_event_new_caps(caps));
-    gst_caps_unref(caps);
-  }
-  GstSegment segment;
-  gst_segment_init(&segment, GST_FORMAT_TIME);
-  gst_pad_push_event(self->srcpad, gst_event_new_segment(&segment));
+  GST_OBJECT_UNLOCK(self);
+  return caps;
 }
 
 // Where the text comes from, for messages: ` of file "PATH"` when upstream reads a file
@@ -148,7 +119,8 @@ static std::string source_name(GstPfapParse* self) {
   std::string name;
   GstQuery* query = gst_query_new_uri();
   gchar* uri = nullptr;
-  if (gst_pad_peer_query(self->sinkpad, query)) gst_query_parse_uri(query, &uri);
+  GstPad* sinkpad = gst_pfap_base_parse_sinkpad(GST_PFAP_BASE_PARSE(self));
+  if (gst_pad_peer_query(sinkpad, query)) gst_query_parse_uri(query, &uri);
   gst_query_unref(query);
   if (uri == nullptr) return name;
   if (gchar* path = g_filename_from_uri(uri, nullptr, nullptr)) {
@@ -194,27 +166,6 @@ static GstFlowReturn bad_line(GstPfapParse* self, size_t column, const std::stri
   return GST_FLOW_ERROR;
 }
 
-static GstFlowReturn push_event(GstPfapParse* self, const pfap::TextEvent& event) {
-  Stream& s = *self->stream;
-  GstBuffer* buffer = pfap_buffer_new(event.event);
-  if (buffer == nullptr) {
-    // TextReader gives values within range, and kMaxLineBytes bounds the FAPs: a bug.
-    GST_ELEMENT_ERROR(self, STREAM, FAILED, (nullptr),
-                      ("line %" G_GUINT64_FORMAT " gives an event x-pfap cannot hold", s.line));
-    return GST_FLOW_ERROR;
-  }
-  GST_BUFFER_PTS(buffer) = event.time_ms * GST_MSECOND;
-  if (event.event.kind == PFAP_EVENT_PHONEME) {
-    GST_BUFFER_DURATION(buffer) = event.event.phoneme.duration_ms * GST_MSECOND;
-  }
-  if (s.discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
-  s.discont = false;
-  send_events(self);
-  GST_LOG_OBJECT(self, "line %" G_GUINT64_FORMAT ": event kind %d at %" GST_TIME_FORMAT, s.line,
-                 event.event.kind, GST_TIME_ARGS(GST_BUFFER_PTS(buffer)));
-  return gst_pad_push(self->srcpad, buffer);
-}
-
 // Reads one whole line, without its '\n' (TextReader drops the '\r' of a "\r\n").
 static GstFlowReturn read_line(GstPfapParse* self, std::string_view line) {
   const gchar* valid_end = nullptr;
@@ -232,12 +183,14 @@ static GstFlowReturn read_line(GstPfapParse* self, std::string_view line) {
     return bad_line(self, result.column, what);
   }
   if (!has_event) return GST_FLOW_OK;
-  return push_event(self, event);
+  GST_LOG_OBJECT(self, "line %" G_GUINT64_FORMAT, self->stream->line);
+  return gst_pfap_base_parse_push(GST_PFAP_BASE_PARSE(self), event);
 }
 
 // Splits `data` into lines, completing the tail kept from the chunks before and keeping the
 // new incomplete one.
-static GstFlowReturn read_chunk(GstPfapParse* self, std::string_view data) {
+static GstFlowReturn gst_pfap_parse_read_chunk(GstPfapBaseParse* parse, std::string_view data) {
+  GstPfapParse* self = GST_PFAP_PARSE(parse);
   Stream& s = *self->stream;
   while (!data.empty()) {
     const size_t end = data.find('\n');
@@ -267,60 +220,20 @@ static GstFlowReturn read_chunk(GstPfapParse* self, std::string_view data) {
   return GST_FLOW_OK;
 }
 
-static GstFlowReturn gst_pfap_parse_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
-  GstPfapParse* self = GST_PFAP_PARSE(parent);
-  GstMapInfo map;
-  if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) {
-    gst_buffer_unref(buffer);
-    GST_ELEMENT_ERROR(self, RESOURCE, READ, (nullptr), ("cannot map the input buffer"));
-    return GST_FLOW_ERROR;
-  }
-  const GstFlowReturn ret = read_chunk(self, {reinterpret_cast<const char*>(map.data), map.size});
-  gst_buffer_unmap(buffer, &map);
-  gst_buffer_unref(buffer);
-  return ret;
-}
-
-static gboolean gst_pfap_parse_sink_event(GstPad* pad, GstObject* parent, GstEvent* event) {
-  GstPfapParse* self = GST_PFAP_PARSE(parent);
+// At EOS: the last line may have no line end.
+static GstFlowReturn gst_pfap_parse_finish(GstPfapBaseParse* parse) {
+  GstPfapParse* self = GST_PFAP_PARSE(parse);
   Stream& s = *self->stream;
-  switch (GST_EVENT_TYPE(event)) {
-    case GST_EVENT_STREAM_START:
-      return gst_pad_push_event(self->srcpad, pfap_make_sparse(event));
-    // Text caps and upstream times say nothing about the output: our caps and segment go
-    // before the first buffer.
-    case GST_EVENT_CAPS:
-    case GST_EVENT_SEGMENT:
-    case GST_EVENT_GAP:
-      gst_event_unref(event);
-      return TRUE;
-    case GST_EVENT_EOS:
-      // The last line may have no line end.
-      if (!s.skipping && !s.tail.empty()) {
-        const GstFlowReturn ret = read_line(self, s.tail);
-        s.tail.clear();
-        // The error is posted; the stream did not end well.
-        if (ret == GST_FLOW_ERROR) {
-          gst_event_unref(event);
-          return FALSE;
-        }
-      }
-      send_events(self);
-      break;
-    case GST_EVENT_FLUSH_STOP:
-      reset(self);
-      break;
-    default:
-      break;
-  }
-  return gst_pad_event_default(pad, parent, event);
+  GstFlowReturn ret = GST_FLOW_OK;
+  if (!s.skipping && !s.tail.empty()) ret = read_line(self, s.tail);
+  s.tail.clear();
+  return ret;
 }
 
 static GstStateChangeReturn gst_pfap_parse_change_state(GstElement* element,
                                                         GstStateChange transition) {
   GstPfapParse* self = GST_PFAP_PARSE(element);
   if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) {
-    reset(self);
     GST_OBJECT_LOCK(self);
     self->bad_lines = 0;
     GST_OBJECT_UNLOCK(self);
@@ -383,6 +296,7 @@ static void gst_pfap_parse_finalize(GObject* object) {
 static void gst_pfap_parse_class_init(GstPfapParseClass* klass) {
   GObjectClass* gobject_class = G_OBJECT_CLASS(klass);
   GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
+  GstPfapBaseParseClass* parse_class = GST_PFAP_BASE_PARSE_CLASS(klass);
 
   GST_DEBUG_CATEGORY_INIT(pfapparse_debug, "pfapparse", 0, "PFAP text parser");
 
@@ -441,19 +355,13 @@ static void gst_pfap_parse_class_init(GstPfapParseClass* klass) {
       "gst-pfap developers");
 
   element_class->change_state = gst_pfap_parse_change_state;
+  parse_class->read_chunk = gst_pfap_parse_read_chunk;
+  parse_class->finish = gst_pfap_parse_finish;
+  parse_class->reset = gst_pfap_parse_reset;
+  parse_class->output_caps = gst_pfap_parse_output_caps;
 }
 
 static void gst_pfap_parse_init(GstPfapParse* self) {
-  self->sinkpad = gst_pad_new_from_static_template(&sink_template, "sink");
-  gst_pad_set_chain_function(self->sinkpad, gst_pfap_parse_chain);
-  gst_pad_set_event_function(self->sinkpad, gst_pfap_parse_sink_event);
-  gst_element_add_pad(GST_ELEMENT(self), self->sinkpad);
-
-  self->srcpad = gst_pad_new_from_static_template(&src_template, "src");
-  gst_pad_use_fixed_caps(self->srcpad);
-  pfap_noseek_set_src_functions(self->srcpad);
-  gst_element_add_pad(GST_ELEMENT(self), self->srcpad);
-
   self->skip_bad_lines = FALSE;
   self->bad_lines = 0;
   self->alphabet = nullptr;

@@ -40,12 +40,8 @@
 #include <optional>
 #include <string>
 
-#include "markupbuffer.h"
-#include "runningtime.h"
 #include "pfap/model.h"
 #include "pfap/text.h"
-#include "pfap/timeline.h"
-#include "warning.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfaptextenc_debug);
 #define GST_CAT_DEFAULT pfaptextenc_debug
@@ -55,11 +51,7 @@ namespace {
 // What the streaming thread keeps between buffers. GObject runs no C++ constructors, so it
 // lives behind a pointer made in init and deleted in finalize.
 struct Stream {
-  Stream() { gst_segment_init(&segment, GST_FORMAT_TIME); }
-
-  GstSegment segment;
   std::optional<int64_t> origin_ns;  // the first event's running time: line time 0
-  pfap::EventTimeline timeline;      // the events' running times
   // Reused for every buffer so that steady streaming does not allocate.
   pfap::TextEvent text;
   std::string line;
@@ -69,18 +61,10 @@ struct Stream {
 
 enum { PROP_0, PROP_STATS };
 
-struct Stats {
-  guint64 events = 0;     // lines written
-  guint64 malformed = 0;  // input buffers dropped: not valid x-pfap events
-  guint64 earlier = 0;    // events earlier than the one before, written at that one's time
-};
-
 struct _GstPfapTextEnc {
-  GstElement parent;
-  GstPad* sinkpad;
-  GstPad* srcpad;
+  GstPfapBaseEnc parent;
   Stream* stream;
-  Stats stats;  // under the object lock: the property is read from any thread
+  guint64 events;  // under the object lock: lines written since READY to PAUSED
 };
 
 static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
@@ -89,56 +73,28 @@ static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
 static GstStaticPadTemplate src_template = GST_STATIC_PAD_TEMPLATE(
     "src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS("text/x-raw, format = (string) utf8"));
 
-G_DEFINE_TYPE(GstPfapTextEnc, gst_pfap_text_enc, GST_TYPE_ELEMENT)
+G_DEFINE_TYPE(GstPfapTextEnc, gst_pfap_text_enc, GST_TYPE_PFAP_BASE_ENC)
 GST_ELEMENT_REGISTER_DEFINE(pfaptextenc, "pfaptextenc", GST_RANK_NONE, GST_TYPE_PFAP_TEXT_ENC)
 
-// Forgets the segment and the time origin (FLUSH_STOP, READY to PAUSED).
-static void reset(GstPfapTextEnc* self) {
-  gst_segment_init(&self->stream->segment, GST_FORMAT_TIME);
-  self->stream->origin_ns.reset();
-  self->stream->timeline.reset();
+// Forgets the time origin (FLUSH_STOP, READY to PAUSED).
+static void gst_pfap_text_enc_reset(GstPfapBaseEnc* enc) {
+  GST_PFAP_TEXT_ENC(enc)->stream->origin_ns.reset();
 }
 
-// The line time of the event just read, whose buffer has `pts`.
-static int64_t line_time_ms(GstPfapTextEnc* self, GstClockTime pts) {
+static GstFlowReturn gst_pfap_text_enc_handle_event(GstPfapBaseEnc* enc, GstBuffer* buffer,
+                                                    const pfap::MarkupEvent& event) {
+  GstPfapTextEnc* self = GST_PFAP_TEXT_ENC(enc);
   Stream& s = *self->stream;
-  // A first event without a PTS is where the segment begins, whose running time is base.
-  int64_t time =
-      s.timeline.start(pfap_running_time(s.segment, pts), static_cast<int64_t>(s.segment.base));
+  s.text.event = event;
+  const int64_t time = gst_pfap_base_enc_place(enc, GST_BUFFER_PTS(buffer), event);
   if (!s.origin_ns) s.origin_ns = time;
-  if (s.timeline.earlier(time)) {
-    const guint64 count = s.timeline.earlier_count();
-    GST_OBJECT_LOCK(self);
-    self->stats.earlier = count;
-    GST_OBJECT_UNLOCK(self);
-    PFAP_WARN_EARLIER_EVENT(self, "written", time, s.timeline.previous_ns(), count);
-    time = s.timeline.previous_ns();
-  }
-  const pfap::MarkupEvent& event = s.text.event;
-  s.timeline.add(time,
-                 event.kind == PFAP_EVENT_PHONEME ? event.phoneme.duration_ms * pfap::kNsPerMs : 0);
-  return (time - *s.origin_ns + pfap::kNsPerMs / 2) / pfap::kNsPerMs;
-}
-
-static GstFlowReturn gst_pfap_text_enc_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
-  GstPfapTextEnc* self = GST_PFAP_TEXT_ENC(parent);
-  Stream& s = *self->stream;
-  if (!pfap_buffer_read(buffer, s.text.event)) {
-    GST_OBJECT_LOCK(self);
-    const guint64 malformed = ++self->stats.malformed;
-    GST_OBJECT_UNLOCK(self);
-    PFAP_WARN_MALFORMED_EVENT(self, buffer, malformed);
-    gst_buffer_unref(buffer);
-    return GST_FLOW_OK;
-  }
-
-  s.text.time_ms = line_time_ms(self, GST_BUFFER_PTS(buffer));
+  s.text.time_ms = (time - *s.origin_ns + pfap::kNsPerMs / 2) / pfap::kNsPerMs;
   s.line.clear();
   pfap::format_text_line(s.text, s.line);
   // The format has no flag for it; a comment tells the reader and pfapparse skips it.
   if (s.text.event.uncertain) s.line += " # uncertain";
   GST_OBJECT_LOCK(self);
-  self->stats.events++;
+  self->events++;
   GST_OBJECT_UNLOCK(self);
   GST_LOG_OBJECT(self, "%s", s.line.c_str());
   s.line += '\n';
@@ -147,41 +103,7 @@ static GstFlowReturn gst_pfap_text_enc_chain(GstPad*, GstObject* parent, GstBuff
   GST_BUFFER_PTS(out) = GST_BUFFER_PTS(buffer);
   GST_BUFFER_DURATION(out) = GST_BUFFER_DURATION(buffer);
   if (GST_BUFFER_IS_DISCONT(buffer)) GST_BUFFER_FLAG_SET(out, GST_BUFFER_FLAG_DISCONT);
-  gst_buffer_unref(buffer);
-  return gst_pad_push(self->srcpad, out);
-}
-
-static gboolean gst_pfap_text_enc_sink_event(GstPad* pad, GstObject* parent, GstEvent* event) {
-  GstPfapTextEnc* self = GST_PFAP_TEXT_ENC(parent);
-  switch (GST_EVENT_TYPE(event)) {
-    case GST_EVENT_CAPS: {
-      // Whatever the input caps say (an alphabet), the text is the same.
-      gst_event_unref(event);
-      GstCaps* caps = gst_static_pad_template_get_caps(&src_template);
-      const gboolean ok = gst_pad_set_caps(self->srcpad, caps);
-      gst_caps_unref(caps);
-      return ok;
-    }
-    case GST_EVENT_SEGMENT: {
-      GstSegment segment;
-      gst_event_copy_segment(event, &segment);
-      if (segment.format != GST_FORMAT_TIME) {
-        GST_ELEMENT_ERROR(
-            self, STREAM, FORMAT, (nullptr),
-            ("%s segment: x-pfap streams have TIME segments", gst_format_get_name(segment.format)));
-        gst_event_unref(event);
-        return FALSE;
-      }
-      self->stream->segment = segment;
-      break;
-    }
-    case GST_EVENT_FLUSH_STOP:
-      reset(self);
-      break;
-    default:
-      break;
-  }
-  return gst_pad_event_default(pad, parent, event);
+  return gst_pad_push(gst_pfap_base_enc_srcpad(enc), out);
 }
 
 static void gst_pfap_text_enc_get_property(GObject* object, guint prop_id, GValue* value,
@@ -189,13 +111,15 @@ static void gst_pfap_text_enc_get_property(GObject* object, guint prop_id, GValu
   GstPfapTextEnc* self = GST_PFAP_TEXT_ENC(object);
   switch (prop_id) {
     case PROP_STATS: {
+      GstPfapBaseEnc* enc = GST_PFAP_BASE_ENC(self);
       GST_OBJECT_LOCK(self);
-      const Stats s = self->stats;
+      const guint64 events = self->events;
       GST_OBJECT_UNLOCK(self);
-      g_value_take_boxed(value, gst_structure_new("application/x-pfap-text-enc-stats", "events",
-                                                  G_TYPE_UINT64, s.events, "malformed",
-                                                  G_TYPE_UINT64, s.malformed, "earlier",
-                                                  G_TYPE_UINT64, s.earlier, nullptr));
+      g_value_take_boxed(
+          value, gst_structure_new("application/x-pfap-text-enc-stats", "events", G_TYPE_UINT64,
+                                   events, "malformed", G_TYPE_UINT64,
+                                   gst_pfap_base_enc_malformed(enc), "earlier", G_TYPE_UINT64,
+                                   gst_pfap_base_enc_earlier(enc), nullptr));
       break;
     }
     default:
@@ -208,11 +132,8 @@ static GstStateChangeReturn gst_pfap_text_enc_change_state(GstElement* element,
                                                            GstStateChange transition) {
   if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) {
     GstPfapTextEnc* self = GST_PFAP_TEXT_ENC(element);
-    reset(self);
-    // The counters start again, as the other elements' do; earlier_count is the timeline's.
-    self->stream->timeline = pfap::EventTimeline{};
     GST_OBJECT_LOCK(self);
-    self->stats = {};
+    self->events = 0;
     GST_OBJECT_UNLOCK(self);
   }
   return GST_ELEMENT_CLASS(gst_pfap_text_enc_parent_class)->change_state(element, transition);
@@ -226,6 +147,7 @@ static void gst_pfap_text_enc_finalize(GObject* object) {
 static void gst_pfap_text_enc_class_init(GstPfapTextEncClass* klass) {
   GObjectClass* gobject_class = G_OBJECT_CLASS(klass);
   GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
+  GstPfapBaseEncClass* enc_class = GST_PFAP_BASE_ENC_CLASS(klass);
 
   GST_DEBUG_CATEGORY_INIT(pfaptextenc_debug, "pfaptextenc", 0, "PFAP text writer");
 
@@ -260,15 +182,11 @@ static void gst_pfap_text_enc_class_init(GstPfapTextEncClass* klass) {
       "gst-pfap developers");
 
   element_class->change_state = gst_pfap_text_enc_change_state;
+  enc_class->handle_event = gst_pfap_text_enc_handle_event;
+  enc_class->reset = gst_pfap_text_enc_reset;
 }
 
 static void gst_pfap_text_enc_init(GstPfapTextEnc* self) {
   self->stream = new Stream{};
-  self->stats = {};
-  self->sinkpad = gst_pad_new_from_static_template(&sink_template, "sink");
-  gst_pad_set_chain_function(self->sinkpad, gst_pfap_text_enc_chain);
-  gst_pad_set_event_function(self->sinkpad, gst_pfap_text_enc_sink_event);
-  gst_element_add_pad(GST_ELEMENT(self), self->sinkpad);
-  self->srcpad = gst_pad_new_from_static_template(&src_template, "src");
-  gst_element_add_pad(GST_ELEMENT(self), self->srcpad);
+  self->events = 0;
 }

@@ -227,6 +227,7 @@ static gboolean gst_rtp_pfap_depay_handle_event(GstRTPBaseDepayload* depay, GstE
 static void drop_malformed(GstRtpPfapDepay* self, pfap::DecodeResult result, guint16 seqnum) {
   guint64 malformed = 0;
   update_stats(self, [&](Stats& s) {
+    ++s.packets;
     ++s.malformed_by_status[static_cast<size_t>(result.status)];
     malformed = ++s.malformed;
   });
@@ -317,12 +318,15 @@ static GstBuffer* gst_rtp_pfap_depay_process_rtp_packet(GstRTPBaseDepayload* dep
       static_cast<const uint8_t*>(gst_rtp_buffer_get_payload(rtp)),
       gst_rtp_buffer_get_payload_len(rtp));
   const pfap::DecodeResult result = pfap::decode_payload(payload, self->stream->packet);
-  update_stats(self, [](Stats& s) { ++s.packets; });
+  // Each path counts the packet in its one update of the stats.
   if (!result.ok()) {
     drop_malformed(self, result, seqnum);
     return nullptr;
   }
-  if (!fits_x_pfap(self, seqnum, payload)) return nullptr;
+  if (!fits_x_pfap(self, seqnum, payload)) {
+    update_stats(self, [](Stats& s) { ++s.packets; });
+    return nullptr;
+  }
 
   // A new SSRC is a new sender, or one restarted: its sequence numbers and FAP state owe
   // nothing to the last one's.
@@ -373,6 +377,7 @@ static GstBuffer* gst_rtp_pfap_depay_process_rtp_packet(GstRTPBaseDepayload* dep
     output(phoneme_buffer(self, i, i == 0 && marker, uncertain, pts));
   });
   update_stats(self, [&](Stats& s) {
+    ++s.packets;
     s.phonemes += packet.phonemes.size();
     s.faps += packet.faps.size();
     s.lost += r.lost;

@@ -127,12 +127,14 @@ struct Stream {
 
 struct _GstRtpPfapPay {
   GstRTPBasePayload parent;
-  // Under the object lock: properties, the pending request and the counters.
+  // Under the object lock: properties and the counters.
   guint max_delay_ms;
   guint recovery_depth;
   guint complete_interval_ms;
-  bool complete_requested;
   Stats stats;
+  // Atomic: whether a request for a complete state waits. The streaming thread reads it before
+  // every packet, and takes the object lock only to count.
+  gint complete_requested;
   Stream* stream;
 };
 
@@ -215,24 +217,32 @@ static pfap::SenderConfig current_config(GstRtpPfapPay* self) {
 }
 
 // An RTP buffer with `packet` as its payload, or nullptr (with an error posted) if it cannot
-// be encoded.
+// be encoded. The header and the payload are memories of their own, as rtpklvpay makes them:
+// the payload is encoded into its memory before it joins the buffer, which costs less than
+// mapping the RTP buffer and finding its payload, and the header is mapped only for M=1.
 static GstBuffer* make_buffer(GstRtpPfapPay* self, const pfap::Packet& packet, bool marker) {
   const size_t size = pfap::encoded_size(packet);
-  GstBuffer* buffer =
-      gst_rtp_base_payload_allocate_output_buffer(GST_RTP_BASE_PAYLOAD(self), size, 0, 0);
-  GstRTPBuffer rtp = GST_RTP_BUFFER_INIT;
-  gst_rtp_buffer_map(buffer, GST_MAP_WRITE, &rtp);
-  const pfap::EncodeStatus status =
-      pfap::encode_payload(packet, {static_cast<uint8_t*>(gst_rtp_buffer_get_payload(&rtp)), size});
-  gst_rtp_buffer_set_marker(&rtp, marker);
-  gst_rtp_buffer_unmap(&rtp);
+  GstMemory* memory = gst_allocator_alloc(nullptr, size, nullptr);
+  GstMapInfo map;
+  gst_memory_map(memory, &map, GST_MAP_WRITE);
+  const pfap::EncodeStatus status = pfap::encode_payload(packet, {map.data, size});
+  gst_memory_unmap(memory, &map);
   if (status != pfap::EncodeStatus::kOk) {
     // Packets come from validated input and the library: this is a bug, not bad data.
-    gst_buffer_unref(buffer);
+    gst_memory_unref(memory);
     GST_ELEMENT_ERROR(self, STREAM, ENCODE, (nullptr),
                       ("cannot encode a packet: %s", pfap::to_string(status)));
     return nullptr;
   }
+  GstBuffer* buffer =
+      gst_rtp_base_payload_allocate_output_buffer(GST_RTP_BASE_PAYLOAD(self), 0, 0, 0);
+  if (marker) {
+    GstRTPBuffer rtp = GST_RTP_BUFFER_INIT;
+    gst_rtp_buffer_map(buffer, GST_MAP_WRITE, &rtp);
+    gst_rtp_buffer_set_marker(&rtp, TRUE);
+    gst_rtp_buffer_unmap(&rtp);
+  }
+  gst_buffer_append_memory(buffer, memory);
   return buffer;
 }
 
@@ -282,12 +292,7 @@ static void account(GstRtpPfapPay* self, const pfap::OutgoingPacket& out, bool r
 static GstFlowReturn push_packet(GstRtpPfapPay* self, const pfap::OutgoingPacket& out) {
   using Kind = pfap::OutgoingPacket::Kind;
   bool requested = false;
-  if (out.kind != Kind::kData) {
-    GST_OBJECT_LOCK(self);
-    requested = self->complete_requested;
-    self->complete_requested = false;
-    GST_OBJECT_UNLOCK(self);
-  }
+  if (out.kind != Kind::kData) requested = g_atomic_int_exchange(&self->complete_requested, FALSE);
   account(self, out, requested);
   if (out.kind == Kind::kCompleteTooLarge) return GST_FLOW_OK;
   GstBuffer* buffer = make_buffer(self, *out.packet, out.marker);
@@ -315,10 +320,7 @@ static GstFlowReturn push_ready(GstRtpPfapPay* self) {
   pfap::Sender& sender = self->stream->sender;
   GstFlowReturn ret = GST_FLOW_OK;
   while (true) {
-    GST_OBJECT_LOCK(self);
-    const bool requested = self->complete_requested;
-    GST_OBJECT_UNLOCK(self);
-    const pfap::OutgoingPacket* out = sender.next(requested);
+    const pfap::OutgoingPacket* out = sender.next(g_atomic_int_get(&self->complete_requested));
     if (out == nullptr) break;
     // After an error the rest is not pushed, but taken, so that the next buffer starts clean.
     if (ret == GST_FLOW_OK) ret = push_packet(self, *out);
@@ -332,10 +334,7 @@ static GstFlowReturn push_ready(GstRtpPfapPay* self) {
 static GstFlowReturn serve_request(GstRtpPfapPay* self) {
   Stream& stream = *self->stream;
   if (stream.pushing) return GST_FLOW_OK;
-  GST_OBJECT_LOCK(self);
-  const bool requested = self->complete_requested;
-  GST_OBJECT_UNLOCK(self);
-  if (!requested) return GST_FLOW_OK;
+  if (!g_atomic_int_get(&self->complete_requested)) return GST_FLOW_OK;
   const pfap::OutgoingPacket* out = stream.sender.complete_now();
   return out != nullptr ? push_packet(self, *out) : GST_FLOW_OK;
 }
@@ -369,7 +368,9 @@ static GstFlowReturn gst_rtp_pfap_pay_handle_buffer(GstRTPBasePayload* payload, 
       GST_CLOCK_TIME_IS_VALID(pts) ? std::optional<int64_t>(pts) : std::nullopt,
       static_cast<int64_t>(payload->segment.start));
   stream.timeline.add(start, int64_t{event.phoneme.duration_ms} * pfap::kNsPerMs);
-  stream.sender.configure(current_config(self));
+  if (const pfap::SenderConfig config = current_config(self); config != stream.sender.config()) {
+    stream.sender.configure(config);
+  }
   stream.sender.push({start, event.phoneme, event.sentence_start}, event.faps);
   return push_ready(self);
 }
@@ -433,9 +434,9 @@ static gboolean gst_rtp_pfap_pay_src_event(GstRTPBasePayload* payload, GstEvent*
   GstRtpPfapPay* self = GST_RTP_PFAP_PAY(payload);
   GST_DEBUG_OBJECT(self, "complete recovery requested");
   GST_OBJECT_LOCK(self);
-  self->complete_requested = true;
   self->stats.requests++;
   GST_OBJECT_UNLOCK(self);
+  g_atomic_int_set(&self->complete_requested, TRUE);
   GstPad* sinkpad = GST_RTP_BASE_PAYLOAD_SINKPAD(payload);
   if (GST_PAD_STREAM_TRYLOCK(sinkpad)) {
     serve_request(self);
@@ -466,8 +467,9 @@ static GstStateChangeReturn gst_rtp_pfap_pay_change_state(GstElement* element,
     reset(self);
     GST_OBJECT_LOCK(self);
     self->stats = {};
-    self->complete_requested = false;  // a new stream starts with a complete packet anyway
     GST_OBJECT_UNLOCK(self);
+    // A new stream starts with a complete packet anyway.
+    g_atomic_int_set(&self->complete_requested, FALSE);
   }
   const GstStateChangeReturn ret =
       GST_ELEMENT_CLASS(gst_rtp_pfap_pay_parent_class)->change_state(element, transition);
@@ -679,7 +681,7 @@ static void gst_rtp_pfap_pay_init(GstRtpPfapPay* self) {
   self->max_delay_ms = kDefaultMaxDelayMs;
   self->recovery_depth = kDefaultRecoveryDepth;
   self->complete_interval_ms = kDefaultCompleteIntervalMs;
-  self->complete_requested = false;
+  self->complete_requested = FALSE;
   self->stats = {};
   self->stream = new Stream{};
   gst_pad_set_query_function(GST_RTP_BASE_PAYLOAD_SRCPAD(self), gst_rtp_pfap_pay_src_query);

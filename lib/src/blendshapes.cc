@@ -132,15 +132,7 @@ VisemeMouth viseme_mouth(Viseme viseme) {
   return kVisemeMouths.at(static_cast<size_t>(viseme));
 }
 
-BlendshapeWeights blendshape_weights(const FapAmplitudes& faps, Viseme viseme) {
-  return blendshape_weights(faps, viseme_mouth(viseme), viseme);
-}
-
-BlendshapeWeights blendshape_weights(const FapAmplitudes& faps, const VisemeMouth& m,
-                                     Viseme viseme) {
-  // The mouth added to the FAPs as pfapface adds it (Animator::faps): the points beside the
-  // middle of each lip move 0.7 as much.
-  FapAmplitudes f = faps;
+void add_mouth(FapAmplitudes& f, const VisemeMouth& m) {
   f[3] += m.open_jaw;
   f[4] += m.lower_t_midlip;
   f[8] += 0.7 * m.lower_t_midlip;
@@ -152,6 +144,17 @@ BlendshapeWeights blendshape_weights(const FapAmplitudes& faps, const VisemeMout
   for (int i : {12, 13, 59, 60}) f[i] += m.raise_corner;
   f[16] += m.push_lip;
   f[17] += m.push_lip;
+}
+
+BlendshapeWeights blendshape_weights(const FapAmplitudes& faps, Viseme viseme) {
+  return blendshape_weights(faps, viseme_mouth(viseme), viseme);
+}
+
+BlendshapeWeights blendshape_weights(const FapAmplitudes& faps, const VisemeMouth& m,
+                                     Viseme viseme) {
+  // The mouth added to the FAPs as pfapface adds it (Animator::faps).
+  FapAmplitudes f = faps;
+  add_mouth(f, m);
 
   BlendshapeWeights w{};
   auto set = [&w](B b, double value) { w[static_cast<size_t>(b)] = value; };

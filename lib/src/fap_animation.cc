@@ -189,7 +189,6 @@ FapRecorder::FapRecorder(double frame_rate, uint32_t max_frames)
 
 void FapRecorder::reset() {
   state_.reset();
-  last_ns_ = 0;
   frames_.clear();
 }
 
@@ -206,8 +205,6 @@ bool FapRecorder::sample_before(int64_t time_ns) {
 }
 
 bool FapRecorder::apply(const MarkupEvent& event, int64_t time_ns) {
-  time_ns = std::max(time_ns, last_ns_);
-  last_ns_ = time_ns;
   if (!sample_before(time_ns)) return false;
   apply_markup(event, time_ns, state_);
   return true;

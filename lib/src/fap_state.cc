@@ -1,20 +1,26 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 #include "pfap/fap_state.h"
 
-#include <algorithm>
 #include <cassert>
 #include <cmath>
 
 namespace pfap {
 
-void FapState::apply(const Fap& fap, int64_t start_ns) {
+[[gnu::always_inline]] inline void FapState::start_transition(const Fap& fap, int64_t start_ns) {
   assert(is_valid(fap));
   // Whatever the track has reached at `start` covers all three starting amplitudes of the
   // draft: 0 before any bookmark, the settled value after one, the curve's value during one.
-  const auto from = static_cast<int32_t>(std::lround(amplitude(fap.index, start_ns)));
+  // Before its start and at rest a track holds a whole value (amplitude()'s first two cases),
+  // so only a running transition needs the curve and rounding.
+  const Track& track = tracks_[fap.index];
+  int32_t from = track.from;
+  if (start_ns >= track.start_ns) {
+    from = start_ns - track.start_ns >= track.duration_ns
+               ? track.settled
+               : static_cast<int32_t>(std::lround(amplitude(fap.index, start_ns)));
+  }
   // A triangle is an excursion: the FAP keeps holding what it held before.
-  const int32_t settled =
-      fap.curve == Curve::kTriangle ? tracks_[fap.index].settled : fap.amplitude;
+  const int32_t settled = fap.curve == Curve::kTriangle ? track.settled : fap.amplitude;
   tracks_[fap.index] = Track{.from = from,
                              .target = fap.amplitude,
                              .settled = settled,
@@ -22,6 +28,8 @@ void FapState::apply(const Fap& fap, int64_t start_ns) {
                              .duration_ns = int64_t{fap.transition_ms} * kNsPerMs,
                              .curve = fap.curve};
 }
+
+void FapState::apply(const Fap& fap, int64_t start_ns) { start_transition(fap, start_ns); }
 
 double FapState::amplitude(int index, int64_t time_ns) const {
   assert(index >= kMinFapIndex && index <= kMaxFapIndex);
@@ -45,34 +53,11 @@ double FapState::amplitude(int index, int64_t time_ns) const {
   return from + (target - from) * u;
 }
 
-int32_t FapState::settled(int index) const {
-  assert(index >= kMinFapIndex && index <= kMaxFapIndex);
-  return tracks_[index].settled;
-}
-
-bool FapState::at_rest(int index, int64_t time_ns) const {
-  assert(index >= kMinFapIndex && index <= kMaxFapIndex);
-  const Track& track = tracks_[index];
-  return time_ns - track.start_ns >= track.duration_ns;
-}
-
-Fap FapState::recovery_entry(int index, int64_t time_ns) const {
-  const Track& track = tracks_[index];
-  const auto fap_index = static_cast<uint8_t>(index);
-  if (at_rest(index, time_ns) || track.curve == Curve::kTriangle) {
-    return {fap_index, settled(index), 0, Curve::kLinear};
-  }
-  // Before the start the whole transition is still to come.
-  const int64_t left_ns = track.start_ns + track.duration_ns - std::max(time_ns, track.start_ns);
-  const auto left_ms = static_cast<uint16_t>((left_ns + kNsPerMs - 1) / kNsPerMs);
-  return {fap_index, track.target, left_ms, track.curve};
-}
-
 void FapState::reset() { tracks_.fill(Track{}); }
 
 void FapState::apply_complete(std::span<const Fap> entries, int64_t time_ns) {
   reset();
-  for (const Fap& entry : entries) apply(entry, time_ns);
+  for (const Fap& entry : entries) start_transition(entry, time_ns);
 }
 
 }  // namespace pfap

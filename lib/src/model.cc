@@ -2,18 +2,8 @@
 #include "pfap/model.h"
 
 #include <algorithm>
-#include <cstdlib>
 
 namespace pfap {
-
-bool is_valid(const Fap& fap) {
-  return fap.index >= kMinFapIndex && fap.index <= kMaxFapIndex &&
-         std::abs(fap.amplitude) <= kMaxAmplitude && fap.transition_ms <= kMaxTransitionMs &&
-         (fap.curve == Curve::kLinear || fap.curve == Curve::kTriangle ||
-          fap.curve == Curve::kSpline);
-}
-
-bool is_valid(const Phoneme& phoneme) { return phoneme.duration_ms <= kMaxPhonemeDurationMs; }
 
 uint8_t f0_code(unsigned hz) { return static_cast<uint8_t>((std::min(hz, kMaxF0Hz) + 1) / 2); }
 

@@ -16,12 +16,6 @@ size_t phoneme_bytes(size_t fap_count) {
   return kPhonemeDescriptorBytes + kFapDescriptorBytes * fap_count;
 }
 
-// Moves the pending packet to `out`; `pending` is left empty, ready for the next packet.
-void finish(PlannedPacket& pending, std::vector<PlannedPacket>& out) {
-  out.push_back(std::move(pending));
-  pending = PlannedPacket{};
-}
-
 }  // namespace
 
 uint32_t rtp_ticks(int64_t time_ns, uint32_t clock_rate) {
@@ -50,7 +44,7 @@ void Packetizer::push(const TimedPhoneme& phoneme, std::span<const Fap> faps,
     if (phoneme.sentence_start || !contiguous ||
         phoneme.start_ns - pending_.start_ns >= config_.max_delay_ns ||
         pending_size_ + bytes > config_.max_payload_size) {
-      finish(pending_, out);
+      finish(out);
     }
   }
 
@@ -70,14 +64,31 @@ void Packetizer::push(const TimedPhoneme& phoneme, std::span<const Fap> faps,
   // or no room for another phoneme (which an oversized packet never has).
   if (phoneme.phoneme.end_of_text || pending_end_ns_ - pending_.start_ns >= config_.max_delay_ns ||
       pending_size_ + kPhonemeDescriptorBytes > config_.max_payload_size) {
-    finish(pending_, out);
+    finish(out);
   }
 }
 
 void Packetizer::drain(std::vector<PlannedPacket>& out) {
-  if (has_pending()) finish(pending_, out);
+  if (has_pending()) finish(out);
 }
 
 void Packetizer::drop() { pending_ = PlannedPacket{}; }
+
+void Packetizer::recycle(std::vector<PlannedPacket>& sent) {
+  for (PlannedPacket& planned : sent) {
+    planned.packet.clear();
+    spare_.push_back(std::move(planned.packet));
+  }
+  sent.clear();
+}
+
+void Packetizer::finish(std::vector<PlannedPacket>& out) {
+  out.push_back(std::move(pending_));
+  pending_ = PlannedPacket{};
+  if (!spare_.empty()) {
+    pending_.packet = std::move(spare_.back());
+    spare_.pop_back();
+  }
+}
 
 }  // namespace pfap

@@ -32,8 +32,10 @@
 //   IB: 00 phoneme follows, 01 FAP follows, 10 and 11 reserved
 #include "pfap/payload.h"
 
+#include <bit>
 #include <cassert>
 #include <cstdlib>
+#include <cstring>
 
 namespace pfap {
 namespace {
@@ -56,21 +58,31 @@ unsigned coverage_code(unsigned covered_packets) {
   return 0;
 }
 
+// Big-endian fields as one copy and a byte swap: GCC made six shifts and stores of the byte
+// loops, and every descriptor goes through these.
+constexpr bool kLittleEndian = std::endian::native == std::endian::little;
+
 uint64_t read_be48(const uint8_t* p) {
-  return (uint64_t{p[0]} << 40) | (uint64_t{p[1]} << 32) | (uint64_t{p[2]} << 24) |
-         (uint64_t{p[3]} << 16) | (uint64_t{p[4]} << 8) | uint64_t{p[5]};
+  uint64_t v = 0;
+  std::memcpy(&v, p, 6);  // the field's bytes first in memory, so at the top on big-endian
+  return (kLittleEndian ? __builtin_bswap64(v) : v) >> 16;
 }
 
 uint32_t read_be32(const uint8_t* p) {
-  return (uint32_t{p[0]} << 24) | (uint32_t{p[1]} << 16) | (uint32_t{p[2]} << 8) | uint32_t{p[3]};
+  uint32_t v;
+  std::memcpy(&v, p, 4);
+  return kLittleEndian ? __builtin_bswap32(v) : v;
 }
 
 void write_be48(uint8_t* p, uint64_t v) {
-  for (int i = 5; i >= 0; --i, v >>= 8) p[i] = static_cast<uint8_t>(v);
+  const uint64_t shifted = v << 16;  // the 48 bits at the top, so they are the first 6 bytes
+  const uint64_t be = kLittleEndian ? __builtin_bswap64(shifted) : shifted;
+  std::memcpy(p, &be, 6);
 }
 
 void write_be32(uint8_t* p, uint32_t v) {
-  for (int i = 3; i >= 0; --i, v >>= 8) p[i] = static_cast<uint8_t>(v);
+  const uint32_t be = kLittleEndian ? __builtin_bswap32(v) : v;
+  std::memcpy(p, &be, 4);
 }
 
 // FAP descriptor and recovery entry without their InfoBits: FAPind 7, s 1, amplitude 22,
@@ -89,8 +101,9 @@ uint32_t pack_phoneme(const Phoneme& phoneme, unsigned info_bits) {
          (uint32_t{phoneme.word_begin} << 2) | info_bits;
 }
 
-// Unpacks and checks the fields a FAP descriptor and a recovery entry share.
-DecodeStatus unpack_fap(uint64_t bits, Fap& fap) {
+// Unpacks and checks the fields a FAP descriptor and a recovery entry share. Always inlined:
+// the decoder's loops call it per descriptor, and GCC left it a call.
+[[gnu::always_inline]] inline DecodeStatus unpack_fap(uint64_t bits, Fap& fap) {
   const unsigned index = static_cast<unsigned>(bits >> 41);
   const int32_t magnitude = static_cast<int32_t>((bits >> 18) & 0x3FFFFF);
   const unsigned curve = static_cast<unsigned>(bits >> 2) & 0b11;
@@ -226,17 +239,20 @@ DecodeResult decode_payload(std::span<const uint8_t> payload, Packet& out) {
   if (type == kRecoveryType1) {
     for (unsigned info_bits = kNextRecovery; info_bits != kEndOfRecovery;
          pos += kFapDescriptorBytes) {
-      if (pos == size) return fail(DecodeStatus::kUnterminatedRecovery, pos);
-      if (size - pos < kFapDescriptorBytes) return fail(DecodeStatus::kTruncated, pos);
+      if (size - pos < kFapDescriptorBytes) {
+        return fail(pos == size ? DecodeStatus::kUnterminatedRecovery : DecodeStatus::kTruncated,
+                    pos);
+      }
       const uint64_t bits = read_be48(data + pos);
       info_bits = bits & 0b11;
       if (info_bits != kNextRecovery && info_bits != kEndOfRecovery) {
         return fail(DecodeStatus::kReservedInfoBits, pos);
       }
-      Fap& entry = out.recovery.emplace_back();
+      Fap entry;
       if (const DecodeStatus status = unpack_fap(bits, entry); status != DecodeStatus::kOk) {
         return fail(status, pos);
       }
+      out.recovery.push_back(entry);
     }
   }
 
@@ -335,9 +351,11 @@ EncodeStatus encode_payload(const Packet& packet, std::span<uint8_t> out) {
   uint8_t* p = out.data();
   *p++ = static_cast<uint8_t>(complete << 7 | type << 5 | pp << 2 | announce(0));
 
-  for (size_t i = 0; i < packet.recovery.size(); ++i, p += kFapDescriptorBytes) {
-    const bool last = i + 1 == packet.recovery.size();
-    write_be48(p, pack_fap(packet.recovery[i], last ? kEndOfRecovery : kNextRecovery));
+  // Pointers, not indexes compared with size(): a size of 12-byte Faps is a division.
+  const Fap* const recovery_end = packet.recovery.data() + packet.recovery.size();
+  for (const Fap* entry = packet.recovery.data(); entry != recovery_end;
+       ++entry, p += kFapDescriptorBytes) {
+    write_be48(p, pack_fap(*entry, entry + 1 == recovery_end ? kEndOfRecovery : kNextRecovery));
   }
   size_t fap = 0;
   for (size_t i = 0; i < phonemes.size(); ++i, p += kPhonemeDescriptorBytes) {

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bitset>
 #include <cassert>
 
 namespace pfap {
@@ -13,21 +14,23 @@ namespace {
 void entries_for(std::span<const std::vector<RecoverySender::SentFap>> packets,
                  const FapState& state, int64_t time_ns, std::vector<Fap>& out) {
   // A triangle that is over changed nothing a FAP holds (FapState): the draft leaves it out.
-  std::array<bool, kFapCount> in_effect{};
+  std::bitset<kFapCount> in_effect;
+  // The indexes in effect, as found: a few per packet, so sorting them costs less than
+  // walking every FAP index.
+  std::array<uint8_t, kFapCount> indexes;
   size_t count = 0;
   for (const auto& packet : packets) {
     for (const RecoverySender::SentFap& b : packet) {
       const bool over = time_ns - b.start_ns >= int64_t{b.fap.transition_ms} * kNsPerMs;
-      const bool effect = b.fap.curve != Curve::kTriangle || !over;
-      count += effect && !in_effect[b.fap.index];
-      in_effect[b.fap.index] |= effect;
+      if ((b.fap.curve == Curve::kTriangle && over) || in_effect[b.fap.index]) continue;
+      in_effect[b.fap.index] = true;
+      indexes[count++] = b.fap.index;
     }
   }
+  std::sort(indexes.begin(), indexes.begin() + count);
   out.clear();
   out.reserve(count);  // one allocation per packet at most, not one per doubling
-  for (int index = kMinFapIndex; index <= kMaxFapIndex && out.size() < count; ++index) {
-    if (in_effect[index]) out.push_back(state.recovery_entry(index, time_ns));
-  }
+  for (size_t i = 0; i < count; ++i) out.push_back(state.recovery_entry(indexes[i], time_ns));
 }
 
 }  // namespace

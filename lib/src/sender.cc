@@ -42,7 +42,7 @@ void Sender::drain() { packetizer_.drain(planned_); }
 
 const OutgoingPacket* Sender::next(bool requested) {
   if (next_planned_ == planned_.size()) {
-    planned_.clear();
+    packetizer_.recycle(planned_);
     next_planned_ = 0;
     return nullptr;
   }

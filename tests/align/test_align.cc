@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // The forced aligner (align/): features comparable across rates, the warp, and alignment of
 // espeak-ng speech spoken at another rate and pitch, whose phoneme times are known, with the
-// boundary error bounded; and each kind of bad input giving a pause and its problem.
+// boundary error bounded; the boundary rules (boundaries.h); and each kind of bad input
+// giving a pause and its problem.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,7 +13,9 @@
 #include <vector>
 
 #include "aligner.h"
+#include "boundaries.h"
 #include "dtw.h"
+#include "f0.h"
 #include "features.h"
 
 namespace pfap::align {
@@ -149,13 +152,28 @@ constexpr const char* kSentences[] = {
     "How much wood would a woodchuck chuck if a woodchuck could chuck wood?",
 };
 
+// espeak-ng's speech of `text` with its phoneme starts in the aligner's phonetic convention
+// (boundaries.h), and each phoneme's f0 measured over those.
+tts::Speech phonetic_truth(const std::string& text, const tts::VoiceSettings& voice) {
+  tts::Speech truth = say(text, voice);
+  to_phonetic_boundaries(truth);
+  std::vector<size_t> bounds;
+  for (const tts::SpokenPhoneme& p : truth.phonemes) bounds.push_back(p.start);
+  bounds.push_back(truth.samples.size());
+  const std::vector<double> f0 = tts::segment_f0(truth.samples, truth.sample_rate, bounds);
+  for (size_t k = 0; k < truth.phonemes.size(); ++k) {
+    truth.phonemes[k].event.phoneme.f0 = f0_code(static_cast<unsigned>(std::lround(f0[k])));
+  }
+  return truth;
+}
+
 // Boundary errors in ms of aligning each sentence spoken at `voice` (as the recording, at
 // `rate`) with the aligner's default voice.
 std::vector<double> boundary_errors(const tts::VoiceSettings& voice, unsigned rate) {
   std::vector<double> errors;
   for (const char* text : kSentences) {
     SCOPED_TRACE(text);
-    const tts::Speech truth = say(text, voice);
+    const tts::Speech truth = phonetic_truth(text, voice);
     const std::vector<int16_t> audio = resample(truth.samples, truth.sample_rate, rate);
     const Alignment a = aligned(text, audio, rate);
     EXPECT_EQ(a.problem, Problem::kNone) << a.relative_cost;
@@ -183,8 +201,8 @@ TEST(Aligner, BoundaryErrorOnSlowerLowerSpeech) {
   ASSERT_GT(e.size(), 100u);
   std::printf("boundaries %zu, median %.1f ms, p90 %.1f ms\n", e.size(), percentile(e, 0.5),
               percentile(e, 0.9));
-  EXPECT_LT(percentile(e, 0.5), 20);
-  EXPECT_LT(percentile(e, 0.9), 50);
+  EXPECT_LT(percentile(e, 0.5), 10);
+  EXPECT_LT(percentile(e, 0.9), 25);
 }
 
 TEST(Aligner, BoundaryErrorAt16kHz) {
@@ -192,13 +210,67 @@ TEST(Aligner, BoundaryErrorAt16kHz) {
   ASSERT_GT(e.size(), 100u);
   std::printf("boundaries %zu, median %.1f ms, p90 %.1f ms\n", e.size(), percentile(e, 0.5),
               percentile(e, 0.9));
-  EXPECT_LT(percentile(e, 0.5), 20);
-  EXPECT_LT(percentile(e, 0.9), 50);
+  EXPECT_LT(percentile(e, 0.5), 10);
+  EXPECT_LT(percentile(e, 0.9), 25);
+}
+
+tts::SpokenPhoneme phoneme_at(uint8_t symbol, size_t start) {
+  tts::SpokenPhoneme p;
+  p.event.phoneme.symbol = symbol;
+  p.start = start;
+  return p;
+}
+
+// espeak-ng's voiceless stop starts at its release, its closure's silence at the end of the
+// phoneme before: the start moves to the closure; every start then kPhoneticLeadSeconds earlier.
+TEST(Boundaries, StopStartsAtItsClosureAndEveryStartLeads) {
+  constexpr unsigned kRate = 22050;
+  tts::Speech s;
+  s.sample_rate = kRate;
+  s.samples = tone(200, 0.1, kRate);                        // AA
+  s.samples.resize(s.samples.size() + kRate * 4 / 100, 0);  // 40 ms closure
+  const size_t release = s.samples.size();
+  const std::vector<int16_t> burst = tone(3000, 0.1, kRate);  // P's release, then on
+  s.samples.insert(s.samples.end(), burst.begin(), burst.end());
+  const size_t pause_at = s.samples.size();
+  s.samples.resize(s.samples.size() + kRate / 10, 0);
+  const size_t after_pause = s.samples.size();
+  s.samples.insert(s.samples.end(), burst.begin(), burst.end());
+  s.phonemes = {phoneme_at(1, 0), phoneme_at(28, release), phoneme_at(0, pause_at),
+                phoneme_at(28, after_pause)};
+  to_phonetic_boundaries(s);
+  const size_t lead = static_cast<size_t>(std::lround(kPhoneticLeadSeconds * kRate));
+  EXPECT_EQ(s.phonemes[0].start, 0u);
+  EXPECT_EQ(s.phonemes[1].start, kRate / 10 - lead);  // the closure's start
+  EXPECT_EQ(s.phonemes[2].start, pause_at - lead);
+  EXPECT_EQ(s.phonemes[3].start, after_pause - lead);  // after a pause the silence is the pause's
+}
+
+// A boundary into or out of a pause moves onto the recording's edge of silence nearby; one
+// between two phonemes, or with no silence within 100 ms, stays.
+TEST(Boundaries, PauseBoundariesSnapToTheEdgesOfSilence) {
+  constexpr unsigned kRate = 16000;
+  std::vector<int16_t> audio = tone(200, 0.3, kRate);
+  std::vector<int16_t> hiss(kRate / 5);
+  for (size_t i = 0; i < hiss.size(); ++i) hiss[i] = static_cast<int16_t>(i % 7) - 3;
+  audio.insert(audio.end(), hiss.begin(), hiss.end());
+  const std::vector<int16_t> more = tone(300, 0.5, kRate);
+  audio.insert(audio.end(), more.begin(), more.end());
+  const std::vector<tts::SpokenPhoneme> phonemes = {
+      phoneme_at(1, 0), phoneme_at(0, 1), phoneme_at(2, 2), phoneme_at(3, 3), phoneme_at(0, 4)};
+  // Warped starts: the pause 20 ms early, speech 30 ms late, a phoneme boundary, and a pause
+  // with no silence near it.
+  std::vector<double> starts = {0.28 * kRate, 0.53 * kRate, 0.7 * kRate, 0.85 * kRate};
+  snap_to_silence(phonemes, audio, kRate, starts);
+  EXPECT_DOUBLE_EQ(starts[0], 0.3 * kRate);
+  EXPECT_DOUBLE_EQ(starts[1], 0.5 * kRate);
+  EXPECT_DOUBLE_EQ(starts[2], 0.7 * kRate);
+  EXPECT_DOUBLE_EQ(starts[3], 0.85 * kRate);
 }
 
 TEST(Aligner, KeepsWordStartsStressAndBookmarks) {
   const std::string text = "Hello <FAP 4 1 0 1> world.";
-  const tts::Speech truth = say(text, {"en", 140, 30, 100});
+  const tts::Speech truth = phonetic_truth(text, {"en", 140, 30, 100});
   const Alignment a = aligned(text, truth.samples, truth.sample_rate);
   ASSERT_EQ(a.phonemes.size(), truth.phonemes.size());
   for (size_t k = 0; k < a.phonemes.size(); ++k) {
@@ -209,8 +281,12 @@ TEST(Aligner, KeepsWordStartsStressAndBookmarks) {
     EXPECT_EQ(got.phoneme.end_of_text, want.phoneme.end_of_text) << k;
     EXPECT_EQ(got.sentence_start, want.sentence_start) << k;
     EXPECT_EQ(got.faps, want.faps) << k;
-    // f0 measured on the recording: espeak-ng's at pitch 30 is that of the truth's phoneme.
-    EXPECT_NEAR(got.phoneme.f0, want.phoneme.f0, 5) << k;
+    // f0 measured on the recording: espeak-ng's at pitch 30 is that of the truth's phoneme,
+    // where both segments are long enough for YIN to find one (a boundary a few ms off can
+    // make a 30 ms phoneme give none).
+    if (got.phoneme.f0 != 0 && want.phoneme.f0 != 0) {
+      EXPECT_NEAR(got.phoneme.f0, want.phoneme.f0, 5) << k;
+    }
   }
   // The bookmark is on "world"'s first phoneme.
   const auto with_faps =

@@ -9,7 +9,7 @@
 #include "pfap/fap_state.h"
 #include "pfap/phoneme_table.h"
 
-namespace face {
+namespace pfap::face {
 namespace {
 
 constexpr int64_t kMs = 1'000'000;
@@ -61,7 +61,7 @@ TEST(Animator, EveryVisemeOfTheAlphabetHasItsShape) {
     event.phoneme.symbol = static_cast<uint8_t>(symbol);
     event.phoneme.duration_ms = 300;
     ASSERT_TRUE(animator.apply(event, 0));
-    const MouthShape expected = viseme_shape(arpabet().symbols[symbol].viseme);
+    const MouthShape expected = pfap::viseme_mouth(arpabet().symbols[symbol].viseme);
     EXPECT_DOUBLE_EQ(animator.faps(200 * kMs)[3], expected.open_jaw)
         << arpabet().symbols[symbol].name;
   }
@@ -188,4 +188,4 @@ TEST(Animator, ResetGivesTheNeutralFace) {
 }
 
 }  // namespace
-}  // namespace face
+}  // namespace pfap::face

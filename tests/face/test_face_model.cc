@@ -6,7 +6,7 @@
 
 #include "face/model.h"
 
-namespace face {
+namespace pfap::face {
 namespace {
 
 FacePose pose_with(std::initializer_list<std::pair<int, double>> amplitudes) {
@@ -153,4 +153,4 @@ TEST(FaceModel, ExpressionsMoveTheFace) {
 }
 
 }  // namespace
-}  // namespace face
+}  // namespace pfap::face

@@ -10,7 +10,7 @@
 #include "face/renderer.h"
 #include "release_fonts.h"
 
-namespace face {
+namespace pfap::face {
 namespace {
 
 constexpr int kWidth = 160, kHeight = 120, kStride = kWidth * 4 + 16;
@@ -77,4 +77,4 @@ TEST(Renderer, LongOverlayWraps) {
 }
 
 }  // namespace
-}  // namespace face
+}  // namespace pfap::face

@@ -479,6 +479,22 @@ TEST(PfapFapEnc, MaxFramesBoundsTheFileWithAWarning) {
   EXPECT_EQ(file.frames[7].value[5], 7);
 }
 
+// The writers' one rule (pfap::EventTimeline, PFAP_WARN_EARLIER_EVENT), as pfaptextenc's.
+TEST(PfapFapEnc, EarlierEventIsWrittenAtThePreviousTimeWithAWarning) {
+  ASSERT_TRUE(plugin_available(kElements));
+  const Encoded out = encode(
+      "frame-rate=10", {phoneme_at(100 * GST_MSECOND, 100, {{3, 50, 0, pfap::Curve::kLinear}}),
+                        phoneme_at(40 * GST_MSECOND, 0, {{3, -20, 0, pfap::Curve::kLinear}})});
+  ASSERT_EQ(out.warnings.size(), 1u);
+  EXPECT_NE(out.warnings[0].find("earlier than the one before"), std::string::npos)
+      << out.warnings[0];
+  pfap::FapFile file;
+  ASSERT_TRUE(pfap::read_fap_file(out.text, file).ok()) << out.text;
+  ASSERT_EQ(file.frames.size(), 2u);
+  EXPECT_EQ(file.frames[0].value[3], 0);    // before the first event
+  EXPECT_EQ(file.frames[1].value[3], -20);  // the earlier event, after the first at 100 ms
+}
+
 TEST(PfapFapEnc, NoEventsNoFileAndAWarning) {
   ASSERT_TRUE(plugin_available(kElements));
   const Encoded out = encode("", {});

@@ -148,7 +148,8 @@ TEST(ManyListenersInNamespace, EveryListenerIsWholeWithinOneInterval) {
     l->pipeline = std::make_unique<Pipeline>(
         std::string("udpsrc address=") + kGroup + " port=" + std::to_string(kPort) +
         " auto-multicast=true caps=\"application/x-rtp,media=application,clock-rate=44100,"
-        "encoding-name=PFAP,payload=97\" ! rtpjitterbuffer ! rtppfapdepay name=depay ! "
+        "encoding-name=PFAP,payload=97\" ! rtpjitterbuffer max-dropout-time=0 max-misorder-time=0 "
+        "! rtppfapdepay name=depay ! "
         "fakesink sync=false");
     ASSERT_TRUE(l->pipeline->ok()) << l->pipeline->error();
     GstPad* pad = gst_element_get_static_pad(l->pipeline->by_name("depay"), "src");

@@ -14,10 +14,12 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "markupbuffer.h"
 #include "pipeline.h"
+#include "recognizer.h"
 #include "speech.h"
 #include "temp_dir.h"
 
@@ -204,18 +206,60 @@ TEST(PfapAlign, NoiseAndAnotherTextWarnOfAPoorMatch) {
   expect_tiles(noisy, gst_util_uint64_scale(noise.size(), GST_SECOND, s.sample_rate));
 }
 
-TEST(PfapAlign, EmptyOrMissingTextWarnsAndIsOnePause) {
+TEST(PfapAlign, EmptyTextWarnsAndIsOnePause) {
   const pfap::tts::Speech s = say(kText);
   const GstClockTime end = gst_util_uint64_scale(s.samples.size(), GST_SECOND, s.sample_rate);
   const Result empty = run(s.samples, s.sample_rate, "");
   EXPECT_TRUE(has_warning(empty, "nothing to speak"));
   ASSERT_EQ(empty.events.size(), 1u);
   expect_tiles(empty, end);
+}
+
+// Without a text (no property, text_sink not linked) the phonemes are recognized from the
+// audio, where the build has the recognizer; else the audio is one pause, with a warning.
+TEST(PfapAlign, WithoutTextPhonemesAreRecognizedOrOnePause) {
+  const pfap::tts::Speech s = say(kText);
+  const GstClockTime end = gst_util_uint64_scale(s.samples.size(), GST_SECOND, s.sample_rate);
   const Result none = run(s.samples, s.sample_rate, nullptr);
-  EXPECT_TRUE(has_warning(none, "No text"));
-  ASSERT_EQ(none.events.size(), 1u);
   expect_tiles(none, end);
   EXPECT_EQ(none.audio, s.samples);
+  if (!pfap::align::recognition_available()) {
+    EXPECT_TRUE(has_warning(none, "cannot recognize phonemes"));
+    ASSERT_EQ(none.events.size(), 1u);
+    return;
+  }
+  EXPECT_TRUE(none.warnings.empty());
+  size_t phonemes = 0;
+  for (const Event& e : none.events) phonemes += e.event.phoneme.symbol != 0 ? 1 : 0;
+  EXPECT_GT(phonemes, 20u);  // espeak-ng says 41
+  EXPECT_TRUE(none.events.front().event.sentence_start);
+  EXPECT_TRUE(none.events.back().event.phoneme.end_of_text);
+}
+
+// Bad input without a text: silence, noise and a rate the model does not take each warn, the
+// audio passes unchanged and the phonemes are one pause over it.
+TEST(PfapAlign, WithoutTextBadInputWarnsAndIsOnePause) {
+  if (!pfap::align::recognition_available()) GTEST_SKIP() << "no recognizer in this build";
+  const std::vector<int16_t> silence(16000, 0);
+  std::vector<int16_t> noise(16000);
+  uint32_t x = 1;
+  for (int16_t& v : noise) {
+    x = x * 1664525 + 1013904223;
+    v = static_cast<int16_t>(static_cast<int>((x >> 16) % 16000) - 8000);
+  }
+  const std::vector<std::tuple<std::vector<int16_t>, unsigned, const char*>> cases{
+      {silence, 16000, "silent"},
+      {noise, 16000, "no speech was recognized"},
+      {noise, 8000, "8000 Hz cannot be aligned"},
+  };
+  for (const auto& [audio, rate, warning] : cases) {
+    const Result r = run(audio, rate, nullptr);
+    EXPECT_TRUE(has_warning(r, warning)) << warning;
+    EXPECT_EQ(r.audio, audio);
+    ASSERT_EQ(r.events.size(), 1u) << warning;
+    EXPECT_EQ(r.events[0].event.phoneme.symbol, 0);
+    expect_tiles(r, gst_util_uint64_scale(audio.size(), GST_SECOND, rate));
+  }
 }
 
 TEST(PfapAlign, UnsupportedRateWarnsAndPassesTheAudio) {
@@ -319,7 +363,7 @@ size_t file_size(const std::string& path) {
 
 TEST(PfapAlignDocumented, EveryCommandRuns) {
   const std::vector<std::string> commands = documented_commands();
-  ASSERT_EQ(commands.size(), 3u);
+  ASSERT_EQ(commands.size(), 4u);
   const pfap::testing::TempDir dir;
   const std::string text =
       "Please call Stella. Ask her to bring these things with her from the store.";
@@ -356,6 +400,11 @@ TEST(PfapAlignDocumented, EveryCommandRuns) {
   EXPECT_EQ(symbols(read("speech.pfap")), symbols(from_property));
   ASSERT_EQ(run_line(commands[2], dir), "") << commands[2];
   EXPECT_GT(file_size(dir.file("face.webm")), 20000u);
+  ASSERT_EQ(run_line(commands[3], dir), "") << commands[3];
+  const std::string without_text = read("speech.pfap");
+  // Recognized phonemes, or one pause where the build cannot recognize.
+  EXPECT_GT(std::count(without_text.begin(), without_text.end(), '\n'),
+            pfap::align::recognition_available() ? 30 : 0);
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "element_harness.h"
 #include "glib_log.h"
 #include "heap.h"
 #include "lip_sync.h"
@@ -45,26 +46,17 @@ struct Audio {
   std::vector<int16_t> samples;
 };
 
-// pfaptts between two harnesses: one feeding its sink pad and taking `audio`, one on `pfap`.
-class Tts {
+// pfaptts between two harnesses: the shared fixture's on the sink pad and `audio`, a second
+// one on `pfap`.
+class Tts : public pfap::testing::ElementHarness {
  public:
-  Tts() : h_(gst_harness_new_with_padnames("pfaptts", "sink", "audio")), bus_(gst_bus_new()) {
+  Tts() : ElementHarness(gst_harness_new_with_padnames("pfaptts", "sink", "audio")) {
     pfap_ = gst_harness_new_with_element(h_->element, nullptr, "pfap");
-    gst_element_set_bus(h_->element, bus_);
     gst_harness_set_src_caps_str(h_, "text/x-raw, format=(string)utf8");
   }
-  ~Tts() {
-    gst_bus_set_flushing(bus_, TRUE);
-    gst_harness_teardown(pfap_);
-    gst_harness_teardown(h_);
-    gst_object_unref(bus_);
-  }
-  Tts(const Tts&) = delete;
-  Tts& operator=(const Tts&) = delete;
+  ~Tts() { gst_harness_teardown(pfap_); }
 
-  GstHarness* harness() { return h_; }
   GstHarness* pfap_harness() { return pfap_; }
-  GstElement* element() { return h_->element; }
 
   GstFlowReturn say(std::string_view text, GstClockTime pts = GST_CLOCK_TIME_NONE) {
     return gst_harness_push(h_, text_buffer(text, pts));
@@ -112,13 +104,9 @@ class Tts {
     return out;
   }
 
-  std::vector<std::string> errors() { return pop_messages(bus_, GST_MESSAGE_ERROR); }
-  std::vector<std::string> warnings() { return pop_messages(bus_, GST_MESSAGE_WARNING); }
 
  private:
-  GstHarness* h_;
   GstHarness* pfap_;
-  GstBus* bus_;
 };
 
 uint64_t total_samples(const std::vector<Audio>& audio) {

@@ -10,12 +10,12 @@
 //   export_vectors rtp                  seeded RTP packets and what gst_rtp_buffer_map reads
 //   export_vectors curves               pfap::FapState amplitudes, settled values and
 //                                       recovery entries after seeded bookmarks
-//   export_vectors animator             face::Animator's FAP values after seeded events
+//   export_vectors animator             pfap::face::Animator's FAP values after seeded events
 //   export_vectors alphabet             x-pfap-arpabet: each symbol 0..255's name and viseme
 //   export_vectors recovery             the seeded speech sessions sent with recovery, lost
 //                                       at seeded places, and what RecoveryReceiver holds
 //   export_vectors render DIR           face states, their poses, and their frames drawn by
-//                                       face::render as raw BGRx files in DIR
+//                                       pfap::face::render as raw BGRx files in DIR
 // The JSON shapes are the package's own (web/src/index.d.ts): the tests compare them whole.
 #include <gst/rtp/gstrtpbuffer.h>
 
@@ -34,6 +34,7 @@
 #include "face/animator.h"
 #include "face/model.h"
 #include "face/renderer.h"
+#include "pfap/blendshapes.h"
 #include "pfap/fap_state.h"
 #include "pfap/packetizer.h"
 #include "pfap/payload.h"
@@ -335,7 +336,7 @@ int export_curves() {
   return 0;
 }
 
-std::string values_json(const face::FapValues& f) {
+std::string values_json(const pfap::face::FapValues& f) {
   std::string out = "[";
   for (size_t i = 0; i < f.size(); ++i) out += (i ? "," : "") + number(f[i]);
   return out + "]";
@@ -347,7 +348,7 @@ int export_animator() {
   pfap::testing::RandomMarkup random(1848);
   std::cout << "[";
   for (int run = 0; run < 20; ++run) {
-    face::Animator animator;
+    pfap::face::Animator animator;
     animator.set_alphabet(run % 4 == 3 ? nullptr : pfap::find_alphabet(pfap::kArpabetAlphabet));
     int64_t t = int64_t{random.uniform(0, 1000)} * 1'000'000;
     std::cout << (run ? ",\n" : "")
@@ -529,16 +530,16 @@ int export_recovery() {
 // Face states: the neutral face, every viseme, every expression, the head turned, the eyes,
 // the brows and the cheeks; each drawn in both styles.
 int export_render(const char* dir) {
-  std::vector<std::pair<std::string, face::FapValues>> states;
+  std::vector<std::pair<std::string, pfap::face::FapValues>> states;
   const auto state = [&](std::string name, std::initializer_list<std::pair<int, double>> faps) {
-    face::FapValues f{};
+    pfap::face::FapValues f{};
     for (const auto& [index, amplitude] : faps) f[index] = amplitude;
     states.emplace_back(std::move(name), f);
   };
   state("neutral", {});
   for (int v = 1; v <= 14; ++v) {
-    face::FapValues f{};
-    const face::MouthShape m = face::viseme_shape(static_cast<pfap::Viseme>(v));
+    pfap::face::FapValues f{};
+    const pfap::VisemeMouth m = pfap::viseme_mouth(static_cast<pfap::Viseme>(v));
     f[3] = m.open_jaw;
     f[4] = m.lower_t_midlip;
     f[5] = m.raise_b_midlip;
@@ -548,7 +549,7 @@ int export_render(const char* dir) {
     states.emplace_back("viseme" + std::to_string(v), f);
   }
   for (int e = 1; e <= 6; ++e) {
-    face::FapValues f{};
+    pfap::face::FapValues f{};
     f[68 + e] = 63;
     states.emplace_back("expression" + std::to_string(e), f);
   }
@@ -563,9 +564,9 @@ int export_render(const char* dir) {
 
   std::cout << "[";
   for (size_t i = 0; i < states.size(); ++i) {
-    face::FapValues f = states[i].second;
-    face::add_expressions(f);
-    const face::FacePose pose = face::pose_from_faps(f);
+    pfap::face::FapValues f = states[i].second;
+    pfap::face::add_expressions(f);
+    const pfap::face::FacePose pose = pfap::face::pose_from_faps(f);
     std::cout << (i ? ",\n" : "") << "{\"name\":\"" << states[i].first
               << "\",\"faps\":" << values_json(states[i].second)
               << ",\"pose\":{\"roll\":" << number(pose.roll) << ",\"outline\":[";
@@ -584,17 +585,17 @@ int export_render(const char* dir) {
     }
     std::cout << "],\"eyes\":[";
     for (size_t k = 0; k < 2; ++k) {
-      const face::Eye& e = pose.eyes[k];
+      const pfap::face::Eye& e = pose.eyes[k];
       std::cout << (k ? "," : "") << number(e.center.x) << "," << number(e.center.y) << ","
                 << number(e.half_width) << "," << number(e.upper_lid) << "," << number(e.lower_lid)
                 << "," << number(e.pupil.x) << "," << number(e.pupil.y);
     }
     std::cout << "]}}";
-    for (const auto& [style, style_name] :
-         {std::pair{face::Style::kCartoon, "cartoon"}, std::pair{face::Style::kLine, "line"}}) {
+    for (const auto& [style, style_name] : {std::pair{pfap::face::Style::kCartoon, "cartoon"},
+                                            std::pair{pfap::face::Style::kLine, "line"}}) {
       constexpr int kWidth = 320, kHeight = 240;
       std::vector<uint8_t> pixels(4 * kWidth * kHeight);
-      face::render(pose, style, "", {pixels.data(), kWidth, kHeight, 4 * kWidth, false});
+      pfap::face::render(pose, style, "", {pixels.data(), kWidth, kHeight, 4 * kWidth, false});
       std::ofstream out(std::filesystem::path(dir) / (states[i].first + "-" + style_name + ".bgrx"),
                         std::ios::binary);
       out.write(reinterpret_cast<const char*>(pixels.data()),

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// A face over time, as pfapface's face::Animator (face/src/animator.cc, docs/face.md): the
+// A face over time, as pfapface's pfap::face::Animator (face/src/animator.cc, docs/face.md): the
 // FAP state of every bookmark, the mouth shapes of the phonemes (visemes, with
 // coarticulation) and the expressions, as the amplitude of every FAP at any time.
 

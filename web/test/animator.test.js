@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// Animator and face model against pfapface's (face::Animator, face::pose_from_faps): seeded
-// phonemes (x-pfap-arpabet, unknown symbols, no alphabet), FAPs, recovered and complete states
-// give the same FAP values and overlay text (poses: renderer.test.js); the phoneme table is
-// libpfap's.
+// Animator and face model against pfapface's (pfap::face::Animator,
+// pfap::face::pose_from_faps): seeded phonemes (x-pfap-arpabet, unknown symbols, no alphabet),
+// FAPs, recovered and complete states give the same FAP values and overlay text (poses:
+// renderer.test.js); the phoneme table is libpfap's.
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 
@@ -16,7 +16,7 @@ function near(actual, expected, where) {
   assert.ok(Math.abs(actual - expected) <= EPSILON * Math.max(1, Math.abs(expected)), `${where}: ${actual}, C++ ${expected}`);
 }
 
-test('FAP values over time equal face::Animator\'s', () => {
+test('FAP values over time equal pfap::face::Animator\'s', () => {
   const runs = exportVectors(['animator']);
   assert.equal(runs.length, 20);
   let unknown = 0;

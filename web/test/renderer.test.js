@@ -2,7 +2,7 @@
 // The canvas renderer against pfapface's cairo renderer: for face states (neutral, the 14
 // visemes, the 6 expressions, head turned, tilted and nodding, eyes, brows, cheeks, jaw), the
 // poses are equal and the frames drawn by renderFace on @napi-rs/canvas (Skia) match
-// face::render's (cairo) in both styles, 320x240, within this tolerance:
+// pfap::face::render's (cairo) in both styles, 320x240, within this tolerance:
 //   - mean absolute difference over all pixels and channels at most MEAN_TOLERANCE levels;
 //   - at most FAR_SHARE of the pixels differ by more than FAR_LEVELS in some channel.
 // The two libraries anti-alias edges differently, so edge pixels differ by a few levels and
@@ -68,7 +68,7 @@ function poseOf(faps) {
   return poseFromFaps(f);
 }
 
-test('poses equal face::pose_from_faps\'s', () => {
+test('poses equal pfap::face::pose_from_faps\'s', () => {
   assert.equal(states.length, 29);
   for (const state of states) {
     const pose = poseOf(state.faps);

@@ -7,27 +7,17 @@
 #include <string>
 
 #include "face/model.h"
+#include "pfap/blendshapes.h"
 #include "pfap/fap_state.h"
 #include "pfap/markup_event.h"
 #include "pfap/phoneme_table.h"
 
-namespace face {
+namespace pfap::face {
 
-// A mouth shape as FAP displacements, the same on both sides, in FAP units.
-struct MouthShape {
-  double open_jaw = 0;        // FAP 3
-  double lower_t_midlip = 0;  // FAP 4 (and 8, 9 by half)
-  double raise_b_midlip = 0;  // FAP 5 (and 10, 11 by half)
-  double stretch_corner = 0;  // FAPs 6, 7
-  double raise_corner = 0;    // FAPs 12, 13
-  double push_lip = 0;        // FAPs 16, 17
+// A mouth is the library's pfap::VisemeMouth, each viseme's pfap::viseme_mouth(), so that the
+// face drawn and the blendshapes sent (pfap/blendshapes.h) have one table.
+using MouthShape = pfap::VisemeMouth;
 
-  MouthShape blend(const MouthShape& to, double u) const;  // u = 0 this, 1 `to`
-  bool operator==(const MouthShape&) const = default;
-};
-
-// The shape of each MPEG-4 viseme (kNone: the closed, neutral mouth).
-MouthShape viseme_shape(pfap::Viseme viseme);
 // The mouth of a phoneme whose viseme is unknown, at its widest (mid-phoneme).
 MouthShape generic_mouth();
 
@@ -86,4 +76,4 @@ class Animator {
   int64_t end_ns_ = 0;
 };
 
-}  // namespace face
+}  // namespace pfap::face

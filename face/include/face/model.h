@@ -13,7 +13,7 @@
 
 #include "pfap/model.h"
 
-namespace face {
+namespace pfap::face {
 
 // Amplitudes of every FAP, indexed by FAP number (0..2 unused).
 using FapValues = std::array<double, pfap::kFapCount>;
@@ -86,4 +86,4 @@ void add_expressions(FapValues& faps);
 // amplitude x its unit, then the head rotates by pitch, yaw and roll (FAPs 48..50).
 FacePose pose_from_faps(const FapValues& faps);
 
-}  // namespace face
+}  // namespace pfap::face

@@ -7,7 +7,7 @@
 
 #include "face/model.h"
 
-namespace face {
+namespace pfap::face {
 
 enum class Style {
   kCartoon,  // flat colours: skin, hair, lips, eyes, shaded by the expressions
@@ -30,4 +30,4 @@ struct Frame {
 // dark band (wrapped at word boundaries to the width).
 void render(const FacePose& pose, Style style, std::string_view overlay, const Frame& frame);
 
-}  // namespace face
+}  // namespace pfap::face

@@ -84,10 +84,9 @@ struct HeadPose {
   double roll = 0;
 };
 
-// A mouth as the FAP displacements pfapface's animator adds for a viseme (face::MouthShape,
-// which tests/face checks this agrees with): jaw (FAP 3), upper mid lip down (4; 8, 9 by 0.7),
-// lower mid lip up (5; 10, 11 by 0.7), corners out (6, 7, 53, 54), corners up (12, 13, 59,
-// 60), lips pushed (16, 17).
+// A mouth as FAP displacements, the same on both sides, in FAP units: what pfapface's animator
+// (pfap::face::Animator) adds for a viseme, and what the blendshapes read (add_mouth says
+// which FAPs each field moves).
 struct VisemeMouth {
   double open_jaw = 0;
   double lower_t_midlip = 0;
@@ -102,6 +101,11 @@ struct VisemeMouth {
 
 // The mouth of `viseme` (kNone: closed, neutral).
 VisemeMouth viseme_mouth(Viseme viseme);
+
+// Adds `mouth` to the lip FAPs, inner and outer: jaw (FAP 3), upper mid lip down (4; 8, 9 by
+// 0.7), lower mid lip up (5; 10, 11 by 0.7), corners out (6, 7, 53, 54), corners up (12, 13,
+// 59, 60), lips pushed (16, 17). The points beside the middle of each lip move less.
+void add_mouth(FapAmplitudes& faps, const VisemeMouth& mouth);
 
 // The weights for `faps` (amplitudes in FAP units, as FapState gives them) with `mouth` on
 // them, while `viseme` sounds (kNone in pauses; it adds what FAPs cannot say, th's tongue):

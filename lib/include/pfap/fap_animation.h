@@ -92,9 +92,9 @@ struct NotWritten {
 class FapRecorder {
  public:
   explicit FapRecorder(double frame_rate, uint32_t max_frames = kMaxFapFileFrames);
-  // Applies an event at `time_ns` from frame 0's time (times never go back: an earlier one is
-  // taken at the latest time so far). The frames before it are sampled first. False once
-  // max_frames are sampled: later events are not recorded.
+  // Applies an event at `time_ns` from frame 0's time, 0 or later and never earlier than the
+  // event before (EventTimeline places events so: timeline.h). The frames before it are
+  // sampled first. False once max_frames are sampled: later events are not recorded.
   bool apply(const MarkupEvent& event, int64_t time_ns);
   // Samples the frames that start before `end_ns` (at least frame 0), then more while a
   // transition is still running at the last one. False if max_frames cut the end off.
@@ -112,7 +112,6 @@ class FapRecorder {
   double frame_rate_;
   uint32_t max_frames_;
   FapState state_;
-  int64_t last_ns_ = 0;
   std::vector<FapAmplitudes> frames_;
 };
 

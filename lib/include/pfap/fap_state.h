@@ -15,6 +15,7 @@
 #pragma once
 
 #include <array>
+#include <cassert>
 #include <cstdint>
 #include <span>
 
@@ -31,14 +32,33 @@ class FapState {
   // bookmark applied to it (earlier times give that bookmark's starting amplitude).
   double amplitude(int index, int64_t time_ns) const;
   // What FAP `index` holds once its transition is over (a triangle's p).
-  int32_t settled(int index) const;
+  int32_t settled(int index) const {
+    assert(index >= kMinFapIndex && index <= kMaxFapIndex);
+    return tracks_[index].settled;
+  }
   // Whether FAP `index` has no transition running at `time_ns`.
-  bool at_rest(int index, int64_t time_ns) const;
+  bool at_rest(int index, int64_t time_ns) const {
+    assert(index >= kMinFapIndex && index <= kMaxFapIndex);
+    const Track& track = tracks_[index];
+    return time_ns - track.start_ns >= track.duration_ns;
+  }
   // The recovery entry that brings a receiver to this FAP's settled value from `time_ns` on:
   // the target and the time left (rounded up) of a linear or spline transition still
   // running, else the settled value at once. A running triangle's excursion is left out:
   // recovery restores state, and the triangle's state is the value it returns to.
-  Fap recovery_entry(int index, int64_t time_ns) const;
+  // Inline, with the accessors above: a complete state takes one entry per FAP.
+  Fap recovery_entry(int index, int64_t time_ns) const {
+    const Track& track = tracks_[index];
+    const auto fap_index = static_cast<uint8_t>(index);
+    if (at_rest(index, time_ns) || track.curve == Curve::kTriangle) {
+      return {fap_index, track.settled, 0, Curve::kLinear};
+    }
+    // Before the start the whole transition is still to come.
+    const int64_t left_ns =
+        track.start_ns + track.duration_ns - (time_ns > track.start_ns ? time_ns : track.start_ns);
+    const auto left_ms = static_cast<uint16_t>((left_ns + kNsPerMs - 1) / kNsPerMs);
+    return {fap_index, track.target, left_ms, track.curve};
+  }
   // Every FAP back to 0 with no transition running, as after construction.
   void reset();
   // Takes a complete state (C=1) at `time_ns`: every FAP not among `entries` is 0, so the
@@ -46,6 +66,9 @@ class FapState {
   void apply_complete(std::span<const Fap> entries, int64_t time_ns);
 
  private:
+  // apply(), inlined into apply_complete's loop over every FAP of a complete state.
+  void start_transition(const Fap& fap, int64_t start_ns);
+
   struct Track {
     int32_t from = 0;  // amplitude when the transition started
     int32_t target = 0;

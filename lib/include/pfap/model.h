@@ -55,8 +55,17 @@ struct Phoneme {
   unsigned f0_hz() const { return 2u * f0; }
 };
 
-bool is_valid(const Fap& fap);
-bool is_valid(const Phoneme& phoneme);
+// Inline: the codec checks every descriptor, and a call each costs more than the check.
+inline bool is_valid(const Fap& fap) {
+  const int32_t magnitude = fap.amplitude < 0 ? -fap.amplitude : fap.amplitude;
+  return fap.index >= kMinFapIndex && fap.index <= kMaxFapIndex && magnitude <= kMaxAmplitude &&
+         fap.transition_ms <= kMaxTransitionMs &&
+         (fap.curve == Curve::kLinear || fap.curve == Curve::kTriangle ||
+          fap.curve == Curve::kSpline);
+}
+inline bool is_valid(const Phoneme& phoneme) {
+  return phoneme.duration_ms <= kMaxPhonemeDurationMs;
+}
 
 // The f0 code for a frequency in Hz: nearest 2 Hz step, halves rounded up, saturating at
 // 510 Hz (code 255).

@@ -66,13 +66,20 @@ class Packetizer {
   void drain(std::vector<PlannedPacket>& out);
   // Forgets the pending packet (GStreamer's FLUSH).
   void drop();
+  // Takes back the packets in `sent` (and clears it) once the caller is done with them: their
+  // vectors hold the next packets, so that a steady stream stops allocating.
+  void recycle(std::vector<PlannedPacket>& sent);
 
   bool has_pending() const { return !pending_.packet.phonemes.empty(); }
   const PacketizerConfig& config() const { return config_; }
 
  private:
+  // Moves the pending packet to `out` and starts an empty one, in recycled storage if any.
+  void finish(std::vector<PlannedPacket>& out);
+
   PacketizerConfig config_;
   PlannedPacket pending_;
+  std::vector<Packet> spare_;  // recycled, cleared
   size_t pending_size_ = 0;
   int64_t pending_end_ns_ = 0;  // where the next contiguous phoneme starts
 };

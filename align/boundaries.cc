@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+#include "boundaries.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+namespace pfap::align {
+namespace {
+
+bool is_pause(const tts::SpokenPhoneme& p) { return p.event.phoneme.symbol == 0; }
+
+}  // namespace
+
+void to_phonetic_boundaries(tts::Speech& syn) {
+  constexpr int kQuiet = 8;  // espeak-ng's closures are zeros; its speech is far louder
+  const size_t min_run = syn.sample_rate / 200;      // 5 ms
+  const size_t max_burst = syn.sample_rate / 100;    // 10 ms of release before the event
+  const size_t max_back = syn.sample_rate * 3 / 20;  // 150 ms
+  std::vector<tts::SpokenPhoneme>& ph = syn.phonemes;
+  for (size_t k = 1; k < ph.size(); ++k) {
+    if (is_pause(ph[k]) || is_pause(ph[k - 1])) continue;
+    const size_t start = ph[k].start, floor = ph[k - 1].start;
+    size_t j = start;
+    while (j > floor && start - j <= max_burst && std::abs(syn.samples[j - 1]) > kQuiet) --j;
+    const size_t silence_end = j;
+    while (j > floor && start - j <= max_back && std::abs(syn.samples[j - 1]) <= kQuiet) --j;
+    if (silence_end - j >= min_run && j > floor) ph[k].start = j;
+  }
+  const auto lead = static_cast<size_t>(std::lround(kPhoneticLeadSeconds * syn.sample_rate));
+  for (size_t k = 1; k < ph.size(); ++k) {
+    ph[k].start = std::max(ph[k - 1].start, ph[k].start > lead ? ph[k].start - lead : 0);
+  }
+}
+
+void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
+                     std::span<const int16_t> audio, unsigned rate, std::vector<double>& starts) {
+  constexpr long kRadiusBlocks = 20;     // 100 ms
+  constexpr size_t kMinQuietBlocks = 4;  // 20 ms
+  const size_t block = rate / 200;       // 5 ms
+  const size_t n = block > 0 ? audio.size() / block : 0;
+  if (n < 2 * kMinQuietBlocks) return;
+  std::vector<float> db(n);
+  for (size_t b = 0; b < n; ++b) {
+    double energy = 0;
+    for (size_t i = 0; i < block; ++i) {
+      const double x = audio[b * block + i] / 32768.0;
+      energy += x * x;
+    }
+    db[b] = static_cast<float>(10 * std::log10(energy / static_cast<double>(block) + 1e-12));
+  }
+  std::vector<float> sorted = db;
+  std::sort(sorted.begin(), sorted.end());
+  const float threshold = std::min(sorted[n / 10] + 20, sorted.back() - 20);
+  auto quiet_blocks = [&](long from, long step) {
+    size_t count = 0;
+    for (long b = from; b >= 0 && b < static_cast<long>(n) && db[b] < threshold; b += step) {
+      ++count;
+    }
+    return count;
+  };
+  for (size_t k = 1; k < phonemes.size() && k <= starts.size(); ++k) {
+    const bool speech_ends = is_pause(phonemes[k]) && !is_pause(phonemes[k - 1]);
+    const bool speech_begins = !is_pause(phonemes[k]) && is_pause(phonemes[k - 1]);
+    if (!speech_ends && !speech_begins) continue;
+    // The edge between blocks b - 1 and b nearest the warp's boundary.
+    const long at = std::lround(starts[k - 1] / static_cast<double>(block));
+    for (long d = 0; d <= kRadiusBlocks; ++d) {
+      const long found = [&] {
+        for (long b : {at - d, at + d}) {
+          if (b < 1 || b >= static_cast<long>(n)) continue;
+          if (speech_ends && db[b - 1] >= threshold && quiet_blocks(b, 1) >= kMinQuietBlocks) {
+            return b;
+          }
+          if (speech_begins && db[b] >= threshold && quiet_blocks(b - 1, -1) >= kMinQuietBlocks) {
+            return b;
+          }
+        }
+        return -1L;
+      }();
+      if (found >= 0) {
+        starts[k - 1] = static_cast<double>(found) * static_cast<double>(block);
+        break;
+      }
+    }
+  }
+}
+
+}  // namespace pfap::align

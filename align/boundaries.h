@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Where phoneme boundaries lie, beyond what the warp gives: espeak-ng's phoneme starts moved to
+// where phonetic labels put them, and boundaries next to a pause moved onto the recording's
+// silence. Each rule and what it gave on the Festival corpus: docs/align.md.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "speech.h"
+
+namespace pfap::align {
+
+// How much earlier than espeak-ng's phoneme events phonetic labels put the boundaries: the
+// signed median error was +12 ms on both halves of the Festival corpus; 10 ms was chosen on
+// the tuning half (docs/align.md).
+inline constexpr double kPhoneticLeadSeconds = 0.010;
+
+// Moves the starts of `syn`'s phonemes (espeak-ng's) to phonetic convention, in place:
+//  - espeak-ng starts a voiceless stop (p, t, k, ch) at its release, its closure (digital
+//    silence) at the end of the phoneme before; labels start a stop at its closure, which is
+//    also where the lips close. A phoneme after a non-pause whose start is preceded, within
+//    10 ms, by at least 5 ms of silence (|sample| <= 8) starts where that silence starts
+//    (at most 150 ms back).
+//  - then every start after the first moves kPhoneticLeadSeconds earlier, never before the
+//    start before it.
+void to_phonetic_boundaries(tts::Speech& syn);
+
+// Moves each boundary next to a pause in `phonemes` (a start into a pause: speech ends; a
+// start out of one: speech begins) onto the nearest edge of silence in `audio` within 100 ms:
+// the warp matches a fading end of speech with the synthetic pause. `starts[k]` is phoneme
+// k + 1's start in samples of `audio` (phoneme 0 starts at 0). Silence: 5 ms blocks below the
+// recording's floor (its 10th-percentile block) + 20 dB, or below its loudest - 20 dB if that
+// is lower, for at least 20 ms.
+void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
+                     std::span<const int16_t> audio, unsigned rate, std::vector<double>& starts);
+
+}  // namespace pfap::align

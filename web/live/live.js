@@ -1,0 +1,233 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// The page of tools/pfap-web (docs/web.md): a WebRTC session with the server, the speech
+// played from its audio track, the PFAP packets of its data channel handed to a PfapReceiver,
+// and the face drawn at each animation frame at the PFAP time of the audio being played.
+//
+// Timing: the server stamps the audio and the PFAP packets from one running time r, as
+// audioTimestampOffset + r * 48000 and pfapTimestampOffset + r * 44100 (mod 2^32), and says
+// both offsets once ('timing'). The audio receiver's synchronization source gives the RTP
+// timestamp of the audio last played and when; from it the running time being played now,
+// and from that the PfapReceiver's stream time (ns since the first PFAP packet's timestamp).
+//
+// window.pfapStats holds the figures the browser test reads.
+import { PfapReceiver, Viseme, parseRtp } from '../src/index.js';
+
+/**
+ * Lip sync measured against the sound: each speech onset (the level passing 3 % of the
+ * peak) after at least `silenceMs` of silence (under 1 %) in the played audio, paired with
+ * the nearest frame within `windowMs` that began drawing lips pressed for p, b or m (the
+ * first frame of such a phoneme after one of another): a "pa" sounds as its lips open, at
+ * the start of its p, whose closure is the silence before it. The errors are frame time
+ * minus onset time.
+ * @param {{t: number, rms: number}[]} envelope played audio, 1 ms blocks, performance time
+ * @param {{t: number, pressed: boolean}[]} frames drawn frames, performance time
+ * @returns {number[]} ms
+ */
+export function lipSyncErrors(envelope, frames, { silenceMs = 30, windowMs = 150 } = {}) {
+  const peak = envelope.reduce((m, e) => Math.max(m, e.rms), 0);
+  const onsets = [];
+  let quietSince = -Infinity;
+  let quiet = true;
+  for (const e of envelope) {
+    if (e.rms < peak * 0.01) {
+      if (!quiet) quietSince = e.t;
+      quiet = true;
+    } else if (e.rms > peak * 0.03) {
+      if (quiet && e.t - quietSince >= silenceMs) onsets.push(e.t);
+      quiet = false;
+    }
+  }
+  const closures = [];
+  for (let i = 1; i < frames.length; ++i) {
+    if (!frames[i - 1].pressed && frames[i].pressed) closures.push(frames[i].t);
+  }
+  const errors = [];
+  for (const onset of onsets) {
+    const near = closures.filter((t) => Math.abs(t - onset) <= windowMs);
+    if (near.length === 0) continue;
+    const best = near.reduce((a, b) => (Math.abs(a - onset) <= Math.abs(b - onset) ? a : b));
+    errors.push(Math.round((best - onset) * 100) / 100);
+  }
+  return errors;
+}
+
+export function start({ canvas, audio, form, input, status, saying }) {
+  const stats = {
+    phonemes: 0, packets: 0, lost: 0, recovered: 0, complete: 0, uncertain: 0, late: 0,
+    lipSyncErrorsMs: [], fapStateMatchesSender: false,
+    sender: null, texts: 0, done: 0, connected: false, streamNs: 0, endNs: 0,
+    envelope: [], frames: [],
+  };
+  window.pfapStats = stats;
+  const ws = new WebSocket(`ws://${location.host}/ws`);
+  const send = (m) => ws.readyState === WebSocket.OPEN && ws.send(JSON.stringify(m));
+  const pc = new RTCPeerConnection({ iceServers: [] });
+  const ctx = canvas.getContext('2d');
+  let timing = null;
+  let firstPfapTimestamp = null;
+  let lastSequenceNumber = null;
+  let audioReceiver = null;
+  let audioContext = null;
+  const phonemes = [];  // {timeNs, pressed}: which phoneme is drawn when (lip-sync measurement)
+  let drawn = 0;  // the phoneme drawn last
+
+  const receiver = new PfapReceiver({
+    clockRate: 44100,
+    onEvent: (e) => {
+      if (e.kind === 'phoneme') {
+        ++stats.phonemes;
+        phonemes.push({ timeNs: e.timeNs, pressed: e.phoneme.viseme === Viseme.PBM });
+      }
+      if (e.uncertain) ++stats.uncertain;
+    },
+    onRequestComplete: () => send({ type: 'complete' }),
+    onWarning: (w) => console.warn(w),
+  });
+
+  const show = () => {
+    const s = receiver.stats;
+    Object.assign(stats, { packets: s.packets, lost: s.lost, recovered: s.recovered, complete: s.completeStates, late: s.late });
+    for (const key of ['phonemes', 'packets', 'lost', 'late', 'recovered', 'complete', 'uncertain']) {
+      document.getElementById(key).textContent = String(stats[key]);
+    }
+    document.getElementById('matches').textContent = stats.sender ? (stats.fapStateMatchesSender ? 'yes' : 'no') : '-';
+  };
+
+  // The sender's FAP state after a text: equal to ours once every packet, or the recovery
+  // of those lost, has come. Packets lost at the end have nothing after them to recover
+  // them: then the page asks for a complete state (again until one comes).
+  const compare = ({ repair }) => {
+    const sender = stats.sender;
+    if (!sender) return;
+    const state = receiver.recovery.state;
+    stats.fapStateMatchesSender = sender.settled.every((v, i) => state.settled(i + 3) === v);
+    const behind = () => lastSequenceNumber !== sender.lastSequenceNumber;
+    if (repair && (behind() || !receiver.stateWhole)) {
+      // The message may overtake the last packets (they come another way): they have a
+      // while to arrive before they count as lost.
+      setTimeout(() => {
+        if (stats.sender !== sender) return;
+        if (behind()) receiver.lostUnknown();
+        if (!receiver.stateWhole) send({ type: 'complete' });
+      }, 300);
+    }
+    show();
+  };
+
+  pc.ontrack = (e) => {
+    audioReceiver = e.receiver;
+    const stream = e.streams[0] ?? new MediaStream([e.track]);
+    // Chromium feeds a remote track to Web Audio only while a media element plays it; the
+    // element is muted, the speech heard through the AudioContext, whose tap sees it too.
+    audio.srcObject = stream;
+    audio.play().catch(() => {});
+    playThroughWebAudio(stream);
+  };
+  pc.ondatachannel = (e) => {
+    e.channel.binaryType = 'arraybuffer';
+    e.channel.onmessage = (m) => {
+      const bytes = new Uint8Array(m.data);
+      try {
+        const rtp = parseRtp(bytes);
+        if (firstPfapTimestamp === null) firstPfapTimestamp = rtp.timestamp;
+        // The newest, as the receiver sees it: a packet overtaken by later ones is not.
+        const ahead = (rtp.sequenceNumber - (lastSequenceNumber ?? rtp.sequenceNumber - 1)) & 0xffff;
+        if (ahead > 0 && ahead < 0x8000) lastSequenceNumber = rtp.sequenceNumber;
+      } catch {
+        // the receiver counts and warns about it
+      }
+      receiver.receive(bytes);
+      if (stats.sender) compare({ repair: false });
+      show();
+    };
+  };
+  pc.onicecandidate = (e) => {
+    if (e.candidate) send({ type: 'ice', candidate: e.candidate.candidate, sdpMLineIndex: e.candidate.sdpMLineIndex });
+  };
+  pc.onconnectionstatechange = () => {
+    status.textContent = pc.connectionState;
+    stats.connected = pc.connectionState === 'connected';
+  };
+
+  ws.onmessage = async (event) => {
+    const m = JSON.parse(event.data);
+    if (m.type === 'timing') {
+      timing = m;
+      const text = new URLSearchParams(location.search).get('text');
+      if (text) send({ type: 'say', text });
+    } else if (m.type === 'offer') {
+      await pc.setRemoteDescription({ type: 'offer', sdp: m.sdp });
+      const answer = await pc.createAnswer();
+      await pc.setLocalDescription(answer);
+      send({ type: 'answer', sdp: answer.sdp });
+    } else if (m.type === 'ice') {
+      await pc.addIceCandidate({ candidate: m.candidate, sdpMLineIndex: m.sdpMLineIndex });
+    } else if (m.type === 'saying') {
+      ++stats.texts;
+      stats.sender = null;
+      saying.textContent = `Saying: ${m.text}`;
+    } else if (m.type === 'done' || (m.type === 'state' && stats.sender)) {
+      // The sender's state at the end of a text, then after each complete state asked for
+      // (one asked for mid-text is compared at the text's end).
+      if (m.type === 'done') ++stats.done;
+      stats.sender = m;
+      compare({ repair: true });
+    }
+  };
+  ws.onclose = () => { status.textContent = 'disconnected'; };
+
+  form.onsubmit = (e) => {
+    e.preventDefault();
+    if (input.value.trim()) send({ type: 'say', text: input.value });
+  };
+
+  function playThroughWebAudio(stream) {
+    audioContext = new AudioContext({ latencyHint: 'interactive' });
+    const source = audioContext.createMediaStreamSource(stream);
+    source.connect(audioContext.destination);
+    audioContext.audioWorklet.addModule(new URL('./tap.js', import.meta.url)).then(() => {
+      const tap = new AudioWorkletNode(audioContext, 'pfap-tap');
+      source.connect(tap);
+      tap.port.onmessage = (m) => {
+        // AudioContext time to performance time, at the output (what is heard when).
+        const { contextTime, performanceTime } = audioContext.getOutputTimestamp();
+        const data = m.data;
+        for (let i = 0; i < data.length; i += 2) {
+          stats.envelope.push({ t: performanceTime + (data[i] - contextTime) * 1000, rms: data[i + 1] });
+        }
+      };
+    });
+    audioContext.resume();
+  }
+
+  // The PFAP stream time of the audio heard at performance time `now`, or null before the
+  // audio and the PFAP stream have both begun.
+  function streamNs(now) {
+    if (!timing || firstPfapTimestamp === null || !audioReceiver) return null;
+    const source = audioReceiver.getSynchronizationSources()[0];
+    if (!source) return null;
+    const playedMs = performance.timeOrigin + now - source.timestamp;
+    const latencyMs = audioContext ? (audioContext.baseLatency + (audioContext.outputLatency || 0)) * 1000 : 0;
+    const running = ((source.rtpTimestamp - timing.audioTimestampOffset) >>> 0) / timing.audioClockRate +
+      (playedMs - latencyMs) / 1000;
+    const first = ((firstPfapTimestamp - timing.pfapTimestampOffset) >>> 0) / timing.pfapClockRate;
+    return Math.round((running - first) * 1e9);
+  }
+
+  const frame = (now) => {
+    const ns = streamNs(now);
+    if (ns !== null) {
+      stats.streamNs = ns;
+      stats.endNs = receiver.animator.endNs;
+      receiver.draw(ctx, ns, { style: 'cartoon' });
+      while (drawn + 1 < phonemes.length && phonemes[drawn + 1].timeNs <= ns) ++drawn;
+      const pressed = drawn < phonemes.length && phonemes[drawn].timeNs <= ns && phonemes[drawn].pressed;
+      stats.frames.push({ t: now, pressed });
+      if (stats.frames.length > 20000) stats.frames.splice(0, 10000);
+      if (stats.envelope.length > 200000) stats.envelope.splice(0, 100000);
+    }
+    requestAnimationFrame(frame);
+  };
+  requestAnimationFrame(frame);
+  stats.measureLipSync = () => (stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames));
+}
