@@ -14,14 +14,7 @@ namespace {
 
 // The whole audio as one pause carrying every bookmark's FAPs.
 void pause_over(const tts::Utterance& utterance, size_t n_samples, unsigned rate, Alignment& out) {
-  MarkupEvent e;
-  e.kind = PFAP_EVENT_PHONEME;
-  e.sentence_start = true;
-  e.phoneme.end_of_text = true;
-  for (const tts::Bookmark& b : utterance.bookmarks) {
-    e.faps.insert(e.faps.end(), b.faps.begin(), b.faps.end());
-  }
-  tts::add_phoneme(e, 0, n_samples, rate, out.phonemes);
+  tts::add_phoneme(pause_event(utterance), 0, n_samples, rate, out.phonemes);
 }
 
 // Where the synthetic boundary at `sample` falls in the recording, by the warp between the
@@ -52,6 +45,17 @@ double speech_seconds(const Features& f) {
 }
 
 }  // namespace
+
+MarkupEvent pause_event(const tts::Utterance& utterance) {
+  MarkupEvent e;
+  e.kind = PFAP_EVENT_PHONEME;
+  e.sentence_start = true;
+  e.phoneme.end_of_text = true;
+  for (const tts::Bookmark& b : utterance.bookmarks) {
+    e.faps.insert(e.faps.end(), b.faps.begin(), b.faps.end());
+  }
+  return e;
+}
 
 const char* problem_text(Problem p) {
   switch (p) {

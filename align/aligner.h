@@ -46,6 +46,10 @@ struct Alignment {
   std::vector<tts::Speech::Inexact> inexact;
 };
 
+// A pause carrying every bookmark's FAPs, sentence start and end of text: what stands for an
+// utterance that cannot be aligned.
+MarkupEvent pause_event(const tts::Utterance& utterance);
+
 // Aligns `utterance` to `audio` (mono, `rate` Hz). False with `error` only when espeak-ng
 // cannot speak (no such voice); every other input gives phonemes, with `problem` saying what
 // was wrong. The voice should speak the recording's language; its rate and pitch matter little.

@@ -16,8 +16,6 @@ constexpr uint_t kFilters = 40;
 constexpr smpl_t kLowHz = 100;
 constexpr smpl_t kHighHz = 7000;  // under 8 kHz, half the lowest rate
 constexpr float kFloorDb = -120;
-constexpr float kLevelRangeDb = 50;
-constexpr float kLevelWeight = 6;
 
 }  // namespace
 

@@ -15,6 +15,11 @@ namespace pfap::align {
 inline constexpr unsigned kMinRate = 16000;
 inline constexpr unsigned kMaxRate = 48000;
 
+// The level dimension: 0 for the loudest frame down to -kLevelWeight for kLevelRangeDb below
+// it or less (streaming.cc measures it below the utterance's loudest so far).
+inline constexpr float kLevelRangeDb = 50;
+inline constexpr float kLevelWeight = 6;
+
 struct Features {
   static constexpr size_t kMfccs = 13;         // MFCC 1..13 (c0, the level, is left out)
   static constexpr size_t kDims = kMfccs + 1;  // and the level below the loudest frame

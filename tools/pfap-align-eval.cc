@@ -13,7 +13,8 @@
 //
 //   pfap-align-eval DIR NAME...      (tools/align-eval-festival makes DIR and runs this)
 // With PFAP_ALIGN_EVAL_VERBOSE set it prints both phoneme sequences with their starts in ms;
-// PFAP_ALIGN_EVAL_VOICE picks the espeak-ng voice (default "en").
+// PFAP_ALIGN_EVAL_VOICE picks the espeak-ng voice (default "en"); with PFAP_ALIGN_EVAL_LIVE
+// set it aligns as pfapalign live=true does (align/streaming.h, the audio in 20 ms blocks).
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -30,6 +31,7 @@
 #include "aligner.h"
 #include "pfap/phoneme_table.h"
 #include "recognizer.h"
+#include "streaming.h"
 #include "viseme_frames.h"
 
 namespace {
@@ -176,6 +178,30 @@ double percentile(std::vector<double> v, double p) {
   return v[static_cast<size_t>(p * static_cast<double>(v.size() - 1) + 0.5)];
 }
 
+// As align(), but by the live aligner, the audio given in 20 ms blocks as a microphone gives
+// it; a phoneme sent in pieces is one phoneme.
+bool align_live(const pfap::tts::Utterance& utterance, const pfap::tts::VoiceSettings& voice,
+                const std::vector<int16_t>& samples, unsigned rate, pfap::align::Alignment& out,
+                std::string& error) {
+  pfap::align::StreamingAligner aligner;
+  if (!aligner.start(utterance, voice, rate, error)) return false;
+  std::vector<pfap::tts::SpokenPhoneme> phonemes;
+  const size_t block = rate / 50;
+  for (size_t i = 0; i < samples.size(); i += block) {
+    aligner.push(std::span(samples).subspan(i, std::min(block, samples.size() - i)), phonemes);
+  }
+  aligner.finish(phonemes);
+  out = pfap::align::Alignment{};
+  for (const pfap::tts::SpokenPhoneme& p : phonemes) {
+    if (!out.phonemes.empty() &&
+        out.phonemes.back().event.phoneme.symbol == p.event.phoneme.symbol) {
+      continue;
+    }
+    out.phonemes.push_back(p);
+  }
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -215,7 +241,9 @@ int main(int argc, char** argv) {
     pfap::align::Alignment alignment;
     std::string error;
     const auto t0 = std::chrono::steady_clock::now();
-    if (!pfap::align::align(utterance, voice, samples, rate, alignment, error)) {
+    const bool live = std::getenv("PFAP_ALIGN_EVAL_LIVE") != nullptr;
+    if (!(live ? align_live(utterance, voice, samples, rate, alignment, error)
+               : pfap::align::align(utterance, voice, samples, rate, alignment, error))) {
       std::fprintf(stderr, "%s\n", error.c_str());
       return 1;
     }

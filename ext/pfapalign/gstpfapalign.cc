@@ -31,8 +31,9 @@
  * pocketsphinx (meson feature `recognition`); without it, a warning and one pause.
  *
  * The phonemes come when the audio ends (EOS, a new segment or sample rate), after the text
- * pad's EOS: this element is for recordings, not live sources (docs/align.md says what is not
- * done). Silence, noise, a text that does not match, an empty text or none, bad bookmarks and
+ * pad's EOS; with #GstPfapAlign:live, for live sources, as the audio comes, each within the
+ * latency the element declares (docs/align.md, "Live"). Silence, noise, a text that does not
+ * match, an empty text or none, bad bookmarks and
  * unsupported rates each give a warning (rate-limited), and the stream goes on: an utterance
  * that cannot be aligned is one pause carrying its bookmarks.
  *
@@ -43,6 +44,9 @@
  * |[
  * gst-launch-1.0 filesrc location=speech.wav ! wavparse ! audioconvert ! audioresample ! audio/x-raw,rate=16000 ! pfapalign name=a a.src ! queue ! fakesink a.pfap ! queue ! pfaptextenc ! filesink location=speech.pfap
  * ]| A WAV without its text: the phonemes recognized.
+ * |[
+ * gst-launch-1.0 rtpbin name=r udpsrc address=127.0.0.1 port=5004 caps="application/x-rtp,media=audio,clock-rate=16000,encoding-name=L16,channels=1,payload=96" ! rtpjitterbuffer latency=50 ! rtpL16depay ! audioconvert ! audio/x-raw,format=S16LE ! pfapalign live=true text="Hello world." name=a a.src ! queue ! audioconvert ! rtpL16pay pt=96 ! r.send_rtp_sink_0 r.send_rtp_src_0 ! udpsink host=127.0.0.1 port=5000 r.send_rtcp_src_0 ! udpsink host=127.0.0.1 port=5001 sync=false async=false a.pfap ! queue ! rtppfappay pt=97 ! r.send_rtp_sink_1 r.send_rtp_src_1 ! udpsink host=127.0.0.1 port=5002 r.send_rtcp_src_1 ! udpsink host=127.0.0.1 port=5003 sync=false async=false
+ * ]| Live RTP audio in; the audio and its phonemes out as two RTP sessions, in sync by RTCP.
  */
 // clang-format on
 #include "gstpfapalign.h"
@@ -63,6 +67,7 @@
 #include "ratelimit.h"
 #include "recognizer.h"
 #include "sparse.h"
+#include "streaming.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapalign_debug);
 #define GST_CAT_DEFAULT pfapalign_debug
@@ -77,6 +82,7 @@ enum {
   PROP_0,
   PROP_TEXT,
   PROP_VOICE,
+  PROP_LIVE,
 };
 
 // One text buffer: its running time (NONE: it continues the one before) and bytes.
@@ -97,6 +103,14 @@ struct Stream {
   guint64 bad_bookmarks = 0;
   std::set<std::string> warned_phonemes;          // inexact mnemonics already warned about
   std::array<guint64, 4> recognition_problems{};  // per pfap::align::RecognitionProblem
+
+  // Live: upstream is live, and the phonemes go out as the audio comes (live_* below).
+  bool live = false;
+  pfap::align::StreamingAligner aligner;
+  bool utterance_open = false;     // the aligner has an utterance
+  bool utterance_is_text = false;  // from a text, not the audio before the first
+  size_t utterance_from = 0;       // its first sample, counted from `first`
+  size_t live_samples = 0;         // samples since `first`
 
   std::mutex lock;  // guards what follows, shared with the text pad's thread
   std::condition_variable text_changed;
@@ -119,6 +133,7 @@ struct _GstPfapAlign {
   // Properties, under the object lock.
   gchar* text;
   gchar* voice;
+  gboolean live;
 
   Stream* stream;
 };
@@ -151,6 +166,8 @@ static void reset(GstPfapAlign* self) {
   s.samples.clear();
   s.overflow_warned = false;
   s.pfap_discont = true;
+  s.utterance_open = false;
+  s.live_samples = 0;
   gst_segment_init(&s.segment, GST_FORMAT_TIME);
   std::lock_guard<std::mutex> guard(s.lock);
   s.texts.clear();
@@ -229,12 +246,10 @@ static GstFlowReturn recognize_kept(GstPfapAlign* self) {
   return push_phonemes(self, recognition.phonemes, 0);
 }
 
-// Aligns `bytes` to samples [from, to) and pushes its phonemes on `pfap`. `is_text`: false
-// for the audio before the first utterance, whose empty text is no problem.
-static GstFlowReturn align_utterance(GstPfapAlign* self, const std::string& bytes, size_t from,
-                                     size_t to, bool is_text) {
+// The utterance of the text `bytes` starting at `at`, bad UTF-8 and bookmarks warned about.
+static pfap::tts::Utterance parse_text(GstPfapAlign* self, const std::string& bytes,
+                                       GstClockTime at) {
   Stream& s = *self->stream;
-  const GstClockTime at = s.first + gst_util_uint64_scale(from, GST_SECOND, s.rate);
   std::string text = bytes;
   if (!g_utf8_validate(text.data(), static_cast<gssize>(text.size()), nullptr)) {
     GST_ELEMENT_WARNING(
@@ -253,10 +268,39 @@ static GstFlowReturn align_utterance(GstPfapAlign* self, const std::string& byte
          b.character + 1, GST_TIME_ARGS(at), pfap::to_string(b.status)),
         ("%" G_GUINT64_FORMAT " so far", s.bad_bookmarks));
   }
+  return utterance;
+}
+
+static pfap::tts::VoiceSettings voice_settings(GstPfapAlign* self) {
   GST_OBJECT_LOCK(self);
   pfap::tts::VoiceSettings voice;
   voice.voice = self->voice;
   GST_OBJECT_UNLOCK(self);
+  return voice;
+}
+
+// As pfaptts warns: once per mnemonic of a voice whose phonemes x-pfap-arpabet lacks.
+static void warn_inexact(GstPfapAlign* self, const std::vector<pfap::tts::Speech::Inexact>& inexact,
+                         const pfap::tts::VoiceSettings& voice) {
+  Stream& s = *self->stream;
+  for (const pfap::tts::Speech::Inexact& i : inexact) {
+    if (!s.warned_phonemes.insert(i.mnemonic).second) continue;
+    const std::string sent_as(i.sent_as);
+    GST_ELEMENT_WARNING(self, STREAM, FORMAT,
+                        ("espeak-ng phoneme \"%s\" of voice \"%s\" is not in x-pfap-arpabet",
+                         i.mnemonic.c_str(), voice.voice.c_str()),
+                        ("sent as %s", sent_as.c_str()));
+  }
+}
+
+// Aligns `bytes` to samples [from, to) and pushes its phonemes on `pfap`. `is_text`: false
+// for the audio before the first utterance, whose empty text is no problem.
+static GstFlowReturn align_utterance(GstPfapAlign* self, const std::string& bytes, size_t from,
+                                     size_t to, bool is_text) {
+  Stream& s = *self->stream;
+  const GstClockTime at = s.first + gst_util_uint64_scale(from, GST_SECOND, s.rate);
+  const pfap::tts::Utterance utterance = parse_text(self, bytes, at);
+  const pfap::tts::VoiceSettings voice = voice_settings(self);
 
   pfap::align::Alignment alignment;
   std::string error;
@@ -269,17 +313,18 @@ static GstFlowReturn align_utterance(GstPfapAlign* self, const std::string& byte
                    GST_TIME_ARGS(at), alignment.phonemes.size(), audio.size(),
                    alignment.relative_cost);
   if (is_text) warn_problem(self, alignment.problem, at, alignment.relative_cost);
-  // As pfaptts warns: once per mnemonic of a voice whose phonemes x-pfap-arpabet lacks.
-  for (const pfap::tts::Speech::Inexact& i : alignment.inexact) {
-    if (!s.warned_phonemes.insert(i.mnemonic).second) continue;
-    const std::string sent_as(i.sent_as);
-    GST_ELEMENT_WARNING(self, STREAM, FORMAT,
-                        ("espeak-ng phoneme \"%s\" of voice \"%s\" is not in x-pfap-arpabet",
-                         i.mnemonic.c_str(), voice.voice.c_str()),
-                        ("sent as %s", sent_as.c_str()));
-  }
+  warn_inexact(self, alignment.inexact, voice);
 
   return push_phonemes(self, alignment.phonemes, from);
+}
+
+// The sample, counted from `first`, where a text at `running_time` starts; 0 before the audio.
+static size_t text_start(GstPfapAlign* self, GstClockTime running_time) {
+  Stream& s = *self->stream;
+  const guint64 position =
+      gst_segment_position_from_running_time(&s.segment, GST_FORMAT_TIME, running_time);
+  if (!GST_CLOCK_TIME_IS_VALID(position) || position <= s.first) return 0;
+  return gst_util_uint64_scale_round(position - s.first, s.rate, GST_SECOND);
 }
 
 // Aligns the audio kept so far with its texts and pushes the phonemes, then forgets both. At
@@ -318,12 +363,7 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
       }
       continue;
     }
-    const guint64 position =
-        gst_segment_position_from_running_time(&s.segment, GST_FORMAT_TIME, t.running_time);
-    size_t from = 0;
-    if (GST_CLOCK_TIME_IS_VALID(position) && position > s.first) {
-      from = gst_util_uint64_scale_round(position - s.first, s.rate, GST_SECOND);
-    }
+    const size_t from = text_start(self, t.running_time);
     if (from >= n && !eos) {
       later.push_back(std::move(t));
       continue;
@@ -351,6 +391,156 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
   return ret;
 }
 
+// Live (#GstPfapAlign:live): the phonemes go out as the audio comes, by align/streaming.h;
+// docs/align.md, "Live". One utterance is open at a time: the text property's, each text
+// buffer's from its PTS (or from its arrival when it has none or comes late), or a pause for
+// the audio before the first.
+
+static GstFlowReturn live_push(GstPfapAlign* self,
+                               const std::vector<pfap::tts::SpokenPhoneme>& phonemes) {
+  return push_phonemes(self, phonemes, self->stream->utterance_from);
+}
+
+// Ends the open utterance at the audio so far and pushes its last phonemes.
+static GstFlowReturn live_end_utterance(GstPfapAlign* self) {
+  Stream& s = *self->stream;
+  if (!s.utterance_open) return GST_FLOW_OK;
+  s.utterance_open = false;
+  std::vector<pfap::tts::SpokenPhoneme> phonemes;
+  s.aligner.finish(phonemes);
+  return live_push(self, phonemes);
+}
+
+// Ends the open utterance and starts that of `bytes` at the audio so far. `is_text` as in
+// align_utterance.
+static GstFlowReturn live_start_utterance(GstPfapAlign* self, const std::string& bytes,
+                                          bool is_text) {
+  Stream& s = *self->stream;
+  const GstFlowReturn ret = live_end_utterance(self);
+  if (ret != GST_FLOW_OK) return ret;
+  const GstClockTime at = s.first + gst_util_uint64_scale(s.live_samples, GST_SECOND, s.rate);
+  const pfap::tts::Utterance utterance = parse_text(self, bytes, at);
+  const pfap::tts::VoiceSettings voice = voice_settings(self);
+  std::string error;
+  if (!s.aligner.start(utterance, voice, s.rate, error)) {
+    GST_ELEMENT_ERROR(self, LIBRARY, FAILED, ("%s", error.c_str()), (nullptr));
+    return GST_FLOW_ERROR;
+  }
+  if (is_text) warn_problem(self, s.aligner.problem(), at, 0);
+  warn_inexact(self, s.aligner.inexact(), voice);
+  s.utterance_open = true;
+  s.utterance_from = s.live_samples;
+  return GST_FLOW_OK;
+}
+
+// Gives `samples` to the open utterance and pushes the phonemes now settled.
+static GstFlowReturn live_feed(GstPfapAlign* self, std::span<const int16_t> samples) {
+  Stream& s = *self->stream;
+  std::vector<pfap::tts::SpokenPhoneme> phonemes;
+  s.aligner.push(samples, phonemes);
+  s.live_samples += samples.size();
+  return live_push(self, phonemes);
+}
+
+// Takes the texts of text_sink that start before sample `end`, as (first sample, bytes) in
+// order, none before the audio so far.
+static std::vector<std::pair<size_t, std::string>> live_take_texts(GstPfapAlign* self, size_t end) {
+  Stream& s = *self->stream;
+  std::vector<std::pair<size_t, std::string>> starting;
+  std::lock_guard<std::mutex> guard(s.lock);
+  std::vector<Text> later;
+  for (Text& t : s.texts) {
+    const size_t from = GST_CLOCK_TIME_IS_VALID(t.running_time)
+                            ? std::max(text_start(self, t.running_time), s.live_samples)
+                            : s.live_samples;
+    if (from < end) {
+      starting.emplace_back(from, std::move(t.bytes));
+    } else {
+      later.push_back(std::move(t));
+    }
+  }
+  s.texts.swap(later);
+  std::stable_sort(starting.begin(), starting.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  return starting;
+}
+
+// The audio of `buffer` to the aligner, cut where utterances start; the audio pushed after
+// the phonemes it settles.
+static GstFlowReturn live_chain(GstPfapAlign* self, GstBuffer* buffer) {
+  Stream& s = *self->stream;
+  std::vector<int16_t> samples;
+  GstMapInfo map;
+  if (gst_buffer_map(buffer, &map, GST_MAP_READ)) {
+    const auto* in = reinterpret_cast<const uint8_t*>(map.data);
+    samples.resize(map.size / sizeof(int16_t));
+    for (size_t i = 0; i < samples.size(); ++i) {
+      samples[i] = static_cast<int16_t>(GST_READ_UINT16_LE(in + 2 * i));
+    }
+    gst_buffer_unmap(buffer, &map);
+  }
+  GstFlowReturn ret = GST_FLOW_OK;
+  if (!s.utterance_open) {
+    GST_OBJECT_LOCK(self);
+    const bool has_property = self->text != nullptr;
+    const std::string property = has_property ? self->text : "";
+    GST_OBJECT_UNLOCK(self);
+    const bool from_pad = gst_pad_is_linked(self->textpad);
+    if (!from_pad && !has_property) {
+      GST_ELEMENT_WARNING(self, STREAM, DECODE, ("No text for the audio: it is one pause"),
+                          ("set the text property or link text_sink; recognition without the "
+                           "text is not live"));
+    }
+    ret = live_start_utterance(self, from_pad ? "" : property, !from_pad && has_property);
+  }
+  size_t done = 0;
+  for (auto& [from, bytes] : live_take_texts(self, s.live_samples + samples.size())) {
+    if (ret != GST_FLOW_OK) break;
+    const size_t n = from - s.live_samples;
+    ret = live_feed(self, std::span(samples).subspan(done, n));
+    done += n;
+    if (ret == GST_FLOW_OK) ret = live_start_utterance(self, bytes, true);
+  }
+  if (ret == GST_FLOW_OK) ret = live_feed(self, std::span(samples).subspan(done));
+  if (ret != GST_FLOW_OK) {
+    gst_buffer_unref(buffer);
+    return ret;
+  }
+  return gst_flow_combiner_update_pad_flow(self->flow_combiner, self->srcpad,
+                                           gst_pad_push(self->srcpad, buffer));
+}
+
+// The audio ended (EOS, a new segment or rate): the open utterance's last phonemes.
+static GstFlowReturn live_end(GstPfapAlign* self) {
+  Stream& s = *self->stream;
+  const GstFlowReturn ret = live_end_utterance(self);
+  s.first = GST_CLOCK_TIME_NONE;
+  s.live_samples = 0;
+  return ret;
+}
+
+// The latency upstream's plus kLiveLatencyMs: when the phonemes of the audio come at the latest.
+static gboolean live_latency_query(GstPfapAlign* self, GstQuery* query) {
+  if (!gst_pad_peer_query(self->sinkpad, query)) return FALSE;
+  gboolean live = FALSE;
+  GstClockTime min = 0, max = GST_CLOCK_TIME_NONE;
+  gst_query_parse_latency(query, &live, &min, &max);
+  const GstClockTime ours = pfap::align::kLiveLatencyMs * GST_MSECOND;
+  GST_DEBUG_OBJECT(self, "upstream latency %" GST_TIME_FORMAT ", ours %" GST_TIME_FORMAT,
+                   GST_TIME_ARGS(min), GST_TIME_ARGS(ours));
+  gst_query_set_latency(query, live, min + ours,
+                        GST_CLOCK_TIME_IS_VALID(max) ? max + ours : GST_CLOCK_TIME_NONE);
+  return TRUE;
+}
+
+static gboolean gst_pfap_align_src_query(GstPad* pad, GstObject* parent, GstQuery* query) {
+  GstPfapAlign* self = GST_PFAP_ALIGN(parent);
+  if (GST_QUERY_TYPE(query) == GST_QUERY_LATENCY && self->stream->live) {
+    return live_latency_query(self, query);
+  }
+  return gst_pad_query_default(pad, parent, query);
+}
+
 static GstFlowReturn gst_pfap_align_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
   GstPfapAlign* self = GST_PFAP_ALIGN(parent);
   Stream& s = *self->stream;
@@ -365,6 +555,7 @@ static GstFlowReturn gst_pfap_align_chain(GstPad*, GstObject* parent, GstBuffer*
     // (and the audio sink, which waits for the pipeline, start).
     gst_pad_push_event(self->pfappad, gst_event_new_gap(s.first, 0));
   }
+  if (s.live) return live_chain(self, buffer);
   GstMapInfo map;
   if (gst_buffer_map(buffer, &map, GST_MAP_READ)) {
     const size_t count = map.size / sizeof(int16_t);
@@ -416,7 +607,11 @@ static gboolean gst_pfap_align_sink_event(GstPad* pad, GstObject* parent, GstEve
       gint rate = 0;
       gst_structure_get_int(gst_caps_get_structure(caps, 0), "rate", &rate);
       if (static_cast<unsigned>(rate) != s.rate) {
-        align_kept(self, false);
+        if (s.live) {
+          live_end(self);
+        } else {
+          align_kept(self, false);
+        }
         s.rate = static_cast<unsigned>(rate);
         if (s.rate < pfap::align::kMinRate || s.rate > pfap::align::kMaxRate) {
           GST_ELEMENT_WARNING(self, STREAM, FORMAT,
@@ -428,7 +623,11 @@ static gboolean gst_pfap_align_sink_event(GstPad* pad, GstObject* parent, GstEve
       break;
     }
     case GST_EVENT_SEGMENT: {
-      align_kept(self, false);
+      if (s.live) {
+        live_end(self);
+      } else {
+        align_kept(self, false);
+      }
       const GstSegment* segment = nullptr;
       gst_event_parse_segment(event, &segment);
       gst_segment_copy_into(segment, &s.segment);
@@ -439,7 +638,11 @@ static gboolean gst_pfap_align_sink_event(GstPad* pad, GstObject* parent, GstEve
       gst_pad_push_event(self->pfappad, gst_event_ref(event));
       break;
     case GST_EVENT_EOS:
-      align_kept(self, true);
+      if (s.live) {
+        live_end(self);
+      } else {
+        align_kept(self, true);
+      }
       gst_pad_push_event(self->pfappad, gst_event_new_eos());
       break;
     case GST_EVENT_FLUSH_START: {
@@ -538,6 +741,9 @@ static GstStateChangeReturn gst_pfap_align_change_state(GstElement* element,
     s.recognition_problems = {};
     s.bad_bookmarks = 0;
     s.warned_phonemes.clear();
+    GST_OBJECT_LOCK(self);
+    s.live = self->live;
+    GST_OBJECT_UNLOCK(self);
     unsigned rate = 0;
     std::string error;
     GST_OBJECT_LOCK(self);
@@ -573,6 +779,9 @@ static void gst_pfap_align_set_property(GObject* object, guint prop_id, const GV
       self->voice = g_value_dup_string(value);
       if (self->voice == nullptr) self->voice = g_strdup(kDefaultVoice);
       break;
+    case PROP_LIVE:
+      self->live = g_value_get_boolean(value);
+      break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
       break;
@@ -590,6 +799,9 @@ static void gst_pfap_align_get_property(GObject* object, guint prop_id, GValue* 
       break;
     case PROP_VOICE:
       g_value_set_string(value, self->voice);
+      break;
+    case PROP_LIVE:
+      g_value_set_boolean(value, self->live);
       break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
@@ -641,6 +853,20 @@ static void gst_pfap_align_class_init(GstPfapAlignClass* klass) {
       gobject_class, PROP_VOICE,
       g_param_spec_string("voice", "Voice", "espeak-ng voice of the recording's language",
                           kDefaultVoice, kReady));
+  /**
+   * GstPfapAlign:live:
+   *
+   * Aligns as the audio comes, for live sources: each phoneme goes out by the time 350 ms
+   * (and one upstream buffer) more than its start has come, and the LATENCY query says
+   * 400 ms more than upstream's (docs/align.md, "Live"). Off: the phonemes come when the
+   * audio ends, aligned on it whole. Read when the element goes to PAUSED.
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_LIVE,
+      g_param_spec_boolean("live", "Live",
+                           "Align as the audio comes, each phoneme out within 400 ms (the "
+                           "latency it declares), instead of when the audio ends",
+                           FALSE, kReady));
 
   gst_element_class_add_static_pad_template(element_class, &sink_template);
   gst_element_class_add_static_pad_template(element_class, &text_template);
@@ -665,6 +891,8 @@ static void gst_pfap_align_init(GstPfapAlign* self) {
   gst_pad_set_event_function(self->textpad, gst_pfap_align_text_event);
   self->srcpad = gst_pad_new_from_static_template(&src_template, "src");
   self->pfappad = gst_pad_new_from_static_template(&pfap_template, "pfap");
+  gst_pad_set_query_function(self->srcpad, gst_pfap_align_src_query);
+  gst_pad_set_query_function(self->pfappad, gst_pfap_align_src_query);
   gst_pad_use_fixed_caps(self->pfappad);
   for (GstPad* pad : {self->sinkpad, self->srcpad}) {
     GST_PAD_SET_PROXY_CAPS(pad);
@@ -680,6 +908,7 @@ static void gst_pfap_align_init(GstPfapAlign* self) {
 
   self->text = nullptr;
   self->voice = g_strdup(kDefaultVoice);
+  self->live = FALSE;
   self->stream = new Stream{};
   gst_segment_init(&self->stream->segment, GST_FORMAT_TIME);
   gst_segment_init(&self->stream->text_segment, GST_FORMAT_TIME);

@@ -10,7 +10,8 @@
 //    SDP and the caps carry the alphabet, audio arrives, every phoneme arrives.
 //  - DocumentedLines.*: each command block of that docs section, run as written but with free
 //    ports, the source tree's docs/examples/ and temporary output files.
-//  - Readme.*: the pfaptts commands of README.md, "Text to speech", run the same way.
+//  - Readme.*: the pfaptts commands of README.md, "Text to speech", run the same way; its
+//    pfapalign lines are checked to be those of docs/elements.md, which test_pfapalign* run.
 //  - Story.*: pfap-story, the main job: speech over RTP with loss, rendered and muxed.
 //  - PlayStream.*: generic players, no pipeline written by hand: playbin on the RTSP example
 //    (rtppfapdepay and pfapface plugged by themselves, face within a video frame of the
@@ -50,6 +51,7 @@
 #include "pfap_buffers.h"
 #include "pipeline.h"
 #include "temp_dir.h"
+#include "udp_ports.h"
 
 namespace {
 
@@ -191,31 +193,6 @@ ProcessResult run(const std::vector<std::string>& args) {
   return r;
 }
 
-// UDP ports on 127.0.0.1 that were free a moment ago: each bound to port 0 by the system,
-// all held until the last is found (so they differ), then released for the pipelines.
-std::vector<int> free_udp_ports(size_t n) {
-  std::vector<int> sockets;
-  std::vector<int> ports;
-  for (size_t i = 0; i < n; ++i) {
-    const int fd = socket(AF_INET, SOCK_DGRAM, 0);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    address.sin_port = 0;
-    socklen_t length = sizeof address;
-    if (fd < 0 || bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 ||
-        getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) != 0) {
-      ADD_FAILURE() << "cannot bind a UDP socket on 127.0.0.1";
-      if (fd >= 0) close(fd);
-      break;
-    }
-    sockets.push_back(fd);
-    ports.push_back(ntohs(address.sin_port));
-  }
-  for (int fd : sockets) close(fd);
-  return ports;
-}
-
 // pfap-rtsp-server FILE 0 as a subprocess: the URL it prints, SIGTERM on stop().
 class RtspServer {
  public:
@@ -293,6 +270,7 @@ class RtspServer {
 // ---------------------------------------------------------------------------------------------
 // Pipelines
 
+using pfap::testing::free_udp_ports;
 using pfap::testing::Pipeline;
 using pfap::testing::plugin_available;
 using pfap::testing::TempDir;
@@ -771,6 +749,16 @@ std::vector<std::string> readme_commands(const std::string& heading) {
   return documented_commands("README.md", kReadmeSection, heading);
 }
 
+std::vector<std::string> readme_align_commands() {
+  std::vector<std::string> out;
+  for (const char* heading : {"### A recording", "### Live"}) {
+    for (std::string& c : documented_commands("README.md", "## PFAP from any speech", heading)) {
+      out.push_back(std::move(c));
+    }
+  }
+  return out;
+}
+
 // The .pfap lines as (start ms, duration ms, number of bookmarked FAPs).
 struct PfapLine {
   long start_ms;
@@ -799,8 +787,23 @@ TEST(Readme, EveryCommandIsTested) {
     if (line.rfind("```", 0) == 0) in_block = !in_block;
     if (in_block && line.rfind("gst-launch-1.0", 0) == 0) ++launch_lines;
   }
-  EXPECT_EQ(readme_commands("### Into files").size() + readme_commands("### Over RTP").size(),
+  EXPECT_EQ(readme_commands("### Into files").size() + readme_commands("### Over RTP").size() +
+                readme_align_commands().size(),
             launch_lines);
+}
+
+// README.md's pfapalign lines are docs/elements.md's, which test_pfapalign and
+// test_pfapalign_live run.
+TEST(Readme, AlignCommandsAreTheDocumentedOnes) {
+  const std::vector<std::string> readme = readme_align_commands();
+  ASSERT_EQ(readme.size(), 2u);
+  const std::string doc = read_file(source_path("docs/elements.md"));
+  const size_t section = doc.find("## pfapalign");
+  ASSERT_NE(section, std::string::npos);
+  const std::string text = doc.substr(section, doc.find("\n## ", section + 1) - section);
+  for (const std::string& command : readme) {
+    EXPECT_NE(text.find("\n" + command + "\n"), std::string::npos) << command;
+  }
 }
 
 // Speech into a WAV file and its phonemes into a .pfap file: the phonemes cover the audio.

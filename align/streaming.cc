@@ -1,0 +1,233 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+#include "streaming.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "f0.h"
+
+namespace pfap::align {
+namespace {
+
+// The recording's features are computed over the audio since the settled point and up to this
+// much before it: enough speech for the MFCCs' normalization, a bounded cost per step.
+constexpr unsigned kContextMs = 1000;
+// The audio before the context is dropped once there is this much of it.
+constexpr unsigned kTrimMs = 2000;
+// Quieter than this, the recording's loudest frame so far is not taken for speech: the level
+// dimension is measured below this, so that the silence before someone speaks stays a pause.
+constexpr float kMinLoudestDb = kSpeechLevelDb + 20;
+constexpr size_t kNone = std::numeric_limits<size_t>::max();
+
+size_t samples_of(unsigned ms, unsigned rate) { return size_t{ms} * rate / 1000; }
+
+// An open-end warp of recording frames [r0, r0 + rows) against synthetic frames [s0, s0 +
+// cols), both from their first frames, with align()'s steps; the path ends at the recording's
+// last frame and at the synthetic frame j where the summed distance over rows + j is least (the
+// last frame when `closed`). Of the ends tried (docs/align.md, "Live"), this one gave the
+// least error: the mean over the path's own steps ran ahead into the speech, the plain sum
+// lagged behind it. For each synthetic frame up to `end`, the first and last recording frame
+// on the path (counted from r0, s0).
+struct OpenWarp {
+  size_t end = 0;
+  std::vector<size_t> first, last;
+};
+
+// Frames quieter than kSpeechLevelDb become one and the same silence: MFCCs at their mean
+// (0) and the level at its lowest. Normalized MFCCs of silence or of a microphone's hiss are
+// anything, and without this the warp went on into the text's speech while the speaker had
+// not yet begun.
+void silence_quiet_frames(Features& f) {
+  for (size_t k = 0; k < f.n_frames; ++k) {
+    if (f.level_db[k] >= kSpeechLevelDb) continue;
+    float* x = f.data.data() + k * Features::kDims;
+    std::fill(x, x + Features::kMfccs, 0.0f);
+    x[Features::kMfccs] = -kLevelWeight;
+  }
+}
+
+OpenWarp open_warp(const Features& rec, size_t r0, size_t rows, const Features& syn, size_t s0,
+                   size_t cols, bool closed) {
+  std::vector<float> d(rows * cols);      // the least summed distance from (0, 0) to each cell
+  std::vector<size_t> back(rows * cols);  // the cell it came from
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  for (size_t r = 0; r < rows; ++r) {
+    const std::span<const float> x = rec.frame(r0 + r);
+    for (size_t j = 0; j < cols; ++j) {
+      const std::span<const float> y = syn.frame(s0 + j);
+      float sum = 0;
+      for (size_t k = 0; k < Features::kDims; ++k) sum += (x[k] - y[k]) * (x[k] - y[k]);
+      float best = r == 0 && j == 0 ? 0 : kInf;
+      size_t from = 0;
+      auto consider = [&](size_t cell) {
+        if (d[cell] < best) best = d[cell], from = cell;
+      };
+      if (r > 0 && j > 0) consider((r - 1) * cols + j - 1);
+      if (r > 0) consider((r - 1) * cols + j);
+      if (j > 0) consider(r * cols + j - 1);
+      d[r * cols + j] = best + std::sqrt(sum);
+      back[r * cols + j] = from;
+    }
+  }
+  OpenWarp w;
+  w.end = cols - 1;
+  if (!closed) {
+    double best = std::numeric_limits<double>::infinity();
+    for (size_t j = 0; j < cols; ++j) {
+      const double mean = d[(rows - 1) * cols + j] / static_cast<double>(rows + j + 1);
+      if (mean < best) best = mean, w.end = j;
+    }
+  }
+  w.first.assign(w.end + 1, kNone);
+  w.last.assign(w.end + 1, 0);
+  for (size_t r = rows - 1, j = w.end;;) {
+    w.first[j] = std::min(w.first[j], r);
+    w.last[j] = std::max(w.last[j], r);
+    if (r == 0 && j == 0) break;
+    const size_t from = back[r * cols + j];
+    r = from / cols, j = from % cols;
+  }
+  return w;
+}
+
+}  // namespace
+
+bool StreamingAligner::start(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
+                             unsigned rate, std::string& error) {
+  *this = StreamingAligner{};
+  rate_ = rate;
+  if (!tts::speak(utterance, voice, syn_, error)) return false;
+  if (rate < kMinRate || rate > kMaxRate) {
+    problem_ = Problem::kBadRate;
+  } else if (std::none_of(syn_.phonemes.begin(), syn_.phonemes.end(),
+                          [](const auto& p) { return p.event.phoneme.symbol != 0; })) {
+    problem_ = Problem::kEmptyText;
+  }
+  if (problem_ != Problem::kNone) {
+    syn_.phonemes.assign(1, tts::SpokenPhoneme{pause_event(utterance), 0, 0});
+    return true;
+  }
+  // As align() does: silence before the synthetic speech matches the recording's lead-in;
+  // the first phoneme (espeak-ng's short pause) takes it.
+  const size_t pad = syn_.sample_rate / 10;
+  syn_.samples.insert(syn_.samples.begin(), pad, 0);
+  syn_.samples.resize(syn_.samples.size() + pad, 0);
+  for (size_t k = 1; k < syn_.phonemes.size(); ++k) syn_.phonemes[k].start += pad;
+  synf_ = mfcc(syn_.samples, syn_.sample_rate);
+  silence_quiet_frames(synf_);
+  return true;
+}
+
+void StreamingAligner::push(std::span<const int16_t> samples,
+                            std::vector<tts::SpokenPhoneme>& out) {
+  rec_.insert(rec_.end(), samples.begin(), samples.end());
+  if (this->samples() - last_step_ < samples_of(kStepMs, rate_)) return;
+  last_step_ = this->samples();
+  step(false, out);
+}
+
+void StreamingAligner::finish(std::vector<tts::SpokenPhoneme>& out) {
+  if (next_ < syn_.phonemes.size()) step(true, out);
+}
+
+void StreamingAligner::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
+  const size_t n = samples();
+  const size_t lookahead = samples_of(kLookaheadMs, rate_);
+  const size_t horizon = at_end ? n : n - std::min(n, lookahead);
+
+  if (problem_ == Problem::kNone && rec_settled_ < n) {
+    const size_t context = samples_of(kContextMs, rate_);
+    const size_t w0 = std::min(rec_settled_, n - std::min(n, context));
+    Features rec = mfcc(std::span(rec_).subspan(w0 - rec_first_), rate_);
+    // The level below the loudest frame of the utterance so far, not of this window.
+    loudest_db_ =
+        std::max(loudest_db_, *std::max_element(rec.level_db.begin(), rec.level_db.end()));
+    const float reference = std::max(loudest_db_, kMinLoudestDb);
+    for (size_t k = 0; k < rec.n_frames; ++k) {
+      const float below = std::clamp(rec.level_db[k] - reference, -kLevelRangeDb, 0.0f);
+      rec.data[k * Features::kDims + Features::kMfccs] = below / kLevelRangeDb * kLevelWeight;
+    }
+    silence_quiet_frames(rec);
+    const size_t r0 = rec.frame_at(rec_settled_ - w0);
+    const size_t rows = rec.n_frames - r0;
+    const size_t s0 = synf_.frame_at(syn_settled_);
+    const size_t cols = at_end ? synf_.n_frames - s0 : std::min(synf_.n_frames - s0, 3 * rows + 40);
+    const OpenWarp w = open_warp(rec, r0, rows, synf_, s0, cols, at_end);
+    auto rec_centre = [&](size_t r) { return w0 + rec.centre(r0 + r); };
+
+    // Where the synthetic sample `b` falls in the recording, as align()'s map_boundary; kNone
+    // past the warp's end.
+    auto map = [&](size_t b) -> size_t {
+      const double pos = (static_cast<double>(b) - static_cast<double>(synf_.centre(s0))) /
+                         static_cast<double>(synf_.hop);
+      if (pos <= 0) return rec_settled_;
+      const size_t i = static_cast<size_t>(std::ceil(pos));
+      if (i > w.end) return at_end ? n : kNone;
+      const double t = pos - static_cast<double>(i - 1);
+      const double from = static_cast<double>(rec_centre(w.last[i - 1]));
+      const double to = static_cast<double>(rec_centre(w.first[i]));
+      return static_cast<size_t>(std::lround(from + t * (to - from)));
+    };
+    while (next_ + 1 < syn_.phonemes.size()) {
+      const size_t b = syn_.phonemes[next_ + 1].start;
+      const size_t at = map(b);
+      if (at == kNone || at > horizon) break;
+      syn_settled_ = b;
+      emit(std::clamp(at, rec_settled_, n), true, out);
+    }
+    if (!at_end && horizon > rec_settled_ + samples_of(kHoldMs, rate_)) {
+      // The phoneme goes on past the hold: a piece up to the horizon, and the warp restarts
+      // from the synthetic frame matched there (within the phoneme).
+      const size_t fr =
+          std::min(rec.frame_at(horizon - w0) - std::min(rec.frame_at(horizon - w0), r0), rows - 1);
+      size_t j = 0;
+      while (j < w.end && w.last[j] < fr) ++j;
+      const size_t lo = syn_.phonemes[next_].start;
+      const size_t hi = next_ + 1 < syn_.phonemes.size() ? syn_.phonemes[next_ + 1].start - 1
+                                                         : syn_.samples.size();
+      syn_settled_ = std::clamp(synf_.centre(s0 + j), std::max(lo, syn_settled_), std::max(lo, hi));
+      emit(horizon, false, out);
+    }
+  } else if (!at_end && horizon > rec_settled_ + samples_of(kHoldMs, rate_)) {
+    emit(horizon, false, out);  // a pause for the whole utterance, in pieces
+  }
+  if (at_end) {
+    while (next_ < syn_.phonemes.size()) emit(n, true, out);
+  }
+  // The audio the next steps need: the context before the settled point, which covers
+  // emit()'s half window. The rest goes, a block of kTrimMs at a time.
+  const size_t keep_from = rec_settled_ - std::min(rec_settled_, samples_of(kContextMs, rate_));
+  if (keep_from >= rec_first_ + samples_of(kTrimMs, rate_)) {
+    rec_.erase(rec_.begin(), rec_.begin() + static_cast<std::ptrdiff_t>(keep_from - rec_first_));
+    rec_first_ = keep_from;
+  }
+}
+
+void StreamingAligner::emit(size_t to, bool whole, std::vector<tts::SpokenPhoneme>& out) {
+  MarkupEvent e = syn_.phonemes[next_].event;
+  if (next_started_) {
+    // As pfap::split_long_phoneme's pieces: what marks the phoneme's start is on the first.
+    e.faps.clear();
+    e.sentence_start = false;
+    e.phoneme.stress = false;
+    e.phoneme.word_begin = false;
+  }
+  if (!whole) e.phoneme.end_of_text = false;
+  // f0 on the piece, YIN's windows centred in it.
+  const size_t half_window = 512;
+  const size_t a = rec_settled_ - std::min(rec_settled_, half_window);
+  const size_t b = std::min(samples(), to + half_window);
+  const size_t bounds[] = {rec_settled_ - a, to - a};
+  const double hz =
+      to > rec_settled_
+          ? tts::segment_f0(std::span(rec_).subspan(a - rec_first_, b - a), rate_, bounds)[0]
+          : 0;
+  e.phoneme.f0 = f0_code(static_cast<unsigned>(std::lround(hz)));
+  tts::add_phoneme(e, rec_settled_, to, rate_, out);
+  rec_settled_ = to;
+  next_started_ = !whole;
+  if (whole) ++next_;
+}
+
+}  // namespace pfap::align

@@ -1,0 +1,184 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// The live aligner (align/streaming.*): audio pushed in 20 ms blocks, as a microphone gives
+// it; every phoneme given out within the stated bound of the audio, the phonemes tiling the
+// audio, and their boundaries near espeak-ng's own times for speech at another rate and pitch.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "streaming.h"
+
+namespace pfap::align {
+namespace {
+
+tts::Utterance utterance(const std::string& text) {
+  std::vector<tts::BadBookmark> bad;
+  tts::Utterance u = tts::parse_utterance(text, bad);
+  EXPECT_TRUE(bad.empty());
+  return u;
+}
+
+tts::Speech say(const std::string& text, const tts::VoiceSettings& voice) {
+  tts::Speech s;
+  std::string error;
+  EXPECT_TRUE(tts::speak(utterance(text), voice, s, error)) << error;
+  return s;
+}
+
+// Runs the live aligner over `audio` in 20 ms blocks and checks after each that everything
+// but the last kLookaheadMs + kHoldMs + kStepMs and a block has been given out.
+std::vector<tts::SpokenPhoneme> live(const std::string& text, const std::vector<int16_t>& audio,
+                                     unsigned rate, Problem want = Problem::kNone) {
+  StreamingAligner a;
+  std::string error;
+  EXPECT_TRUE(a.start(utterance(text), {}, rate, error)) << error;
+  EXPECT_EQ(a.problem(), want);
+  std::vector<tts::SpokenPhoneme> out;
+  const size_t block = rate / 50;
+  const size_t bound = size_t{kLookaheadMs + kHoldMs + kStepMs} * rate / 1000 + block;
+  for (size_t i = 0; i < audio.size(); i += block) {
+    const size_t n = std::min(block, audio.size() - i);
+    a.push(std::span(audio).subspan(i, n), out);
+    EXPECT_EQ(a.samples(), i + n);
+    EXPECT_GE(a.settled() + bound, a.samples()) << "at " << a.samples();
+    // What was given out is what settled() says.
+    EXPECT_EQ(out.empty() ? 0 : out.back().start + out.back().n_samples, a.settled());
+  }
+  a.finish(out);
+  // Contiguous from 0 to the end, durations adding up on the ms grid.
+  size_t next = 0;
+  uint64_t ms = 0;
+  for (const tts::SpokenPhoneme& p : out) {
+    EXPECT_EQ(p.start, next);
+    next = p.start + p.n_samples;
+    ms += p.event.phoneme.duration_ms;
+  }
+  EXPECT_EQ(next, audio.size());
+  EXPECT_EQ(ms, (static_cast<uint64_t>(audio.size()) * 1000 + rate / 2) / rate);
+  return out;
+}
+
+// (symbol, start in s) with neighbours of the same symbol (a phoneme's pieces) as one.
+std::vector<std::pair<int, double>> merged(const std::vector<tts::SpokenPhoneme>& ps, unsigned rate,
+                                           size_t offset = 0) {
+  std::vector<std::pair<int, double>> out;
+  for (const tts::SpokenPhoneme& p : ps) {
+    const int symbol = p.event.phoneme.symbol;
+    if (!out.empty() && out.back().first == symbol) continue;
+    out.emplace_back(symbol, static_cast<double>(p.start + offset) / rate);
+  }
+  return out;
+}
+
+constexpr const char* kSentences[] = {
+    "The quick brown fox jumps over the lazy dog.",
+    "Please call Stella and ask her to bring these things with her from the store.",
+    "She sells sea shells by the sea shore, and the shells she sells are surely seashells.",
+    "How much wood would a woodchuck chuck if a woodchuck could chuck wood?",
+};
+
+double percentile(const std::vector<double>& sorted, double p) {
+  return sorted.empty() ? 1e9 : sorted[static_cast<size_t>(p * (sorted.size() - 1))];
+}
+
+TEST(Streaming, BoundaryErrorWithinTheLatencyBound) {
+  std::vector<double> errors;
+  for (const char* text : kSentences) {
+    SCOPED_TRACE(text);
+    // espeak-ng at another rate and pitch, after 400 ms of silence and before 300 ms more.
+    const tts::Speech truth = say(text, {"en", 130, 25, 100});
+    const unsigned rate = truth.sample_rate;
+    const size_t lead = rate * 2 / 5;
+    std::vector<int16_t> audio(lead, 0);
+    audio.insert(audio.end(), truth.samples.begin(), truth.samples.end());
+    audio.resize(audio.size() + rate * 3 / 10, 0);
+    const auto got = merged(live(text, audio, rate), rate);
+    auto want = merged(truth.phonemes, rate, lead);
+    want.front().second = 0;  // the silence before is the first pause's
+    ASSERT_EQ(got.size(), want.size());
+    for (size_t k = 1; k < got.size(); ++k) {
+      EXPECT_EQ(got[k].first, want[k].first) << k;
+      errors.push_back(std::abs(got[k].second - want[k].second) * 1000);
+    }
+  }
+  std::sort(errors.begin(), errors.end());
+  std::printf("live: boundaries %zu, median %.1f ms, p90 %.1f ms\n", errors.size(),
+              percentile(errors, 0.5), percentile(errors, 0.9));
+  ASSERT_GT(errors.size(), 100u);
+  EXPECT_LT(percentile(errors, 0.5), 30);
+  EXPECT_LT(percentile(errors, 0.9), 80);
+}
+
+TEST(Streaming, BookmarksWordStartsAndStressOnTheFirstPieceOnly) {
+  const std::string text = "<FAP 3 1 0 1>Hello world.";
+  const tts::Speech truth = say(text, {"en", 140, 30, 100});
+  std::vector<int16_t> audio = truth.samples;
+  audio.resize(audio.size() + truth.sample_rate, 0);  // a second of pause: sent in pieces
+  const auto out = live(text, audio, truth.sample_rate);
+  size_t with_faps = 0, word_begins = 0;
+  for (const tts::SpokenPhoneme& p : out) {
+    with_faps += p.event.faps.empty() ? 0 : 1;
+    word_begins += p.event.phoneme.word_begin ? 1 : 0;
+  }
+  size_t want_word_begins = 0;
+  for (const tts::SpokenPhoneme& p : truth.phonemes) {
+    want_word_begins += p.event.phoneme.word_begin ? 1 : 0;
+  }
+  EXPECT_EQ(with_faps, 1u);
+  EXPECT_EQ(word_begins, want_word_begins);
+  EXPECT_GT(out.size(), truth.phonemes.size());  // the last pause is in pieces
+  EXPECT_TRUE(out.back().event.phoneme.end_of_text);
+  EXPECT_EQ(std::count_if(out.begin(), out.end(),
+                          [](const auto& p) { return p.event.phoneme.end_of_text; }),
+            1);
+}
+
+TEST(Streaming, SilenceIsAPauseUntilTheSpeech) {
+  // Two seconds of silence, a little noise in it: a pause, given out in pieces as it goes on.
+  StreamingAligner a;
+  std::string error;
+  ASSERT_TRUE(a.start(utterance("Hello world."), {}, 16000, error));
+  std::vector<int16_t> silence(32000);
+  uint32_t x = 1;
+  for (int16_t& v : silence) {
+    x = x * 1664525 + 1013904223;
+    v = static_cast<int16_t>((x >> 16) % 64) - 32;
+  }
+  std::vector<tts::SpokenPhoneme> out;
+  for (size_t i = 0; i < silence.size(); i += 320) {
+    a.push(std::span(silence).subspan(i, 320), out);
+  }
+  EXPECT_GT(out.size(), 5u);
+  for (const tts::SpokenPhoneme& p : out) EXPECT_EQ(p.event.phoneme.symbol, 0);
+}
+
+TEST(Streaming, EmptyTextAndBadRateArePausesInPieces) {
+  const std::vector<int16_t> audio(16000, 1000);
+  const auto empty = live("<FAP 3 1 0 1>", audio, 16000, Problem::kEmptyText);
+  const auto bad_rate =
+      live("Hello world.", std::vector<int16_t>(8000, 1000), 8000, Problem::kBadRate);
+  for (const auto* out : {&empty, &bad_rate}) {
+    ASSERT_GT(out->size(), 1u);
+    for (const tts::SpokenPhoneme& p : *out) EXPECT_EQ(p.event.phoneme.symbol, 0);
+  }
+  EXPECT_EQ(empty.front().event.faps.size(), 1u);
+}
+
+TEST(Streaming, NoAudioAndShortAudio) {
+  StreamingAligner a;
+  std::string error;
+  ASSERT_TRUE(a.start(utterance(kSentences[1]), {}, 16000, error));
+  std::vector<tts::SpokenPhoneme> out;
+  a.finish(out);  // no audio: every phoneme, of no length
+  EXPECT_FALSE(out.empty());
+  for (const tts::SpokenPhoneme& p : out) EXPECT_EQ(p.n_samples, 0u);
+  live(kSentences[1], std::vector<int16_t>(800, 3000), 16000);  // 50 ms: squeezed in
+}
+
+}  // namespace
+}  // namespace pfap::align

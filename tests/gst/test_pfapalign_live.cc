@@ -1,0 +1,407 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// pfapalign live=true in live pipelines: a live appsrc giving a recorded utterance in real
+// time, 20 ms a buffer, as a microphone would; and the documented line, RTP audio in, audio
+// and phonemes out over RTP. The "recording" is espeak-ng's at another rate and pitch, whose
+// phoneme times are known.
+#include <gst/check/gstharness.h>
+#include <gst/gst.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "markupbuffer.h"
+#include "pipeline.h"
+#include "speech.h"
+#include "streaming.h"
+#include "temp_dir.h"
+#include "udp_ports.h"
+
+namespace {
+
+using namespace std::chrono_literals;
+
+constexpr const char* kText = "Please call Stella and ask her to bring these things.";
+constexpr GstClockTime kBlock = 20 * GST_MSECOND;
+constexpr GstClockTime kDeclared = pfap::align::kLiveLatencyMs * GST_MSECOND;
+// The bound align/streaming.h states: kLookaheadMs + kHoldMs + kStepMs and one block.
+constexpr GstClockTime kBound =
+    (pfap::align::kLookaheadMs + pfap::align::kHoldMs + pfap::align::kStepMs) * GST_MSECOND +
+    kBlock;
+
+pfap::tts::Speech say(const std::string& text, int rate, int pitch) {
+  std::vector<pfap::tts::BadBookmark> bad;
+  pfap::tts::Speech s;
+  std::string error;
+  EXPECT_TRUE(
+      pfap::tts::speak(pfap::tts::parse_utterance(text, bad), {"en", rate, pitch, 100}, s, error));
+  return s;
+}
+
+// A phoneme as it left pfapalign, with what the element had of the audio then.
+struct Pushed {
+  GstClockTime pts;
+  GstClockTime duration;
+  int symbol;
+  GstClockTime audio_end;  // the end of the last audio buffer pfapalign had taken
+  GstClockTime running;    // the pipeline's running time when it was pushed
+};
+
+struct Probes {
+  std::mutex mutex;
+  GstClockTime audio_end = 0;
+  std::vector<Pushed> pushed;
+  GstElement* pipeline = nullptr;
+
+  static GstPadProbeReturn on_audio(GstPad*, GstPadProbeInfo* info, gpointer data) {
+    auto* self = static_cast<Probes*>(data);
+    GstBuffer* b = GST_PAD_PROBE_INFO_BUFFER(info);
+    std::lock_guard lock(self->mutex);
+    self->audio_end = GST_BUFFER_PTS(b) + GST_BUFFER_DURATION(b);
+    return GST_PAD_PROBE_OK;
+  }
+  static GstPadProbeReturn on_pfap(GstPad*, GstPadProbeInfo* info, gpointer data) {
+    auto* self = static_cast<Probes*>(data);
+    GstBuffer* b = GST_PAD_PROBE_INFO_BUFFER(info);
+    pfap::MarkupEvent e;
+    EXPECT_TRUE(pfap_buffer_read(b, e));
+    GstClock* clock = gst_element_get_clock(self->pipeline);
+    const GstClockTime now = clock != nullptr ? gst_clock_get_time(clock) : 0;
+    if (clock != nullptr) gst_object_unref(clock);
+    std::lock_guard lock(self->mutex);
+    self->pushed.push_back({GST_BUFFER_PTS(b), GST_BUFFER_DURATION(b), e.phoneme.symbol,
+                            self->audio_end, now - gst_element_get_base_time(self->pipeline)});
+    return GST_PAD_PROBE_OK;
+  }
+};
+
+void probe(GstElement* element, const char* pad_name, GstPadProbeCallback callback,
+           Probes* probes) {
+  GstPad* pad = gst_element_get_static_pad(element, pad_name);
+  gst_pad_add_probe(pad, GST_PAD_PROBE_TYPE_BUFFER, callback, probes, nullptr);
+  gst_object_unref(pad);
+}
+
+GstClockTime latency_of(GstElement* element_or_pipeline, GstPad* pad = nullptr) {
+  GstQuery* q = gst_query_new_latency();
+  gboolean live = FALSE;
+  GstClockTime min = GST_CLOCK_TIME_NONE;
+  const bool ok =
+      pad != nullptr ? gst_pad_query(pad, q) : gst_element_query(element_or_pipeline, q);
+  if (ok) gst_query_parse_latency(q, &live, &min, nullptr);
+  gst_query_unref(q);
+  EXPECT_TRUE(ok && live);
+  return min;
+}
+
+TEST(PfapAlignLive, DeclaresItsLatencyAndKeepsThePhonemesInSyncWithinIt) {
+  // 400 ms of silence, the utterance, 300 ms of silence.
+  const pfap::tts::Speech truth = say(kText, 130, 25);
+  const unsigned rate = truth.sample_rate;
+  const size_t lead = rate * 2 / 5;
+  std::vector<int16_t> audio(lead, 0);
+  audio.insert(audio.end(), truth.samples.begin(), truth.samples.end());
+  audio.resize(audio.size() + rate * 3 / 10, 0);
+
+  pfap::testing::Pipeline p(
+      "appsrc name=src is-live=true format=time min-latency=20000000 caps=\"audio/x-raw,"
+      "format=S16LE,layout=interleaved,channels=1,rate=" +
+      std::to_string(rate) + "\" ! pfapalign name=a live=true text=\"" + kText +
+      "\" a.src ! queue ! fakesink sync=true a.pfap ! queue ! fakesink sync=true");
+  ASSERT_TRUE(p.ok()) << p.error();
+  GstElement* src = p.by_name("src");
+  GstElement* align = p.by_name("a");
+  Probes probes;
+  probes.pipeline = p.get();
+  probe(align, "sink", Probes::on_audio, &probes);
+  probe(align, "pfap", Probes::on_pfap, &probes);
+  ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+
+  // Each block pushed once the clock has passed its end, as a capture device gives it.
+  GstClock* clock = nullptr;
+  for (auto waited = 0ms; clock == nullptr && waited < 10s; waited += 10ms) {
+    clock = gst_element_get_clock(p.get());
+    if (clock == nullptr) std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_NE(clock, nullptr);
+  const size_t block = static_cast<size_t>(gst_util_uint64_scale(kBlock, rate, GST_SECOND));
+  for (size_t i = 0; i < audio.size(); i += block) {
+    const size_t n = std::min(block, audio.size() - i);
+    GstBuffer* b = gst_buffer_new_memdup(audio.data() + i, n * 2);
+    GST_BUFFER_PTS(b) = gst_util_uint64_scale(i, GST_SECOND, rate);
+    GST_BUFFER_DURATION(b) = gst_util_uint64_scale(i + n, GST_SECOND, rate) - GST_BUFFER_PTS(b);
+    const GstClockTime due =
+        gst_element_get_base_time(p.get()) + GST_BUFFER_PTS(b) + GST_BUFFER_DURATION(b);
+    while (gst_clock_get_time(clock) < due) std::this_thread::sleep_for(2ms);
+    GstFlowReturn ret = GST_FLOW_OK;
+    g_signal_emit_by_name(src, "push-buffer", b, &ret);
+    gst_buffer_unref(b);
+    ASSERT_EQ(ret, GST_FLOW_OK);
+  }
+  gst_object_unref(clock);
+
+  // The latency: appsrc's 20 ms and pfapalign's stated kLiveLatencyMs, on its pad and for the
+  // whole pipeline, which the sinks wait by (there with their processing deadline, 20 ms).
+  GstPad* pfap_pad = gst_element_get_static_pad(align, "pfap");
+  EXPECT_EQ(latency_of(nullptr, pfap_pad), 20 * GST_MSECOND + kDeclared);
+  gst_object_unref(pfap_pad);
+  guint64 deadline = 0;
+  g_object_get(p.find("fakesink"), "processing-deadline", &deadline, nullptr);
+  EXPECT_EQ(latency_of(p.get()), 20 * GST_MSECOND + kDeclared + deadline);
+
+  g_signal_emit_by_name(src, "end-of-stream", nullptr);
+  ASSERT_EQ(p.wait_eos(10s), "");
+  gst_element_set_state(p.get(), GST_STATE_NULL);
+
+  std::lock_guard lock(probes.mutex);
+  const std::vector<Pushed>& got = probes.pushed;
+  ASSERT_GT(got.size(), 20u);
+  // The phonemes tile the audio from 0 to its end.
+  GstClockTime next = 0;
+  for (const Pushed& e : got) {
+    EXPECT_EQ(e.pts, next);
+    next = e.pts + e.duration;
+  }
+  EXPECT_EQ(next, gst_util_uint64_scale(audio.size(), GST_SECOND, rate));
+  // Each left within the bound of the audio it describes: before the EOS, no phoneme starts
+  // more than kBound before the end of the audio taken so far.
+  size_t early = 0;
+  GstClockTime most_behind = 0, most_late = 0;
+  for (const Pushed& e : got) {
+    if (e.audio_end < next) {
+      ++early;
+      EXPECT_LE(e.audio_end, e.pts + kBound) << "phoneme at " << e.pts;
+      most_behind = std::max(most_behind, e.audio_end - e.pts);
+      most_late = std::max(most_late, e.running > e.pts ? e.running - e.pts : 0);
+    }
+  }
+  EXPECT_GT(early, got.size() / 2) << "most phonemes leave before the audio ends";
+  // By the clock it depends on the machine keeping up (not at -O0 with sanitizers on a busy
+  // machine): printed, not checked.
+  std::printf(
+      "live pipeline: a phoneme's start at most %.0f ms before the audio's end, pushed "
+      "at most %.0f ms after its start by the clock (declared %.0f ms)\n",
+      static_cast<double>(most_behind) / GST_MSECOND, static_cast<double>(most_late) / GST_MSECOND,
+      static_cast<double>(kDeclared) / GST_MSECOND);
+
+  // In sync with the audio they describe: the phonemes (pieces of one merged) where espeak-ng
+  // put them in the recording.
+  std::vector<std::pair<int, double>> want, have;
+  for (const pfap::tts::SpokenPhoneme& ph : truth.phonemes) {
+    if (want.empty() || want.back().first != ph.event.phoneme.symbol) {
+      want.emplace_back(ph.event.phoneme.symbol, static_cast<double>(ph.start + lead) / rate);
+    }
+  }
+  for (const Pushed& e : got) {
+    if (have.empty() || have.back().first != e.symbol) {
+      have.emplace_back(e.symbol, static_cast<double>(e.pts) / GST_SECOND);
+    }
+  }
+  ASSERT_EQ(have.size(), want.size());
+  std::vector<double> errors;
+  for (size_t k = 1; k < have.size(); ++k) {
+    EXPECT_EQ(have[k].first, want[k].first) << k;
+    errors.push_back(std::abs(have[k].second - want[k].second) * 1000);
+  }
+  std::sort(errors.begin(), errors.end());
+  const double median = errors[errors.size() / 2];
+  std::printf("live pipeline: %zu phonemes pushed, %zu boundaries, median error %.1f ms\n",
+              got.size(), errors.size(), median);
+  EXPECT_LT(median, 30);
+}
+
+// Utterances on text_sink, live: each starts at its PTS, the phonemes of the first come while
+// the audio still flows, and the audio passes unchanged.
+TEST(PfapAlignLive, UtterancesOnTheTextPadStartAtTheirPts) {
+  const pfap::tts::Speech a = say("Good morning.", 140, 30);
+  const pfap::tts::Speech b = say("See you tomorrow.", 140, 30);
+  const unsigned rate = a.sample_rate;
+  std::vector<int16_t> audio = a.samples;
+  audio.resize(audio.size() + rate / 2, 0);  // half a second of silence
+  const size_t b_start = audio.size();
+  audio.insert(audio.end(), b.samples.begin(), b.samples.end());
+  const GstClockTime b_time = gst_util_uint64_scale(b_start, GST_SECOND, rate);
+
+  // live is read when the element goes to PAUSED, which the first harness does.
+  GstElement* element = gst_element_factory_make("pfapalign", nullptr);
+  ASSERT_NE(element, nullptr);
+  g_object_set(element, "live", TRUE, nullptr);
+  GstHarness* h = gst_harness_new_with_element(element, "sink", "src");
+  gst_object_unref(element);
+  GstHarness* pfap = gst_harness_new_with_element(h->element, nullptr, "pfap");
+  GstHarness* t = gst_harness_new_with_element(h->element, "text_sink", nullptr);
+  gst_harness_set_src_caps_str(h, ("audio/x-raw, format=(string)S16LE, layout=(string)"
+                                   "interleaved, channels=(int)1, rate=(int)" +
+                                   std::to_string(rate))
+                                      .c_str());
+  gst_harness_set_src_caps_str(t, "text/x-raw, format=(string)utf8");
+  for (const auto& [pts, text] :
+       {std::pair<GstClockTime, std::string>{0, "Good morning."}, {b_time, "See you tomorrow."}}) {
+    GstBuffer* buffer = gst_buffer_new_memdup(text.data(), text.size());
+    GST_BUFFER_PTS(buffer) = pts;
+    ASSERT_EQ(gst_harness_push(t, buffer), GST_FLOW_OK);
+  }
+  std::vector<int16_t> passed;
+  std::vector<std::pair<GstClockTime, pfap::MarkupEvent>> events;
+  size_t before_end = 0;
+  const size_t block = rate / 50;
+  for (size_t i = 0; i < audio.size(); i += block) {
+    const size_t n = std::min(block, audio.size() - i);
+    GstBuffer* buffer = gst_buffer_new_memdup(audio.data() + i, n * 2);
+    GST_BUFFER_PTS(buffer) = gst_util_uint64_scale(i, GST_SECOND, rate);
+    GST_BUFFER_DURATION(buffer) =
+        gst_util_uint64_scale(i + n, GST_SECOND, rate) - GST_BUFFER_PTS(buffer);
+    ASSERT_EQ(gst_harness_push(h, buffer), GST_FLOW_OK);
+    GstBuffer* out = gst_harness_pull(h);
+    GstMapInfo map;
+    ASSERT_TRUE(gst_buffer_map(out, &map, GST_MAP_READ));
+    const auto* samples = reinterpret_cast<const int16_t*>(map.data);
+    passed.insert(passed.end(), samples, samples + map.size / 2);
+    gst_buffer_unmap(out, &map);
+    gst_buffer_unref(out);
+    while (GstBuffer* e = gst_harness_try_pull(pfap)) {
+      pfap::MarkupEvent event;
+      EXPECT_TRUE(pfap_buffer_read(e, event));
+      events.emplace_back(GST_BUFFER_PTS(e), event);
+      gst_buffer_unref(e);
+    }
+    if (i + n < b_start) before_end = events.size();
+  }
+  gst_harness_push_event(t, gst_event_new_eos());
+  gst_harness_push_event(h, gst_event_new_eos());
+  while (GstBuffer* e = gst_harness_try_pull(pfap)) {
+    pfap::MarkupEvent event;
+    EXPECT_TRUE(pfap_buffer_read(e, event));
+    events.emplace_back(GST_BUFFER_PTS(e), event);
+    gst_buffer_unref(e);
+  }
+  EXPECT_EQ(passed, audio);
+  // The first utterance's phonemes, all but the last pause, before the second's audio.
+  EXPECT_GE(before_end + 1, a.phonemes.size());
+  const auto second =
+      std::find_if(events.begin(), events.end(), [&](const auto& e) { return e.first >= b_time; });
+  ASSERT_NE(second, events.end());
+  EXPECT_EQ(second->first, b_time);
+  EXPECT_TRUE(second->second.sentence_start);
+  gst_harness_teardown(t);
+  gst_harness_teardown(pfap);
+  gst_harness_teardown(h);
+}
+
+// The live line of docs/elements.md's pfapalign section, its ports made free ones.
+std::string documented_live_line() {
+  std::ifstream in(PFAP_SOURCE_DIR "/docs/elements.md");
+  std::stringstream all;
+  all << in.rdbuf();
+  const std::string doc = all.str();
+  const size_t from = doc.find("## pfapalign");
+  const size_t to = doc.find("\n## ", from + 1);
+  std::istringstream section(doc.substr(from, to - from));
+  std::string found;
+  for (std::string line; std::getline(section, line);) {
+    if (line.starts_with("gst-launch-1.0 ") && line.find(" live=true ") != std::string::npos) {
+      EXPECT_TRUE(found.empty()) << "one live line";
+      found = line.substr(std::string("gst-launch-1.0 ").size());
+    }
+  }
+  return found;
+}
+
+// `port=N` made `port=` the free port that `ports` maps N to.
+std::string with_ports(const std::string& line, std::map<int, int>& ports) {
+  static const std::regex port("port=([0-9]+)");
+  std::string out;
+  auto last = line.cbegin();
+  for (std::sregex_iterator it(line.begin(), line.end(), port), end; it != end; ++it) {
+    out.append(last, (*it)[0].first);
+    const int documented = std::stoi((*it)[1].str());
+    if (!ports.contains(documented)) ports[documented] = pfap::testing::free_udp_ports(1).at(0);
+    out += "port=" + std::to_string(ports[documented]);
+    last = (*it)[0].second;
+  }
+  out.append(last, line.cend());
+  return out;
+}
+
+TEST(PfapAlignLive, DocumentedRtpLineRuns) {
+  const std::string line = documented_live_line();
+  ASSERT_FALSE(line.empty());
+  std::map<int, int> ports;
+  pfap::testing::Pipeline aligner(with_ports(line, ports));
+  ASSERT_TRUE(aligner.ok()) << aligner.error();
+  // The receiver of "Next to audio", at the audio's 16 kHz; phonemes counted as they come.
+  pfap::testing::Pipeline receiver(
+      with_ports("rtpbin name=r "
+                 "udpsrc address=127.0.0.1 port=5000 caps=\"application/x-rtp,media=audio,"
+                 "clock-rate=16000,encoding-name=L16,channels=1,payload=96\" ! r.recv_rtp_sink_0 "
+                 "udpsrc address=127.0.0.1 port=5001 ! r.recv_rtcp_sink_0 "
+                 "udpsrc address=127.0.0.1 port=5002 caps=\"application/x-rtp,media=application,"
+                 "clock-rate=44100,encoding-name=PFAP,payload=97\" ! r.recv_rtp_sink_1 "
+                 "udpsrc address=127.0.0.1 port=5003 ! r.recv_rtcp_sink_1 "
+                 "r. ! rtpL16depay ! fakesink r. ! rtppfapdepay ! pfaptextenc name=d ! fakesink",
+                 ports));
+  ASSERT_TRUE(receiver.ok()) << receiver.error();
+  // The speech sent in real time as RTP L16 at 16 kHz to the line's port 5004.
+  const pfap::testing::TempDir dir;
+  {
+    pfap::testing::Pipeline make("pfaptts rate=140 pitch=30 text=\"" + std::string(kText) +
+                                 "\" name=t t.audio ! queue ! wavenc ! filesink location=" +
+                                 dir.file("speech.wav") + " t.pfap ! queue ! fakesink");
+    ASSERT_TRUE(make.ok()) << make.error();
+    ASSERT_EQ(make.set_state(GST_STATE_PLAYING), "");
+    ASSERT_EQ(make.wait_eos(30s), "");
+  }
+  pfap::testing::Pipeline sender(with_ports(
+      "filesrc location=" + dir.file("speech.wav") +
+          " ! wavparse ! audioconvert ! audioresample ! audio/x-raw,rate=16000,channels=1 ! "
+          "rtpL16pay pt=96 ! udpsink host=127.0.0.1 port=5004",
+      ports));
+  ASSERT_TRUE(sender.ok()) << sender.error();
+
+  std::atomic<int> phonemes{0};  // lines of pfaptextenc: one a phoneme
+  GstPad* pad = gst_element_get_static_pad(receiver.by_name("d"), "src");
+  gst_pad_add_probe(
+      pad, GST_PAD_PROBE_TYPE_BUFFER,
+      [](GstPad*, GstPadProbeInfo* info, gpointer count) {
+        GstMapInfo map;
+        GstBuffer* b = GST_PAD_PROBE_INFO_BUFFER(info);
+        if (gst_buffer_map(b, &map, GST_MAP_READ)) {
+          *static_cast<std::atomic<int>*>(count) += static_cast<int>(
+              std::count(map.data, map.data + map.size, static_cast<guint8>('\n')));
+          gst_buffer_unmap(b, &map);
+        }
+        return GST_PAD_PROBE_OK;
+      },
+      &phonemes, nullptr);
+  gst_object_unref(pad);
+
+  ASSERT_EQ(receiver.set_state(GST_STATE_PLAYING), "");
+  ASSERT_EQ(aligner.set_state(GST_STATE_PLAYING), "");
+  ASSERT_EQ(sender.set_state(GST_STATE_PLAYING), "");
+  ASSERT_EQ(sender.wait_eos(20s), "") << "the sender sends in real time";
+  // The phonemes of the utterance: espeak-ng's, a few more when one is sent in pieces.
+  const size_t want = say(kText, 175, 50).phonemes.size();
+  for (auto waited = 0ms; static_cast<size_t>(phonemes) < want * 3 / 4 && waited < 10s;
+       waited += 50ms) {
+    std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_GE(static_cast<size_t>(phonemes), want * 3 / 4);
+  EXPECT_EQ(aligner.poll_error(), "");
+  EXPECT_EQ(receiver.poll_error(), "");
+  gst_element_set_state(sender.get(), GST_STATE_NULL);
+  gst_element_set_state(aligner.get(), GST_STATE_NULL);
+  gst_element_set_state(receiver.get(), GST_STATE_NULL);
+}
+
+}  // namespace

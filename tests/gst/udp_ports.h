@@ -1,0 +1,40 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Free UDP ports on 127.0.0.1 for tests that run documented lines with fixed ports.
+#pragma once
+
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <vector>
+
+namespace pfap::testing {
+
+// UDP ports on 127.0.0.1 that were free a moment ago: each bound to port 0 by the system,
+// all held until the last is found (so they differ), then released for the pipelines.
+inline std::vector<int> free_udp_ports(size_t n) {
+  std::vector<int> sockets;
+  std::vector<int> ports;
+  for (size_t i = 0; i < n; ++i) {
+    const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    address.sin_port = 0;
+    socklen_t length = sizeof address;
+    if (fd < 0 || bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 ||
+        getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) != 0) {
+      ADD_FAILURE() << "cannot bind a UDP socket on 127.0.0.1";
+      if (fd >= 0) close(fd);
+      break;
+    }
+    sockets.push_back(fd);
+    ports.push_back(ntohs(address.sin_port));
+  }
+  for (int fd : sockets) close(fd);
+  return ports;
+}
+
+}  // namespace pfap::testing
