@@ -17,29 +17,20 @@
 #include "dtw.h"
 #include "f0.h"
 #include "features.h"
+#include "speech_fixtures.h"
 
 namespace pfap::align {
 namespace {
+
+using testing::expect_tiles;
+using testing::say;
+using testing::utterance;
 
 std::vector<int16_t> tone(double hz, double seconds, unsigned rate) {
   std::vector<int16_t> s(static_cast<size_t>(seconds * rate));
   for (size_t i = 0; i < s.size(); ++i) {
     s[i] = static_cast<int16_t>(8000 * std::sin(2 * std::numbers::pi * hz * i / rate));
   }
-  return s;
-}
-
-tts::Utterance utterance(const std::string& text) {
-  std::vector<tts::BadBookmark> bad;
-  tts::Utterance u = tts::parse_utterance(text, bad);
-  EXPECT_TRUE(bad.empty());
-  return u;
-}
-
-tts::Speech say(const std::string& text, const tts::VoiceSettings& voice) {
-  tts::Speech s;
-  std::string error;
-  EXPECT_TRUE(tts::speak(utterance(text), voice, s, error)) << error;
   return s;
 }
 
@@ -63,18 +54,8 @@ Alignment aligned(const std::string& text, const std::vector<int16_t>& audio, un
   return a;
 }
 
-// The phonemes tile the audio and their durations add up to its length in ms.
 void expect_tiles(const Alignment& a, size_t n_samples, unsigned rate) {
-  ASSERT_FALSE(a.phonemes.empty());
-  size_t next = 0;
-  uint64_t ms = 0;
-  for (const tts::SpokenPhoneme& p : a.phonemes) {
-    EXPECT_EQ(p.start, next);
-    next = p.start + p.n_samples;
-    ms += p.event.phoneme.duration_ms;
-  }
-  EXPECT_EQ(next, n_samples);
-  EXPECT_EQ(ms, (static_cast<uint64_t>(n_samples) * 1000 + rate / 2) / rate);
+  testing::expect_tiles(a.phonemes, n_samples, rate);
 }
 
 TEST(Features, SameSoundAtTwoRatesGivesTheSameFrames) {

@@ -13,18 +13,13 @@
 #include <vector>
 
 #include "recognizer.h"
+#include "speech_fixtures.h"
 #include "viseme_frames.h"
 
 namespace pfap::align {
 namespace {
 
-tts::Speech say(const std::string& text, const tts::VoiceSettings& voice) {
-  std::vector<tts::BadBookmark> bad;
-  tts::Speech s;
-  std::string error;
-  EXPECT_TRUE(tts::speak(tts::parse_utterance(text, bad), voice, s, error)) << error;
-  return s;
-}
+using testing::say;
 
 std::vector<TimedSymbol> timed(const std::vector<tts::SpokenPhoneme>& phonemes, unsigned rate) {
   std::vector<TimedSymbol> out;
@@ -54,18 +49,8 @@ Recognition recognized(const std::vector<int16_t>& audio, unsigned rate) {
   return out;
 }
 
-// The phonemes tile the audio and their durations add up to its length in ms.
 void expect_tiles(const Recognition& r, size_t n_samples, unsigned rate) {
-  ASSERT_FALSE(r.phonemes.empty());
-  size_t next = 0;
-  uint64_t ms = 0;
-  for (const tts::SpokenPhoneme& p : r.phonemes) {
-    EXPECT_EQ(p.start, next);
-    next = p.start + p.n_samples;
-    ms += p.event.phoneme.duration_ms;
-  }
-  EXPECT_EQ(next, n_samples);
-  EXPECT_EQ(ms, (static_cast<uint64_t>(n_samples) * 1000 + rate / 2) / rate);
+  testing::expect_tiles(r.phonemes, n_samples, rate);
 }
 
 void expect_one_pause(const Recognition& r, size_t n_samples, unsigned rate) {

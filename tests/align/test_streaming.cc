@@ -11,24 +11,14 @@
 #include <string>
 #include <vector>
 
+#include "speech_fixtures.h"
 #include "streaming.h"
 
 namespace pfap::align {
 namespace {
 
-tts::Utterance utterance(const std::string& text) {
-  std::vector<tts::BadBookmark> bad;
-  tts::Utterance u = tts::parse_utterance(text, bad);
-  EXPECT_TRUE(bad.empty());
-  return u;
-}
-
-tts::Speech say(const std::string& text, const tts::VoiceSettings& voice) {
-  tts::Speech s;
-  std::string error;
-  EXPECT_TRUE(tts::speak(utterance(text), voice, s, error)) << error;
-  return s;
-}
+using testing::say;
+using testing::utterance;
 
 // Runs the live aligner over `audio` in 20 ms blocks and checks after each that everything
 // but the last kLookaheadMs + kHoldMs + kStepMs and a block has been given out.
@@ -50,16 +40,7 @@ std::vector<tts::SpokenPhoneme> live(const std::string& text, const std::vector<
     EXPECT_EQ(out.empty() ? 0 : out.back().start + out.back().n_samples, a.settled());
   }
   a.finish(out);
-  // Contiguous from 0 to the end, durations adding up on the ms grid.
-  size_t next = 0;
-  uint64_t ms = 0;
-  for (const tts::SpokenPhoneme& p : out) {
-    EXPECT_EQ(p.start, next);
-    next = p.start + p.n_samples;
-    ms += p.event.phoneme.duration_ms;
-  }
-  EXPECT_EQ(next, audio.size());
-  EXPECT_EQ(ms, (static_cast<uint64_t>(audio.size()) * 1000 + rate / 2) / rate);
+  testing::expect_tiles(out, audio.size(), rate);
   return out;
 }
 
