@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // What the align/ tests share: texts spoken by espeak-ng with known phoneme times, and the
-// check that phonemes tile the audio they were given.
+// check that phonemes tile the audio they were given, and resampling.
 #pragma once
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -28,6 +29,21 @@ inline tts::Speech say(const std::string& text, const tts::VoiceSettings& voice)
   std::string error;
   EXPECT_TRUE(tts::speak(utterance(text), voice, s, error)) << error;
   return s;
+}
+
+// `in` at rate `from` resampled to `to` by linear interpolation: enough for speech whose
+// energy is well under 8 kHz.
+inline std::vector<int16_t> resample(const std::vector<int16_t>& in, unsigned from,
+                                     unsigned to) {
+  std::vector<int16_t> out(in.size() * to / from);
+  for (size_t i = 0; i < out.size(); ++i) {
+    const double x = static_cast<double>(i) * from / to;
+    const size_t k = static_cast<size_t>(x);
+    const double t = x - static_cast<double>(k);
+    const double b = k + 1 < in.size() ? in[k + 1] : in[k];
+    out[i] = static_cast<int16_t>(std::lround(in[k] * (1 - t) + b * t));
+  }
+  return out;
 }
 
 // The phonemes tile the audio (contiguous from 0 to its end) and their durations add up to

@@ -23,6 +23,7 @@ namespace pfap::align {
 namespace {
 
 using testing::expect_tiles;
+using testing::resample;
 using testing::say;
 using testing::utterance;
 
@@ -32,19 +33,6 @@ std::vector<int16_t> tone(double hz, double seconds, unsigned rate) {
     s[i] = static_cast<int16_t>(8000 * std::sin(2 * std::numbers::pi * hz * i / rate));
   }
   return s;
-}
-
-// Linear interpolation: enough for speech whose energy is well under 8 kHz.
-std::vector<int16_t> resample(const std::vector<int16_t>& in, unsigned from, unsigned to) {
-  std::vector<int16_t> out(in.size() * to / from);
-  for (size_t i = 0; i < out.size(); ++i) {
-    const double x = static_cast<double>(i) * from / to;
-    const size_t k = static_cast<size_t>(x);
-    const double t = x - static_cast<double>(k);
-    const double b = k + 1 < in.size() ? in[k + 1] : in[k];
-    out[i] = static_cast<int16_t>(std::lround(in[k] * (1 - t) + b * t));
-  }
-  return out;
 }
 
 Alignment aligned(const std::string& text, const std::vector<int16_t>& audio, unsigned rate) {

@@ -19,25 +19,13 @@
 namespace pfap::align {
 namespace {
 
+using testing::resample;
 using testing::say;
 
 std::vector<TimedSymbol> timed(const std::vector<tts::SpokenPhoneme>& phonemes, unsigned rate) {
   std::vector<TimedSymbol> out;
   for (const tts::SpokenPhoneme& p : phonemes) {
     out.push_back({static_cast<double>(p.start) / rate, p.event.phoneme.symbol});
-  }
-  return out;
-}
-
-// Linear interpolation: enough for speech whose energy is well under 8 kHz.
-std::vector<int16_t> resample(const std::vector<int16_t>& in, unsigned from, unsigned to) {
-  std::vector<int16_t> out(in.size() * to / from);
-  for (size_t i = 0; i < out.size(); ++i) {
-    const double x = static_cast<double>(i) * from / to;
-    const size_t k = static_cast<size_t>(x);
-    const double t = x - static_cast<double>(k);
-    const double b = k + 1 < in.size() ? in[k + 1] : in[k];
-    out[i] = static_cast<int16_t>(std::lround(in[k] * (1 - t) + b * t));
   }
   return out;
 }

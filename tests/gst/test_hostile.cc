@@ -39,6 +39,19 @@ using pfap::testing::Pipeline;
 
 constexpr GstClockTime kPhoneme = 40 * GST_MSECOND;
 
+// The bytes of every buffer the appsink "out" of `p` holds.
+std::vector<Packet> pulled_packets(Pipeline& p) {
+  std::vector<Packet> out;
+  for (GstSample* s : pfap::testing::pull_all(p.by_name("out"))) {
+    GstMapInfo map;
+    gst_buffer_map(gst_sample_get_buffer(s), &map, GST_MAP_READ);
+    out.emplace_back(map.data, map.data + map.size);
+    gst_buffer_unmap(gst_sample_get_buffer(s), &map);
+    gst_sample_unref(s);
+  }
+  return out;
+}
+
 // `n` phonemes of 40 ms, one RTP packet each (max-delay=0), as rtppfappay makes them.
 std::vector<Packet> good_packets(int n) {
   Pipeline p(
@@ -56,15 +69,7 @@ std::vector<Packet> good_packets(int n) {
   }
   pfap::testing::end_of_stream(p.by_name("src"));
   EXPECT_EQ(p.wait_eos(std::chrono::seconds(10)), "");
-  std::vector<Packet> out;
-  for (GstSample* s : pfap::testing::pull_all(p.by_name("out"))) {
-    GstMapInfo map;
-    gst_buffer_map(gst_sample_get_buffer(s), &map, GST_MAP_READ);
-    out.emplace_back(map.data, map.data + map.size);
-    gst_buffer_unmap(gst_sample_get_buffer(s), &map);
-    gst_sample_unref(s);
-  }
-  return out;
+  return pulled_packets(p);
 }
 
 // The documented SRTP key (docs/security.md): 30 bytes, AES-128-ICM and HMAC-SHA1-80.
@@ -83,14 +88,7 @@ std::vector<Packet> srtp_protect(const std::vector<Packet>& packets) {
   }
   pfap::testing::end_of_stream(p.by_name("src"));
   EXPECT_EQ(p.wait_eos(std::chrono::seconds(10)), "");
-  std::vector<Packet> out;
-  for (GstSample* s : pfap::testing::pull_all(p.by_name("out"))) {
-    GstMapInfo map;
-    gst_buffer_map(gst_sample_get_buffer(s), &map, GST_MAP_READ);
-    out.emplace_back(map.data, map.data + map.size);
-    gst_buffer_unmap(gst_sample_get_buffer(s), &map);
-    gst_sample_unref(s);
-  }
+  std::vector<Packet> out = pulled_packets(p);
   EXPECT_EQ(out.size(), packets.size());
   return out;
 }
