@@ -134,6 +134,11 @@ GstPad* sink_pad_of(GstElement* bin, const char* name) {
 // cost is a few dozen bytes per stream each 100 ms.
 constexpr guint64 kRtcpIntervalNs = 100'000'000;
 
+// Sender reports map RTP time to the buffers' capture time, not to when they are sent
+// (rtpbin's rtcp-sync-send-time=false): rtppfappay holds phonemes up to max-delay before it
+// sends them, and a busy server sends late, so with send time the reports said the phonemes
+// were later than their audio, and the client's lip sync moved them back by that much
+// (120 ms under load: the third phoneme of hello.pfap at 250 ms instead of 130).
 void on_media_prepared(GstRTSPMedia* media, gpointer) {
   for (guint i = 0; i < gst_rtsp_media_n_streams(media); ++i) {
     GObject* session = gst_rtsp_stream_get_rtpsession(gst_rtsp_media_get_stream(media, i));
@@ -141,6 +146,19 @@ void on_media_prepared(GstRTSPMedia* media, gpointer) {
     g_object_set(session, "rtcp-min-interval", kRtcpIntervalNs, nullptr);
     g_object_unref(session);
   }
+  GstElement* element = gst_rtsp_media_get_element(media);
+  GstObject* pipeline = gst_object_get_parent(GST_OBJECT(element));
+  gst_object_unref(element);
+  if (pipeline == nullptr) return;
+  GstIterator* it = gst_bin_iterate_all_by_element_factory_name(GST_BIN(pipeline), "rtpbin");
+  GValue item = G_VALUE_INIT;
+  while (gst_iterator_next(it, &item) == GST_ITERATOR_OK) {
+    g_object_set(g_value_get_object(&item), "rtcp-sync-send-time", FALSE, nullptr);
+    g_value_reset(&item);
+  }
+  g_value_unset(&item);
+  gst_iterator_free(it);
+  gst_object_unref(pipeline);
 }
 
 // Sets the .pfap file on each new media's filesrc (no quoting of paths in kLaunch) and ties

@@ -110,7 +110,7 @@ int parse_options(int argc, char** argv, Options& options) {
 }
 
 std::string sender_description(const Options& o) {
-  return "rtpbin name=rtpbin rtp-profile=avpf "
+  return "rtpbin name=rtpbin rtp-profile=avpf rtcp-sync-send-time=false "
          "pfaptts name=tts text=" +
          quoted(o.text) +
          " tts.audio ! queue ! audioconvert ! rtpL16pay name=apay pt=96 "
