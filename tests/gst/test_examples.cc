@@ -39,7 +39,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
-#include <map>
 #include <memory>
 #include <mutex>
 #include <regex>
@@ -48,6 +47,7 @@
 #include <vector>
 
 #include "pfap/markup.h"
+#include "documented_commands.h"
 #include "pfap_buffers.h"
 #include "pipeline.h"
 #include "temp_dir.h"
@@ -57,6 +57,12 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
+using pfap::testing::commands_in;
+using pfap::testing::doc_section;
+using pfap::testing::lines_of;
+using pfap::testing::read_file;
+using pfap::testing::replace_all;
+using pfap::testing::source_path;
 
 // The plugin's elements the examples use.
 constexpr const char* kElements[] = {"pfapparse", "pfaptextenc", "rtppfappay", "rtppfapdepay"};
@@ -71,31 +77,6 @@ constexpr int64_t kRtpToleranceMs = 1;
 
 // ---------------------------------------------------------------------------------------------
 // Files
-
-std::string source_path(const std::string& relative) {
-  return std::string(PFAP_SOURCE_DIR) + "/" + relative;
-}
-
-std::string read_file(const std::string& path) {
-  gchar* contents = nullptr;
-  gsize length = 0;
-  if (!g_file_get_contents(path.c_str(), &contents, &length, nullptr)) return "<cannot read>";
-  std::string text(contents, length);
-  g_free(contents);
-  return text;
-}
-
-std::vector<std::string> lines_of(const std::string& text) {
-  std::vector<std::string> lines;
-  size_t start = 0;
-  while (start < text.size()) {
-    size_t end = text.find('\n', start);
-    if (end == std::string::npos) end = text.size();
-    lines.push_back(text.substr(start, end - start));
-    start = end + 1;
-  }
-  return lines;
-}
 
 // The lines that carry an event (not blank, not comment-only), each with its '\n'.
 std::string event_lines(const std::string& text) {
@@ -341,37 +322,10 @@ template <typename Done>
 // ---------------------------------------------------------------------------------------------
 // The documented commands
 
-// The commands in the ```sh blocks under `heading` (to the next heading) in `section` of `file`
-// (a source path): comment lines dropped, lines ending in '\' joined.
+// The commands under `heading` in `section` of `file` (a source path).
 std::vector<std::string> documented_commands(const std::string& file, const std::string& section,
                                              const std::string& heading) {
-  const std::vector<std::string> lines = lines_of(read_file(source_path(file)));
-  std::vector<std::string> commands;
-  bool in_section = false, in_heading = false, in_block = false, continued = false;
-  for (const std::string& line : lines) {
-    if (!in_block && line.rfind("## ", 0) == 0) in_section = line == section;
-    if (!in_section) continue;
-    if (!in_block && line.rfind("### ", 0) == 0) in_heading = line == heading;
-    if (!in_heading) continue;
-    if (line.rfind("```", 0) == 0) {
-      in_block = !in_block;
-      continue;
-    }
-    if (!in_block || (!continued && line.rfind('#', 0) == 0)) continue;
-    std::string part = line;
-    const bool continues = !part.empty() && part.back() == '\\';
-    if (continues) part.pop_back();
-    if (continued) {
-      commands.back() += " " + part.substr(part.find_first_not_of(' '));
-    } else {
-      commands.push_back(part);
-    }
-    continued = continues;
-  }
-  for (std::string& c : commands) {
-    while (!c.empty() && c.back() == ' ') c.pop_back();
-  }
-  return commands;
+  return commands_in(pfap::testing::section(doc_section(file, section), heading));
 }
 
 // Those of docs/elements.md, "Text markup: sending and receiving a session".
@@ -397,46 +351,18 @@ class Substitution {
     replace_all(command, "speech.pfap", dir_.file("speech.pfap"));
     replace_all(command, "speech.wav", dir_.file("speech.wav"));
     if (!rtsp_url_.empty()) replace_all(command, "rtsp://127.0.0.1:8554/pfap", rtsp_url_);
-    static const std::regex port("port=([0-9]+)");
-    std::string out;
-    auto last = command.cbegin();
-    for (std::sregex_iterator it(command.begin(), command.end(), port), end; it != end; ++it) {
-      out.append(last, (*it)[0].first);
-      out += "port=" + std::to_string(free_port(std::stoi((*it)[1].str())));
-      last = (*it)[0].second;
-    }
-    out.append(last, command.cend());
-    return out;
+    return free_ports_(command);
   }
 
   // The launch description of a gst-launch-1.0 command (without the program and -e).
   std::string launch(const std::string& command) {
-    std::string c = (*this)(command);
-    for (const char* prefix : {"gst-launch-1.0 ", "-e "}) {
-      if (c.rfind(prefix, 0) == 0) c = c.substr(std::string(prefix).size());
-    }
-    return c;
+    return pfap::testing::launch_description((*this)(command));
   }
 
  private:
-  static void replace_all(std::string& s, const std::string& from, const std::string& to) {
-    for (size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size())) {
-      s.replace(at, from.size(), to);
-    }
-  }
-
-  int free_port(int documented) {
-    auto it = ports_.find(documented);
-    if (it != ports_.end()) return it->second;
-    const std::vector<int> free = free_udp_ports(1);
-    const int port = free.empty() ? documented : free[0];
-    ports_[documented] = port;
-    return port;
-  }
-
   const TempDir& dir_;
   std::string rtsp_url_;
-  std::map<int, int> ports_;
+  pfap::testing::FreePorts free_ports_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -606,13 +532,11 @@ TEST(Rtsp, ServesAudioAndPhonemes) {
 // Every command of the section is under a heading that a test below runs, and the examples'
 // README shows no gst-launch-1.0 line of its own.
 TEST(DocumentedLines, EveryCommandIsTested) {
-  const std::string doc = read_file(source_path("docs/elements.md"));
-  const size_t start = doc.find(kSection);
-  ASSERT_NE(start, std::string::npos) << kSection;
+  const std::vector<std::string> lines = doc_section("docs/elements.md", kSection);
+  ASSERT_FALSE(lines.empty()) << kSection;
   size_t in_section = 0;
   bool in_block = false;
-  for (const std::string& line : lines_of(doc.substr(start))) {
-    if (!in_block && line.rfind("## ", 0) == 0 && line != kSection) break;  // the next section
+  for (const std::string& line : lines) {
     if (line.rfind("```", 0) == 0) in_block = !in_block;
     if (in_block && (line.rfind("gst-launch-1.0", 0) == 0 || line.rfind("build/", 0) == 0)) {
       ++in_section;
@@ -797,12 +721,10 @@ TEST(Readme, EveryCommandIsTested) {
 TEST(Readme, AlignCommandsAreTheDocumentedOnes) {
   const std::vector<std::string> readme = readme_align_commands();
   ASSERT_EQ(readme.size(), 2u);
-  const std::string doc = read_file(source_path("docs/elements.md"));
-  const size_t section = doc.find("## pfapalign");
-  ASSERT_NE(section, std::string::npos);
-  const std::string text = doc.substr(section, doc.find("\n## ", section + 1) - section);
+  const std::vector<std::string> documented = doc_section("docs/elements.md", "## pfapalign");
   for (const std::string& command : readme) {
-    EXPECT_NE(text.find("\n" + command + "\n"), std::string::npos) << command;
+    EXPECT_NE(std::find(documented.begin(), documented.end(), command), documented.end())
+        << command;
   }
 }
 
@@ -1309,26 +1231,6 @@ TEST(PlayStream, FfmpegReadingForAFixedTimeEnds) {
   EXPECT_EQ(server.stop(), 0);
 }
 
-// The commands of a "## " section's ```sh blocks in `file`: comment lines and trailing
-// comments dropped, a trailing '&' too.
-std::vector<std::string> section_commands(const std::string& file, const std::string& section) {
-  std::vector<std::string> commands;
-  bool in_section = false, in_block = false;
-  for (const std::string& line : lines_of(read_file(source_path(file)))) {
-    if (!in_block && line.rfind("## ", 0) == 0) in_section = line == section;
-    if (!in_section) continue;
-    if (line.rfind("```", 0) == 0) {
-      in_block = !in_block;
-      continue;
-    }
-    if (!in_block || line.rfind('#', 0) == 0) continue;
-    std::string c = line.substr(0, line.find(" #"));
-    while (!c.empty() && (c.back() == ' ' || c.back() == '&')) c.pop_back();
-    if (!c.empty()) commands.push_back(c);
-  }
-  return commands;
-}
-
 // The "play a stream" commands of README.md and docs/elements.md, with fake sinks: the server
 // is started, and each player plays to its end and exits.
 TEST(PlayStream, DocumentedCommandsPlayToTheirEnd) {
@@ -1337,7 +1239,7 @@ TEST(PlayStream, DocumentedCommandsPlayToTheirEnd) {
       {"README.md", "## Play a stream"}, {"docs/elements.md", "## Playing a stream"}};
   for (const auto& [file, section] : sections) {
     SCOPED_TRACE(file + ", " + section);
-    const std::vector<std::string> commands = section_commands(file, section);
+    const std::vector<std::string> commands = commands_in(doc_section(file, section));
     ASSERT_GE(commands.size(), 3u);
     std::unique_ptr<RtspServer> server;
     int players = 0;

@@ -24,6 +24,7 @@
 #include "pfap/fap_animation.h"
 #include "pfap/fap_file.h"
 #include "pfap/fap_state.h"
+#include "documented_commands.h"
 #include "pfap_buffers.h"
 #include "pipeline.h"
 #include "temp_dir.h"
@@ -31,8 +32,12 @@
 namespace {
 
 namespace fs = std::filesystem;
+using pfap::testing::doc_section;
+using pfap::testing::launch_descriptions;
 using pfap::testing::Pipeline;
 using pfap::testing::plugin_available;
+using pfap::testing::read_file;
+using pfap::testing::replace_all;
 using pfap::testing::TempDir;
 
 constexpr const char* kElements[] = {"fapparse", "pfapfapenc", "rtppfappay", "rtppfapdepay"};
@@ -56,15 +61,6 @@ std::vector<fs::path> shared_files() {
   if ((files).empty())                                \
   GTEST_SKIP() << "no .fap files in " << shared_dir() \
                << ": the real MPEG-4 FAP files live beside the project in ../shared/fap"
-
-std::string read_all(const fs::path& path) {
-  gchar* contents = nullptr;
-  gsize length = 0;
-  if (!g_file_get_contents(path.c_str(), &contents, &length, nullptr)) return "";
-  std::string text(contents, length);
-  g_free(contents);
-  return text;
-}
 
 std::vector<pfap::FapAmplitudes> amplitudes_of(const pfap::FapFile& file) {
   std::vector<pfap::FapAmplitudes> out;
@@ -91,7 +87,7 @@ TEST(FapParse, EachRealFileGivesBackEveryValueAtItsFrameTimes) {
   SKIP_WITHOUT_SHARED_FILES(files);
   for (const fs::path& path : files) {
     SCOPED_TRACE(path.filename().string());
-    const std::string bytes = read_all(path);
+    const std::string bytes = read_file(path);
     pfap::FapFile file;
     ASSERT_TRUE(pfap::read_fap_file(bytes, file).ok());
 
@@ -355,7 +351,7 @@ TEST(FapRoundTrip, WithoutLossEveryFrameComesBack) {
   SKIP_WITHOUT_SHARED_FILES(files);
   for (const fs::path& path : files) {
     SCOPED_TRACE(path.filename().string());
-    const std::string bytes = read_all(path);
+    const std::string bytes = read_file(path);
     pfap::FapFile file;
     ASSERT_TRUE(pfap::read_fap_file(bytes, file).ok());
     const RoundTrip r = round_trip(bytes, 0.0, 1);
@@ -372,7 +368,7 @@ TEST(FapRoundTrip, TenPercentLossRecoveredGivesEveryFrameTheReceiverHadWhole) {
   unsigned frames = 0, checked = 0, packets = 0, dropped = 0;
   for (const fs::path& path : files) {
     SCOPED_TRACE(path.filename().string());
-    const std::string bytes = read_all(path);
+    const std::string bytes = read_file(path);
     pfap::FapFile file;
     ASSERT_TRUE(pfap::read_fap_file(bytes, file).ok());
     const RoundTrip r = round_trip(bytes, 0.10, 2000 + static_cast<uint32_t>(frames));
@@ -506,44 +502,13 @@ TEST(PfapFapEnc, NoEventsNoFileAndAWarning) {
 // ---------------------------------------------------------------------------------------------
 // docs/elements.md, "MPEG-4 FAP files"
 
-std::string source_path(const std::string& relative) {
-  return std::string(PFAP_SOURCE_DIR) + "/" + relative;
-}
-
-std::vector<std::string> documented_commands() {
-  const std::string doc = read_all(source_path("docs/elements.md"));
-  const size_t start = doc.find("\n## MPEG-4 FAP files\n");
-  EXPECT_NE(start, std::string::npos);
-  const size_t end = doc.find("\n## ", start + 1);
-  std::vector<std::string> commands;
-  bool in_block = false;
-  size_t at = start + 1;
-  while (at < end) {
-    size_t eol = doc.find('\n', at);
-    if (eol == std::string::npos) eol = doc.size();
-    std::string line = doc.substr(at, eol - at);
-    at = eol + 1;
-    if (line.rfind("```", 0) == 0) in_block = !in_block;
-    if (!in_block || line.rfind("gst-launch-1.0 ", 0) != 0) continue;
-    line = line.substr(std::string("gst-launch-1.0 ").size());
-    if (line.rfind("-e ", 0) == 0) line = line.substr(3);
-    commands.push_back(line);
-  }
-  return commands;
-}
-
-void replace_all(std::string& s, const std::string& from, const std::string& to) {
-  for (size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size())) {
-    s.replace(at, from.size(), to);
-  }
-}
-
 TEST(FapDocumented, EveryCommandRunsToEos) {
   const auto files = shared_files();
   SKIP_WITHOUT_SHARED_FILES(files);
   const char* used[] = {"fapparse", "pfapfapenc", "pfaptts", "pfapface", "netsim"};
   ASSERT_TRUE(plugin_available(used));
-  const std::vector<std::string> commands = documented_commands();
+  const std::vector<std::string> commands =
+      launch_descriptions(doc_section("docs/elements.md", "## MPEG-4 FAP files"));
   ASSERT_EQ(commands.size(), 4u);
   TempDir dir;
   for (std::string command : commands) {
@@ -561,7 +526,7 @@ TEST(FapDocumented, EveryCommandRunsToEos) {
   for (const char* name : {"hello.fap", "joy-again.fap"}) {
     SCOPED_TRACE(name);
     pfap::FapFile file;
-    const pfap::FapFileResult result = pfap::read_fap_file(read_all(dir.file(name)), file);
+    const pfap::FapFileResult result = pfap::read_fap_file(read_file(dir.file(name)), file);
     EXPECT_TRUE(result.ok()) << pfap::describe(result);
     EXPECT_GT(file.frames.size(), 10u);
   }

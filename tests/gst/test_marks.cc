@@ -6,38 +6,30 @@
 
 #include <array>
 #include <chrono>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include "../common/temp_dir.h"
 #include "pfap/markup.h"
 #include "pfap/markup_event.h"
+#include "documented_commands.h"
 #include "pfap_buffers.h"
 #include "pipeline.h"
+#include "temp_dir.h"
 
 namespace {
 
 using namespace std::chrono_literals;
 using pfap::Phoneme;
 using pfap::testing::Pipeline;
+using pfap::testing::read_file;
+using pfap::testing::replace_all;
+using pfap::testing::source_path;
 using pfap::testing::TempDir;
 
 constexpr GstClockTime kMs = GST_MSECOND;
 constexpr std::array<const char*, 5> kElements{"pfapmarksenc", "pfapmarksparse", "pfapparse",
                                                "rtppfappay", "pfapface"};
-
-std::string read_file(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  std::ostringstream text;
-  text << file.rdbuf();
-  return text.str();
-}
-
-std::string source_path(const std::string& relative) {
-  return std::string(PFAP_SOURCE_DIR) + "/" + relative;
-}
 
 // The text of every buffer the harness holds, in order.
 std::string pull_text(GstHarness* h) {
@@ -268,39 +260,15 @@ TEST_F(MarksParse, RhubarbJsonIsReadWholeAtEos) {
 
 constexpr const char* kSection = "## Speech marks: avatars' vocabularies in and out";
 
-std::vector<std::string> documented_commands() {
-  std::istringstream doc(read_file(source_path("docs/elements.md")));
-  std::vector<std::string> commands;
-  bool in_section = false, in_block = false;
-  std::string line;
-  while (std::getline(doc, line)) {
-    if (!in_block && line.rfind("## ", 0) == 0) in_section = line == kSection;
-    if (!in_section) continue;
-    if (line.rfind("```", 0) == 0) {
-      in_block = !in_block;
-      continue;
-    }
-    if (in_block && !line.empty() && line[0] != '#') commands.push_back(line);
-  }
-  return commands;
-}
-
-void replace_all(std::string& s, const std::string& from, const std::string& to) {
-  for (size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size())) {
-    s.replace(at, from.size(), to);
-  }
-}
-
 TEST(DocumentedMarks, EveryCommandGivesTheExampleFile) {
   ASSERT_TRUE(pfap::testing::plugin_available(kElements));
-  const std::vector<std::string> commands = documented_commands();
+  const std::vector<std::string> commands =
+      pfap::testing::launch_descriptions(pfap::testing::doc_section("docs/elements.md", kSection));
   ASSERT_EQ(commands.size(), 10u);
   TempDir dir;
   int compared = 0;
   for (std::string command : commands) {
     SCOPED_TRACE(command);
-    ASSERT_EQ(command.rfind("gst-launch-1.0 ", 0), 0u);
-    command.erase(0, std::string("gst-launch-1.0 ").size());
     replace_all(command, "docs/examples/", source_path("docs/examples/"));
     replace_all(command, "autovideosink", "fakesink name=video");
     // The output file, to a temporary one of the same name.

@@ -17,6 +17,7 @@
 #include <tuple>
 #include <vector>
 
+#include "documented_commands.h"
 #include "markupbuffer.h"
 #include "pipeline.h"
 #include "recognizer.h"
@@ -320,36 +321,21 @@ TEST(PfapAlign, WaitForTheTextsEosEndsWithTheStream) {
 // The launch lines of docs/elements.md's pfapalign section, each run on a WAV pfaptts makes;
 // the live one (live=true, RTP in and out) is run by test_pfapalign_live.
 std::vector<std::string> documented_commands() {
-  std::ifstream in(PFAP_SOURCE_DIR "/docs/elements.md");
-  std::stringstream all;
-  all << in.rdbuf();
-  const std::string doc = all.str();
-  const size_t from = doc.find("## pfapalign");
-  const size_t to = doc.find("\n## ", from + 1);
-  std::istringstream section(doc.substr(from, to - from));
   std::vector<std::string> out;
-  for (std::string line; std::getline(section, line);) {
-    if (line.starts_with("gst-launch-1.0 ") && line.find(" live=true ") == std::string::npos) {
-      out.push_back(line);
-    }
+  for (std::string& d : pfap::testing::launch_descriptions(
+           pfap::testing::doc_section("docs/elements.md", "## pfapalign"))) {
+    if (d.find(" live=true ") == std::string::npos) out.push_back(std::move(d));
   }
   return out;
 }
 
-std::string replace_all(std::string s, const std::string& from, const std::string& to) {
-  for (size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size())) {
-    s.replace(at, from.size(), to);
-  }
-  return s;
-}
-
-std::string run_line(const std::string& line, const pfap::testing::TempDir& dir) {
-  std::string d = line.substr(std::string("gst-launch-1.0 ").size());
-  if (d.starts_with("-e ")) d = d.substr(3);
+// `description` run to its end with its files in `dir`: "" or what went wrong.
+std::string run_line(std::string description, const pfap::testing::TempDir& dir) {
   for (const char* f : {"speech.wav", "speech.txt", "speech.pfap", "face.webm"}) {
-    d = replace_all(d, std::string("location=") + f, "location=" + dir.file(f));
+    pfap::testing::replace_all(description, std::string("location=") + f,
+                               "location=" + dir.file(f));
   }
-  pfap::testing::Pipeline p(d);
+  pfap::testing::Pipeline p(description);
   if (!p.ok()) return p.error();
   std::string e = p.set_state(GST_STATE_PLAYING);
   if (e.empty()) e = p.wait_eos(std::chrono::seconds(60));

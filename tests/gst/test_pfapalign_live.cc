@@ -12,15 +12,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
-#include <map>
 #include <mutex>
-#include <regex>
-#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "documented_commands.h"
 #include "markupbuffer.h"
 #include "pipeline.h"
 #include "speech.h"
@@ -299,58 +296,34 @@ TEST(PfapAlignLive, UtterancesOnTheTextPadStartAtTheirPts) {
   gst_harness_teardown(h);
 }
 
-// The live line of docs/elements.md's pfapalign section, its ports made free ones.
+// The live line of docs/elements.md's pfapalign section, as a pipeline description.
 std::string documented_live_line() {
-  std::ifstream in(PFAP_SOURCE_DIR "/docs/elements.md");
-  std::stringstream all;
-  all << in.rdbuf();
-  const std::string doc = all.str();
-  const size_t from = doc.find("## pfapalign");
-  const size_t to = doc.find("\n## ", from + 1);
-  std::istringstream section(doc.substr(from, to - from));
   std::string found;
-  for (std::string line; std::getline(section, line);) {
-    if (line.starts_with("gst-launch-1.0 ") && line.find(" live=true ") != std::string::npos) {
-      EXPECT_TRUE(found.empty()) << "one live line";
-      found = line.substr(std::string("gst-launch-1.0 ").size());
-    }
+  for (std::string& d : pfap::testing::launch_descriptions(
+           pfap::testing::doc_section("docs/elements.md", "## pfapalign"))) {
+    if (d.find(" live=true ") == std::string::npos) continue;
+    EXPECT_TRUE(found.empty()) << "one live line";
+    found = std::move(d);
   }
   return found;
-}
-
-// `port=N` made `port=` the free port that `ports` maps N to.
-std::string with_ports(const std::string& line, std::map<int, int>& ports) {
-  static const std::regex port("port=([0-9]+)");
-  std::string out;
-  auto last = line.cbegin();
-  for (std::sregex_iterator it(line.begin(), line.end(), port), end; it != end; ++it) {
-    out.append(last, (*it)[0].first);
-    const int documented = std::stoi((*it)[1].str());
-    if (!ports.contains(documented)) ports[documented] = pfap::testing::free_udp_ports(1).at(0);
-    out += "port=" + std::to_string(ports[documented]);
-    last = (*it)[0].second;
-  }
-  out.append(last, line.cend());
-  return out;
 }
 
 TEST(PfapAlignLive, DocumentedRtpLineRuns) {
   const std::string line = documented_live_line();
   ASSERT_FALSE(line.empty());
-  std::map<int, int> ports;
-  pfap::testing::Pipeline aligner(with_ports(line, ports));
+  pfap::testing::FreePorts free_ports;
+  pfap::testing::Pipeline aligner(free_ports(line));
   ASSERT_TRUE(aligner.ok()) << aligner.error();
   // The receiver of "Next to audio", at the audio's 16 kHz; phonemes counted as they come.
   pfap::testing::Pipeline receiver(
-      with_ports("rtpbin name=r "
+      free_ports("rtpbin name=r "
                  "udpsrc address=127.0.0.1 port=5000 caps=\"application/x-rtp,media=audio,"
                  "clock-rate=16000,encoding-name=L16,channels=1,payload=96\" ! r.recv_rtp_sink_0 "
                  "udpsrc address=127.0.0.1 port=5001 ! r.recv_rtcp_sink_0 "
                  "udpsrc address=127.0.0.1 port=5002 caps=\"application/x-rtp,media=application,"
                  "clock-rate=44100,encoding-name=PFAP,payload=97\" ! r.recv_rtp_sink_1 "
                  "udpsrc address=127.0.0.1 port=5003 ! r.recv_rtcp_sink_1 "
-                 "r. ! rtpL16depay ! fakesink r. ! rtppfapdepay ! pfaptextenc name=d ! fakesink",
-                 ports));
+                 "r. ! rtpL16depay ! fakesink r. ! rtppfapdepay ! pfaptextenc name=d ! fakesink"));
   ASSERT_TRUE(receiver.ok()) << receiver.error();
   // The speech sent in real time as RTP L16 at 16 kHz to the line's port 5004.
   const pfap::testing::TempDir dir;
@@ -362,11 +335,10 @@ TEST(PfapAlignLive, DocumentedRtpLineRuns) {
     ASSERT_EQ(make.set_state(GST_STATE_PLAYING), "");
     ASSERT_EQ(make.wait_eos(30s), "");
   }
-  pfap::testing::Pipeline sender(with_ports(
+  pfap::testing::Pipeline sender(free_ports(
       "filesrc location=" + dir.file("speech.wav") +
           " ! wavparse ! audioconvert ! audioresample ! audio/x-raw,rate=16000,channels=1 ! "
-          "rtpL16pay pt=96 ! udpsink host=127.0.0.1 port=5004",
-      ports));
+          "rtpL16pay pt=96 ! udpsink host=127.0.0.1 port=5004"));
   ASSERT_TRUE(sender.ok()) << sender.error();
 
   std::atomic<int> phonemes{0};  // lines of pfaptextenc: one a phoneme

@@ -28,6 +28,7 @@
 #include "pfap/markup_event.h"
 #include "pfap/phoneme_table.h"
 #include "glib_log.h"
+#include "documented_commands.h"
 #include "pfap_buffers.h"
 #include "pipeline.h"
 #include "release_fonts.h"
@@ -39,16 +40,17 @@ using pfap::Curve;
 using pfap::Fap;
 using pfap::MarkupEvent;
 using pfap::Phoneme;
+using pfap::testing::doc_section;
+using pfap::testing::launch_descriptions;
 using pfap::testing::markup_buffer;
 using pfap::testing::Pipeline;
+using pfap::testing::read_file;
+using pfap::testing::replace_all;
+using pfap::testing::source_path;
 using pfap::testing::TempDir;
 
 constexpr GstClockTime kMs = GST_MSECOND;
 constexpr const char* kSmallCaps = "video/x-raw,format=BGRx,width=160,height=120,framerate=25/1";
-
-std::string source_path(const std::string& relative) {
-  return std::string(PFAP_SOURCE_DIR) + "/" + relative;
-}
 
 uint8_t symbol(const char* name) {
   return *pfap::find_symbol(*pfap::find_alphabet(pfap::kArpabetAlphabet), name);
@@ -727,43 +729,9 @@ TEST(PfapFaceGolden, ReferencesDiffer) {
 // ---------------------------------------------------------------------------------------------
 // The commands of docs/elements.md, "pfapface"
 
-std::string read_text(const std::string& path) {
-  gchar* contents = nullptr;
-  gsize length = 0;
-  if (!g_file_get_contents(path.c_str(), &contents, &length, nullptr)) return "";
-  std::string text(contents, length);
-  g_free(contents);
-  return text;
-}
-
-// The gst-launch-1.0 lines of the section's ```sh blocks, without the program and -e.
+// The gst-launch-1.0 lines of docs/elements.md's pfapface section, as pipeline descriptions.
 std::vector<std::string> documented_commands() {
-  const std::string doc = read_text(source_path("docs/elements.md"));
-  const size_t start = doc.find("\n## pfapface\n");
-  EXPECT_NE(start, std::string::npos);
-  const size_t end = doc.find("\n## ", start + 1);
-  std::vector<std::string> commands;
-  bool in_block = false;
-  size_t at = start + 1;
-  while (at < end) {
-    size_t eol = doc.find('\n', at);
-    if (eol == std::string::npos) eol = doc.size();
-    std::string line = doc.substr(at, eol - at);
-    at = eol + 1;
-    if (line.rfind("```", 0) == 0) in_block = !in_block;
-    if (!in_block) continue;
-    for (const char* prefix : {"gst-launch-1.0 ", "-e "}) {
-      if (line.rfind(prefix, 0) == 0) line = line.substr(std::string(prefix).size());
-    }
-    if (line.rfind("filesrc", 0) == 0 || line.rfind("udpsrc", 0) == 0) commands.push_back(line);
-  }
-  return commands;
-}
-
-void replace_all(std::string& s, const std::string& from, const std::string& to) {
-  for (size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size())) {
-    s.replace(at, from.size(), to);
-  }
+  return launch_descriptions(doc_section("docs/elements.md", "## pfapface"));
 }
 
 // A documented command made runnable here: the source tree's examples, output files in
@@ -793,7 +761,7 @@ TEST(PfapFaceDocumented, FilesRenderToTheEnd) {
     }
     EXPECT_EQ(p.wait_eos(std::chrono::seconds(60), true), "") << commands[i];
     if (commands[i].find("face.webm") != std::string::npos) {
-      EXPECT_GT(read_text(dir.file("face.webm")).size(), 10000u);
+      EXPECT_GT(read_file(dir.file("face.webm")).size(), 10000u);
     }
     if (commands[i].find("pngenc") != std::string::npos) {
       EXPECT_EQ(dir.count(), 59) << "hello.pfap: its smile fades until 2.33 s";

@@ -8,11 +8,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "documented_commands.h"
 
 namespace {
 
@@ -166,20 +167,17 @@ std::string registry_reference() {
   return out.str();
 }
 
-// The text block under kSection in docs/elements.md.
+// The first fenced block under kSection in docs/elements.md.
 std::string documented_reference() {
-  std::ifstream file(std::string(PFAP_SOURCE_DIR) + "/docs/elements.md");
-  std::string line, block;
-  bool in_section = false, in_block = false;
-  while (std::getline(file, line)) {
-    if (line.starts_with("## ")) in_section = line == kSection;
-    if (!in_section) continue;
+  std::string block;
+  bool in_block = false;
+  for (const std::string& line : pfap::testing::doc_section("docs/elements.md", kSection)) {
     if (line.starts_with("```")) {
       if (in_block) return block;
       in_block = true;
-      continue;
+    } else if (in_block) {
+      block += line + "\n";
     }
-    if (in_block) block += line + "\n";
   }
   return "";
 }

@@ -8,6 +8,9 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <map>
+#include <regex>
+#include <string>
 #include <vector>
 
 namespace pfap::testing {
@@ -36,5 +39,32 @@ inline std::vector<int> free_udp_ports(size_t n) {
   for (int fd : sockets) close(fd);
   return ports;
 }
+
+// Documented ports made free ones: each `port=N` of a line becomes `port=` a free port, the
+// same documented port always the same free one, so that the lines of a session still meet.
+class FreePorts {
+ public:
+  std::string operator()(const std::string& line) {
+    static const std::regex port("port=([0-9]+)");
+    std::string out;
+    auto last = line.cbegin();
+    for (std::sregex_iterator it(line.begin(), line.end(), port), end; it != end; ++it) {
+      out.append(last, (*it)[0].first);
+      out += "port=" + std::to_string(free_port(std::stoi((*it)[1].str())));
+      last = (*it)[0].second;
+    }
+    out.append(last, line.cend());
+    return out;
+  }
+
+ private:
+  int free_port(int documented) {
+    if (auto it = ports_.find(documented); it != ports_.end()) return it->second;
+    const std::vector<int> free = free_udp_ports(1);
+    return ports_[documented] = free.empty() ? documented : free[0];
+  }
+
+  std::map<int, int> ports_;
+};
 
 }  // namespace pfap::testing
