@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "speech.h"
+#include "streaming.h"  // kLookaheadMs, kHoldMs, kStepMs: the live bound, one for both modes
 
 namespace pfap::align {
 
@@ -50,5 +51,70 @@ bool recognition_available();
 // model loads in 0.3 s, and pocketsphinx 5prealpha leaks part of each decoder it frees); two
 // threads recognizing at one rate take turns.
 bool recognize(std::span<const int16_t> audio, unsigned rate, Recognition& out, std::string& error);
+
+struct LiveDecoder;  // a pocketsphinx decoder of the live pool (recognizer.cc)
+
+// Recognition as the audio comes, for live sources (pfapalign live=true without a text): the
+// audio goes to pocketsphinx as it arrives, and after every kStepMs of it the best path so far
+// is traced back; a phone is settled, and given out, once it ends at least kLookaheadMs before
+// the newest audio, and a phone still going on kLookaheadMs + kHoldMs before it is given out
+// in pieces, as StreamingAligner does: the same bound, so the same declared latency
+// (kLiveLatencyMs). pocketsphinx's utterance restarts at a pause once it is kRestartMs long
+// (its history grows with it). docs/align.md, "Live without the text".
+class StreamingRecognizer {
+ public:
+  StreamingRecognizer() = default;
+  StreamingRecognizer(const StreamingRecognizer&) = delete;
+  StreamingRecognizer& operator=(const StreamingRecognizer&) = delete;
+  ~StreamingRecognizer();
+
+  // Starts recognizing audio (mono, `rate` Hz). False with `error` when the model cannot be
+  // loaded or the build has no recognizer; a rate outside kMinRate..kMaxRate is problem()
+  // kBadRate at once, and the audio one pause, in pieces as it comes.
+  bool start(unsigned rate, std::string& error);
+
+  // Takes the next samples; appends to `out` the phonemes (or pieces) now settled, starts
+  // counted from the first sample, contiguous with those given before.
+  void push(std::span<const int16_t> samples, std::vector<tts::SpokenPhoneme>& out);
+
+  // The audio has ended: appends every phoneme left, the last ending at the last sample (end
+  // of text on it); problem() then also says when nothing was heard.
+  void finish(std::vector<tts::SpokenPhoneme>& out);
+
+  RecognitionProblem problem() const { return problem_; }
+  size_t samples() const { return first_ + audio_.size(); }  // pushed so far
+  size_t settled() const { return settled_; }                // given out so far
+
+ private:
+  // A phone of the best path, in samples from the first pushed.
+  struct Segment {
+    uint8_t symbol;
+    size_t start, end;
+  };
+  std::vector<Segment> best_path() const;
+  void release();  // gives the decoder back
+  void step(bool at_end, std::vector<tts::SpokenPhoneme>& out);
+  // Ends pocketsphinx's utterance and gives out its final path to the newest sample; starts
+  // the next unless `at_end`.
+  void end_utterance(bool at_end, std::vector<tts::SpokenPhoneme>& out);
+  // Gives out `symbol` over [settled_, to); `whole` ends the phoneme, else it is a piece.
+  void emit(uint8_t symbol, size_t to, bool whole, bool end_of_text,
+            std::vector<tts::SpokenPhoneme>& out);
+
+  unsigned rate_ = 0;
+  RecognitionProblem problem_ = RecognitionProblem::kNone;
+  LiveDecoder* decoder_ = nullptr;
+  bool in_utterance_ = false;   // pocketsphinx's
+  std::vector<int16_t> audio_;  // from sample first_: what f0 of the pieces to come needs
+  size_t first_ = 0;            // the sample audio_ starts at
+  size_t utterance_from_ = 0;   // pocketsphinx's utterance's first sample
+  size_t settled_ = 0;
+  size_t last_step_ = 0;
+  float loudest_db_ = -100;
+  uint8_t last_symbol_ = 0;  // of the phoneme given out last
+  bool piece_open_ = false;  // that phoneme was a piece: its rest continues it
+  bool any_speech_ = false;  // a phone other than a pause was given out
+  bool any_out_ = false;
+};
 
 }  // namespace pfap::align

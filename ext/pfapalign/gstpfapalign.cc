@@ -32,7 +32,7 @@
  *
  * The phonemes come when the audio ends (EOS, a new segment or sample rate), after the text
  * pad's EOS; with #GstPfapAlign:live, for live sources, as the audio comes, each within the
- * latency the element declares (docs/align.md, "Live"). Silence, noise, a text that does not
+ * latency the element declares (docs/align.md, "Live"), with a text or without. Silence, noise, a text that does not
  * match, an empty text or none, bad bookmarks and
  * unsupported rates each give a warning (rate-limited), and the stream goes on: an utterance
  * that cannot be aligned is one pause carrying its bookmarks.
@@ -107,10 +107,12 @@ struct Stream {
   // Live: upstream is live, and the phonemes go out as the audio comes (live_* below).
   bool live = false;
   pfap::align::StreamingAligner aligner;
-  bool utterance_open = false;     // the aligner has an utterance
-  bool utterance_is_text = false;  // from a text, not the audio before the first
-  size_t utterance_from = 0;       // its first sample, counted from `first`
-  size_t live_samples = 0;         // samples since `first`
+  pfap::align::StreamingRecognizer recognizer;  // without a text
+  bool utterance_open = false;                  // the aligner (or the recognizer) has an utterance
+  bool recognizing = false;                     // the open utterance is the recognizer's
+  bool utterance_is_text = false;               // from a text, not the audio before the first
+  size_t utterance_from = 0;                    // its first sample, counted from `first`
+  size_t live_samples = 0;                      // samples since `first`
 
   std::mutex lock;  // guards what follows, shared with the text pad's thread
   std::condition_variable text_changed;
@@ -217,6 +219,28 @@ static GstFlowReturn push_phonemes(GstPfapAlign* self,
   return ret;
 }
 
+// Without a text, where the build has no recognizer: a warning (the audio is one pause).
+static void warn_cannot_recognize(GstPfapAlign* self) {
+  GST_ELEMENT_WARNING(self, STREAM, DECODE,
+                      ("No text for the audio, and this build cannot recognize phonemes "
+                       "without it: the audio is one pause"),
+                      ("set the text property or link text_sink; the text-free mode needs "
+                       "pocketsphinx (meson feature `recognition`)"));
+}
+
+// What was wrong with the recognition of the audio from `at`, if anything (rate-limited).
+static void warn_recognition_problem(GstPfapAlign* self, pfap::align::RecognitionProblem problem,
+                                     GstClockTime at) {
+  Stream& s = *self->stream;
+  if (problem == pfap::align::RecognitionProblem::kNone) return;
+  const auto k = static_cast<size_t>(problem);
+  if (!pfap_warn_at(++s.recognition_problems[k])) return;
+  GST_ELEMENT_WARNING(self, STREAM, DECODE,
+                      ("Audio at %" GST_TIME_FORMAT " without text: %s", GST_TIME_ARGS(at),
+                       pfap::align::problem_text(problem)),
+                      ("%" G_GUINT64_FORMAT " so far", s.recognition_problems[k]));
+}
+
 // Without a text: the phonemes of all the audio kept recognized from it alone (the
 // `recognition` build), or one pause with a warning where the build cannot.
 static GstFlowReturn recognize_kept(GstPfapAlign* self) {
@@ -229,19 +253,9 @@ static GstFlowReturn recognize_kept(GstPfapAlign* self) {
       GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));
       return GST_FLOW_ERROR;
     }
-    GST_ELEMENT_WARNING(self, STREAM, DECODE,
-                        ("No text for the audio, and this build cannot recognize phonemes "
-                         "without it: the audio is one pause"),
-                        ("set the text property or link text_sink; the text-free mode needs "
-                         "pocketsphinx (meson feature `recognition`)"));
-  } else if (recognition.problem != pfap::align::RecognitionProblem::kNone) {
-    const auto problem = static_cast<size_t>(recognition.problem);
-    if (pfap_warn_at(++s.recognition_problems[problem])) {
-      GST_ELEMENT_WARNING(self, STREAM, DECODE,
-                          ("Audio at %" GST_TIME_FORMAT " without text: %s", GST_TIME_ARGS(s.first),
-                           pfap::align::problem_text(recognition.problem)),
-                          ("%" G_GUINT64_FORMAT " so far", s.recognition_problems[problem]));
-    }
+    warn_cannot_recognize(self);
+  } else {
+    warn_recognition_problem(self, recognition.problem, s.first);
   }
   return push_phonemes(self, recognition.phonemes, 0);
 }
@@ -394,7 +408,8 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
 // Live (#GstPfapAlign:live): the phonemes go out as the audio comes, by align/streaming.h;
 // docs/align.md, "Live". One utterance is open at a time: the text property's, each text
 // buffer's from its PTS (or from its arrival when it has none or comes late), or a pause for
-// the audio before the first.
+// the audio before the first; without any text, the recognizer's (align/recognizer.h) over
+// the whole stream.
 
 static GstFlowReturn live_push(GstPfapAlign* self,
                                const std::vector<pfap::tts::SpokenPhoneme>& phonemes) {
@@ -407,7 +422,13 @@ static GstFlowReturn live_end_utterance(GstPfapAlign* self) {
   if (!s.utterance_open) return GST_FLOW_OK;
   s.utterance_open = false;
   std::vector<pfap::tts::SpokenPhoneme> phonemes;
-  s.aligner.finish(phonemes);
+  if (s.recognizing) {
+    s.recognizer.finish(phonemes);
+    const GstClockTime at = s.first + gst_util_uint64_scale(s.utterance_from, GST_SECOND, s.rate);
+    warn_recognition_problem(self, s.recognizer.problem(), at);
+  } else {
+    s.aligner.finish(phonemes);
+  }
   return live_push(self, phonemes);
 }
 
@@ -429,6 +450,21 @@ static GstFlowReturn live_start_utterance(GstPfapAlign* self, const std::string&
   if (is_text) warn_problem(self, s.aligner.problem(), at, 0);
   warn_inexact(self, s.aligner.inexact(), voice);
   s.utterance_open = true;
+  s.recognizing = false;
+  s.utterance_from = s.live_samples;
+  return GST_FLOW_OK;
+}
+
+// Without a text: the recognizer's utterance from the audio so far, to the stream's end.
+static GstFlowReturn live_start_recognition(GstPfapAlign* self) {
+  Stream& s = *self->stream;
+  std::string error;
+  if (!s.recognizer.start(s.rate, error)) {  // the model is missing
+    GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));
+    return GST_FLOW_ERROR;
+  }
+  s.utterance_open = true;
+  s.recognizing = true;
   s.utterance_from = s.live_samples;
   return GST_FLOW_OK;
 }
@@ -437,7 +473,11 @@ static GstFlowReturn live_start_utterance(GstPfapAlign* self, const std::string&
 static GstFlowReturn live_feed(GstPfapAlign* self, std::span<const int16_t> samples) {
   Stream& s = *self->stream;
   std::vector<pfap::tts::SpokenPhoneme> phonemes;
-  s.aligner.push(samples, phonemes);
+  if (s.recognizing) {
+    s.recognizer.push(samples, phonemes);
+  } else {
+    s.aligner.push(samples, phonemes);
+  }
   s.live_samples += samples.size();
   return live_push(self, phonemes);
 }
@@ -486,12 +526,12 @@ static GstFlowReturn live_chain(GstPfapAlign* self, GstBuffer* buffer) {
     const std::string property = has_property ? self->text : "";
     GST_OBJECT_UNLOCK(self);
     const bool from_pad = gst_pad_is_linked(self->textpad);
-    if (!from_pad && !has_property) {
-      GST_ELEMENT_WARNING(self, STREAM, DECODE, ("No text for the audio: it is one pause"),
-                          ("set the text property or link text_sink; recognition without the "
-                           "text is not live"));
+    if (!from_pad && !has_property && pfap::align::recognition_available()) {
+      ret = live_start_recognition(self);
+    } else {
+      if (!from_pad && !has_property) warn_cannot_recognize(self);
+      ret = live_start_utterance(self, from_pad ? "" : property, !from_pad && has_property);
     }
-    ret = live_start_utterance(self, from_pad ? "" : property, !from_pad && has_property);
   }
   size_t done = 0;
   for (auto& [from, bytes] : live_take_texts(self, s.live_samples + samples.size())) {
@@ -856,16 +896,17 @@ static void gst_pfap_align_class_init(GstPfapAlignClass* klass) {
   /**
    * GstPfapAlign:live:
    *
-   * Aligns as the audio comes, for live sources: each phoneme goes out by the time 350 ms
-   * (and one upstream buffer) more than its start has come, and the LATENCY query says
-   * 400 ms more than upstream's (docs/align.md, "Live"). Off: the phonemes come when the
-   * audio ends, aligned on it whole. Read when the element goes to PAUSED.
+   * Aligns (or, without a text, recognizes) as the audio comes, for live sources: each
+   * phoneme goes out by the time 350 ms (and one upstream buffer) more than its start has
+   * come, and the LATENCY query says 400 ms more than upstream's (docs/align.md, "Live" and
+   * "Live without the text"). Off: the phonemes come when the audio ends, aligned on it
+   * whole. Read when the element goes to PAUSED.
    */
   g_object_class_install_property(
       gobject_class, PROP_LIVE,
       g_param_spec_boolean("live", "Live",
-                           "Align as the audio comes, each phoneme out within 400 ms (the "
-                           "latency it declares), instead of when the audio ends",
+                           "Align (or recognize) as the audio comes, each phoneme out within "
+                           "400 ms (the latency it declares), instead of when the audio ends",
                            FALSE, kReady));
 
   gst_element_class_add_static_pad_template(element_class, &sink_template);

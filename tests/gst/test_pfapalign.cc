@@ -58,8 +58,13 @@ pfap::tts::Speech say(const std::string& text, int rate = 140, int pitch = 30) {
 // (nullptr: none), or, when `texts` is not empty, with those (PTS, text) buffers on text_sink.
 Result run(const std::vector<int16_t>& samples, unsigned rate, const char* text,
            const std::vector<std::pair<GstClockTime, std::string>>& texts = {},
-           const char* voice = "en") {
+           const char* voice = "en", bool live = false) {
   GstHarness* h = gst_harness_new_with_padnames("pfapalign", "sink", "src");
+  if (live) {  // read when the element goes to PAUSED
+    gst_element_set_state(h->element, GST_STATE_READY);
+    g_object_set(h->element, "live", TRUE, nullptr);
+    gst_element_set_state(h->element, GST_STATE_PLAYING);
+  }
   GstHarness* pfap = gst_harness_new_with_element(h->element, nullptr, "pfap");
   GstHarness* t =
       texts.empty() ? nullptr : gst_harness_new_with_element(h->element, "text_sink", nullptr);
@@ -259,6 +264,35 @@ TEST(PfapAlign, WithoutTextBadInputWarnsAndIsOnePause) {
     EXPECT_EQ(r.audio, audio);
     ASSERT_EQ(r.events.size(), 1u) << warning;
     EXPECT_EQ(r.events[0].event.phoneme.symbol, 0);
+    expect_tiles(r, gst_util_uint64_scale(audio.size(), GST_SECOND, rate));
+  }
+}
+
+// The same live: silence and a bad rate warn when the audio ends, the audio passes unchanged
+// and its phonemes are pauses, given out in pieces as it came. Loud noise is heard as an HH
+// live (docs/align.md, "Live without the text"): the audio passes, its phonemes tile it.
+TEST(PfapAlign, WithoutTextLiveBadInputWarnsAndIsPauses) {
+  if (!pfap::align::recognition_available()) GTEST_SKIP() << "no recognizer in this build";
+  const std::vector<int16_t> silence(32000, 0);
+  std::vector<int16_t> noise(32000);
+  uint32_t x = 1;
+  for (int16_t& v : noise) {
+    x = x * 1664525 + 1013904223;
+    v = static_cast<int16_t>(static_cast<int>((x >> 16) % 16000) - 8000);
+  }
+  const std::vector<std::tuple<std::vector<int16_t>, unsigned, const char*>> cases{
+      {silence, 16000, "silent"},
+      {noise, 8000, "8000 Hz cannot be aligned"},
+  };
+  const Result heard = run(noise, 16000, nullptr, {}, "en", true);
+  EXPECT_EQ(heard.audio, noise);
+  expect_tiles(heard, gst_util_uint64_scale(noise.size(), GST_SECOND, 16000));
+  for (const auto& [audio, rate, warning] : cases) {
+    const Result r = run(audio, rate, nullptr, {}, "en", true);
+    EXPECT_TRUE(has_warning(r, warning)) << warning;
+    EXPECT_EQ(r.audio, audio);
+    EXPECT_GT(r.events.size(), 1u) << warning << ": in pieces";
+    for (const Event& e : r.events) EXPECT_EQ(e.event.phoneme.symbol, 0) << warning;
     expect_tiles(r, gst_util_uint64_scale(audio.size(), GST_SECOND, rate));
   }
 }

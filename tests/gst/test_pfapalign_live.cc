@@ -20,6 +20,7 @@
 #include "documented_commands.h"
 #include "markupbuffer.h"
 #include "pipeline.h"
+#include "recognizer.h"
 #include "speech.h"
 #include "streaming.h"
 #include "temp_dir.h"
@@ -102,6 +103,34 @@ GstClockTime latency_of(GstElement* element_or_pipeline, GstPad* pad = nullptr) 
   return min;
 }
 
+// Pushes `audio` on the live appsrc `src` in kBlock buffers, each once the clock has passed its
+// end, as a capture device gives it.
+void push_in_real_time(GstElement* pipeline, GstElement* src, const std::vector<int16_t>& audio,
+                       unsigned rate) {
+  GstClock* clock = nullptr;
+  for (auto waited = 0ms; clock == nullptr && waited < 10s; waited += 10ms) {
+    clock = gst_element_get_clock(pipeline);
+    if (clock == nullptr) std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_NE(clock, nullptr);
+  const size_t block = static_cast<size_t>(gst_util_uint64_scale(kBlock, rate, GST_SECOND));
+  for (size_t i = 0; i < audio.size(); i += block) {
+    const size_t n = std::min(block, audio.size() - i);
+    GstBuffer* b = gst_buffer_new_memdup(audio.data() + i, n * 2);
+    GST_BUFFER_PTS(b) = gst_util_uint64_scale(i, GST_SECOND, rate);
+    GST_BUFFER_DURATION(b) = gst_util_uint64_scale(i + n, GST_SECOND, rate) - GST_BUFFER_PTS(b);
+    const GstClockTime due =
+        gst_element_get_base_time(pipeline) + GST_BUFFER_PTS(b) + GST_BUFFER_DURATION(b);
+    while (gst_clock_get_time(clock) < due) std::this_thread::sleep_for(2ms);
+    GstFlowReturn ret = GST_FLOW_OK;
+    g_signal_emit_by_name(src, "push-buffer", b, &ret);
+    gst_buffer_unref(b);
+    if (ret != GST_FLOW_OK) gst_object_unref(clock);
+    ASSERT_EQ(ret, GST_FLOW_OK);
+  }
+  gst_object_unref(clock);
+}
+
 TEST(PfapAlignLive, DeclaresItsLatencyAndKeepsThePhonemesInSyncWithinIt) {
   // 400 ms of silence, the utterance, 300 ms of silence.
   const pfap::tts::Speech truth = say(kText, 130, 25);
@@ -125,28 +154,8 @@ TEST(PfapAlignLive, DeclaresItsLatencyAndKeepsThePhonemesInSyncWithinIt) {
   probe(align, "pfap", Probes::on_pfap, &probes);
   ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
 
-  // Each block pushed once the clock has passed its end, as a capture device gives it.
-  GstClock* clock = nullptr;
-  for (auto waited = 0ms; clock == nullptr && waited < 10s; waited += 10ms) {
-    clock = gst_element_get_clock(p.get());
-    if (clock == nullptr) std::this_thread::sleep_for(10ms);
-  }
-  ASSERT_NE(clock, nullptr);
-  const size_t block = static_cast<size_t>(gst_util_uint64_scale(kBlock, rate, GST_SECOND));
-  for (size_t i = 0; i < audio.size(); i += block) {
-    const size_t n = std::min(block, audio.size() - i);
-    GstBuffer* b = gst_buffer_new_memdup(audio.data() + i, n * 2);
-    GST_BUFFER_PTS(b) = gst_util_uint64_scale(i, GST_SECOND, rate);
-    GST_BUFFER_DURATION(b) = gst_util_uint64_scale(i + n, GST_SECOND, rate) - GST_BUFFER_PTS(b);
-    const GstClockTime due =
-        gst_element_get_base_time(p.get()) + GST_BUFFER_PTS(b) + GST_BUFFER_DURATION(b);
-    while (gst_clock_get_time(clock) < due) std::this_thread::sleep_for(2ms);
-    GstFlowReturn ret = GST_FLOW_OK;
-    g_signal_emit_by_name(src, "push-buffer", b, &ret);
-    gst_buffer_unref(b);
-    ASSERT_EQ(ret, GST_FLOW_OK);
-  }
-  gst_object_unref(clock);
+  push_in_real_time(p.get(), src, audio, rate);
+  if (::testing::Test::HasFatalFailure()) return;
 
   // The latency: appsrc's 20 ms and pfapalign's stated kLiveLatencyMs, on its pad and for the
   // whole pipeline, which the sinks wait by (there with their processing deadline, 20 ms).
@@ -216,6 +225,67 @@ TEST(PfapAlignLive, DeclaresItsLatencyAndKeepsThePhonemesInSyncWithinIt) {
   std::printf("live pipeline: %zu phonemes pushed, %zu boundaries, median error %.1f ms\n",
               got.size(), errors.size(), median);
   EXPECT_LT(median, 30);
+}
+
+// Without a text, live: the phonemes recognized as the audio comes (align/recognizer.h), within
+// the same declared latency and bound as with a text, tiling the audio, and speech heard.
+TEST(PfapAlignLive, WithoutTheTextRecognizesWithinTheSameLatency) {
+  if (!pfap::align::recognition_available()) GTEST_SKIP() << "no recognizer in this build";
+  const pfap::tts::Speech truth = say(kText, 130, 25);
+  const unsigned rate = truth.sample_rate;
+  std::vector<int16_t> audio(rate * 2 / 5, 0);
+  audio.insert(audio.end(), truth.samples.begin(), truth.samples.end());
+  audio.resize(audio.size() + rate * 3 / 10, 0);
+
+  pfap::testing::Pipeline p(
+      "appsrc name=src is-live=true format=time min-latency=20000000 caps=\"audio/x-raw,"
+      "format=S16LE,layout=interleaved,channels=1,rate=" +
+      std::to_string(rate) +
+      "\" ! pfapalign name=a live=true a.src ! queue ! fakesink sync=true a.pfap ! queue ! "
+      "fakesink sync=true");
+  ASSERT_TRUE(p.ok()) << p.error();
+  GstElement* src = p.by_name("src");
+  GstElement* align = p.by_name("a");
+  Probes probes;
+  probes.pipeline = p.get();
+  probe(align, "sink", Probes::on_audio, &probes);
+  probe(align, "pfap", Probes::on_pfap, &probes);
+  ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+  push_in_real_time(p.get(), src, audio, rate);
+  if (::testing::Test::HasFatalFailure()) return;
+  GstPad* pfap_pad = gst_element_get_static_pad(align, "pfap");
+  EXPECT_EQ(latency_of(nullptr, pfap_pad), 20 * GST_MSECOND + kDeclared);
+  gst_object_unref(pfap_pad);
+  g_signal_emit_by_name(src, "end-of-stream", nullptr);
+  ASSERT_EQ(p.wait_eos(20s, true), "");
+  gst_element_set_state(p.get(), GST_STATE_NULL);
+
+  std::lock_guard lock(probes.mutex);
+  const std::vector<Pushed>& got = probes.pushed;
+  GstClockTime next = 0;
+  size_t speech = 0, early = 0;
+  GstClockTime most_behind = 0, most_late = 0;
+  for (const Pushed& e : got) {
+    EXPECT_EQ(e.pts, next);
+    next = e.pts + e.duration;
+    speech += e.symbol != 0;
+  }
+  EXPECT_EQ(next, gst_util_uint64_scale(audio.size(), GST_SECOND, rate));
+  for (const Pushed& e : got) {
+    if (e.audio_end >= next) continue;
+    ++early;
+    EXPECT_LE(e.audio_end, e.pts + kBound) << "phoneme at " << e.pts;
+    most_behind = std::max(most_behind, e.audio_end - e.pts);
+    most_late = std::max(most_late, e.running > e.pts ? e.running - e.pts : 0);
+  }
+  EXPECT_GT(speech, 20u) << "espeak-ng says 41";
+  EXPECT_GT(early, got.size() / 2) << "most phonemes leave before the audio ends";
+  std::printf(
+      "live pipeline without text: %zu phonemes (%zu speech), a phoneme's start at most %.0f ms "
+      "before the audio's end, pushed at most %.0f ms after its start by the clock (declared "
+      "%.0f ms)\n",
+      got.size(), speech, static_cast<double>(most_behind) / GST_MSECOND,
+      static_cast<double>(most_late) / GST_MSECOND, static_cast<double>(kDeclared) / GST_MSECOND);
 }
 
 // Utterances on text_sink, live: each starts at its PTS, the phonemes of the first come while
@@ -335,10 +405,10 @@ TEST(PfapAlignLive, DocumentedRtpLineRuns) {
     ASSERT_EQ(make.set_state(GST_STATE_PLAYING), "");
     ASSERT_EQ(make.wait_eos(30s), "");
   }
-  pfap::testing::Pipeline sender(free_ports(
-      "filesrc location=" + dir.file("speech.wav") +
-          " ! wavparse ! audioconvert ! audioresample ! audio/x-raw,rate=16000,channels=1 ! "
-          "rtpL16pay pt=96 ! udpsink host=127.0.0.1 port=5004"));
+  pfap::testing::Pipeline sender(
+      free_ports("filesrc location=" + dir.file("speech.wav") +
+                 " ! wavparse ! audioconvert ! audioresample ! audio/x-raw,rate=16000,channels=1 ! "
+                 "rtpL16pay pt=96 ! udpsink host=127.0.0.1 port=5004"));
   ASSERT_TRUE(sender.ok()) << sender.error();
 
   std::atomic<int> phonemes{0};  // lines of pfaptextenc: one a phoneme
