@@ -8,6 +8,8 @@
 #include "dtw.h"
 #include "f0.h"
 #include "mfcc.h"
+#include "recognizer.h"
+#include "viseme_frames.h"
 
 namespace pfap::align {
 namespace {
@@ -73,6 +75,28 @@ const char* problem_text(Problem p) {
   return "?";
 }
 
+namespace {
+
+// The share of 10 ms frames on which `phonemes` show the viseme the recognizer hears in
+// `audio`; -1 without a recognizer. The warp's cost alone does not tell a right text in another
+// voice from a wrong one (docs/align.md, "Bad input"); what is heard does.
+double heard_agreement(const std::vector<tts::SpokenPhoneme>& phonemes,
+                       std::span<const int16_t> audio, unsigned rate) {
+  Recognition heard;
+  std::string error;
+  if (!recognize(audio, rate, heard, error)) return -1;
+  auto frames = [&](const std::vector<tts::SpokenPhoneme>& ps) {
+    std::vector<TimedSymbol> timed;
+    for (const tts::SpokenPhoneme& p : ps) {
+      timed.push_back({static_cast<double>(p.start) / rate, p.event.phoneme.symbol});
+    }
+    return viseme_frames(timed, static_cast<double>(audio.size()) / rate);
+  };
+  return viseme_agreement(frames(phonemes), frames(heard.phonemes));
+}
+
+}  // namespace
+
 bool align(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
            std::span<const int16_t> audio, unsigned rate, Alignment& out, std::string& error) {
   out = Alignment{};
@@ -135,6 +159,12 @@ bool align(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
     MarkupEvent e = syn.phonemes[k].event;
     e.phoneme.f0 = f0_code(static_cast<unsigned>(std::lround(f0[k])));
     tts::add_phoneme(e, bounds[k], bounds[k + 1], rate, out.phonemes);
+  }
+  if (out.problem == Problem::kNone && w.relative_cost >= kSureMatchCost) {
+    out.heard_agreement = heard_agreement(out.phonemes, audio, rate);
+    if (out.heard_agreement >= 0 && out.heard_agreement < kPoorHeardAgreement) {
+      out.problem = Problem::kPoorMatch;
+    }
   }
   return true;
 }

@@ -26,14 +26,22 @@ enum class Problem {
   kEmptyText,  // no phonemes to align: one pause over the audio
   kNoSpeech,   // the audio is all below kSpeechLevelDb: one pause, bookmarks on it
   kBadRate,    // the rate is outside kMinRate..kMaxRate: one pause, bookmarks on it
-  kPoorMatch,  // aligned, but the audio matches the text poorly: relative_cost high, or
-               // its speech much longer or shorter than the text's spoken by espeak-ng
+  kPoorMatch,  // aligned, but the audio matches the text poorly: the recognizer hears other
+               // visemes than the aligned ones, relative_cost very high, or the speech much
+               // longer or shorter than the text's spoken by espeak-ng
 };
 
 const char* problem_text(Problem p);
 
-inline constexpr float kSpeechLevelDb = -50;    // a frame this loud or louder may be speech
-inline constexpr double kPoorMatchCost = 0.85;  // Warp::relative_cost from which kPoorMatch
+inline constexpr float kSpeechLevelDb = -50;  // a frame this loud or louder may be speech
+// When the text matches its audio (docs/align.md, "Bad input": both statistics measured on
+// right and shuffled texts). Below kSureMatchCost the warp's relative cost says it does; from
+// there, where the build has the recognizer (recognizer.h), the audio matches poorly when the
+// share of 10 ms frames on which the aligned phonemes show the viseme the recognizer hears is
+// below kPoorHeardAgreement; and whatever the recognizer, from kPoorMatchCost.
+inline constexpr double kSureMatchCost = 0.72;
+inline constexpr double kPoorHeardAgreement = 0.44;
+inline constexpr double kPoorMatchCost = 0.97;
 inline constexpr double kMaxSpeechRatio = 2.5;  // recording's speech over espeak-ng's, or back
 
 struct Alignment {
@@ -42,6 +50,9 @@ struct Alignment {
   std::vector<tts::SpokenPhoneme> phonemes;
   Problem problem = Problem::kNone;
   double relative_cost = 0;  // dtw.h; 0 when nothing was aligned
+  // The share of frames on which the recognizer hears the aligned phonemes' visemes; -1 when
+  // not measured (relative_cost below kSureMatchCost, or no recognizer).
+  double heard_agreement = -1;
   // espeak-ng's mnemonics with no exact x-pfap-arpabet symbol, as tts::Speech gives them.
   std::vector<tts::Speech::Inexact> inexact;
 };

@@ -14,7 +14,8 @@
 //   pfap-align-eval DIR NAME...      (tools/align-eval-festival makes DIR and runs this)
 // With PFAP_ALIGN_EVAL_VERBOSE set it prints both phoneme sequences with their starts in ms;
 // PFAP_ALIGN_EVAL_VOICE picks the espeak-ng voice (default "en"); with PFAP_ALIGN_EVAL_LIVE
-// set it aligns as pfapalign live=true does (align/streaming.h, the audio in 20 ms blocks).
+// set it aligns as pfapalign live=true does (align/streaming.h, the audio in 20 ms blocks) and
+// recognizes live too (StreamingRecognizer), beside the offline recognition.
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -202,6 +203,24 @@ bool align_live(const pfap::tts::Utterance& utterance, const pfap::tts::VoiceSet
   return true;
 }
 
+// As recognize(), but by the live recognizer, the audio given in 20 ms blocks; `lag` is the
+// most audio that had come past what was given out, after any block.
+bool recognize_live(const std::vector<int16_t>& samples, unsigned rate,
+                    pfap::align::Recognition& out, size_t& lag, std::string& error) {
+  pfap::align::StreamingRecognizer recognizer;
+  if (!recognizer.start(rate, error)) return false;
+  out = pfap::align::Recognition{};
+  const size_t block = rate / 50;
+  for (size_t i = 0; i < samples.size(); i += block) {
+    recognizer.push(std::span(samples).subspan(i, std::min(block, samples.size() - i)),
+                    out.phonemes);
+    lag = std::max(lag, recognizer.samples() - recognizer.settled());
+  }
+  recognizer.finish(out.phonemes);
+  out.problem = recognizer.problem();
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -215,10 +234,13 @@ int main(int argc, char** argv) {
   if (const char* v = std::getenv("PFAP_ALIGN_EVAL_VOICE")) voice.voice = v;
   const pfap::PhonemeAlphabet& arpabet = *pfap::find_alphabet(pfap::kArpabetAlphabet);
   std::vector<double> aligned_errors, equal_errors, scaled_errors, costs;
-  size_t matched_total = 0, truth_total = 0;
+  size_t matched_total = 0, truth_total = 0, poor = 0;
   double audio_seconds = 0, align_seconds = 0, recognize_seconds = 0, recognize_cpu_seconds = 0;
   const bool recognize = pfap::align::recognition_available();
-  Agreement recognized_agreement, aligned_agreement;
+  const bool live = std::getenv("PFAP_ALIGN_EVAL_LIVE") != nullptr;
+  Agreement recognized_agreement, aligned_agreement, live_agreement, live_offline_agreement;
+  double live_seconds = 0, live_cpu_seconds = 0;
+  size_t live_lag = 0;                     // samples, at 16 kHz or the corpus's rate
   std::vector<pfap::Viseme> truth_frames;  // every sentence's, for the baseline
   for (int a = 2; a < argc; ++a) {
     const std::string base = dir + "/" + argv[a];
@@ -228,10 +250,11 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "%s.wav: not 16-bit mono PCM\n", base.c_str());
       return 1;
     }
-    // PFAP_ALIGN_EVAL_WRONG_TEXT: each recording with the next one's text, to see the cost
-    // of a text that does not match.
-    const bool wrong = std::getenv("PFAP_ALIGN_EVAL_WRONG_TEXT") != nullptr;
-    std::ifstream text_in(dir + "/" + argv[wrong ? 2 + (a - 1) % (argc - 2) : a] + ".txt");
+    // PFAP_ALIGN_EVAL_WRONG_TEXT=k: each recording with the text k places on (default 1), to
+    // see the poor-match statistics of a text that does not match.
+    const char* wrong = std::getenv("PFAP_ALIGN_EVAL_WRONG_TEXT");
+    const int shift = wrong != nullptr ? std::max(1, std::atoi(wrong)) : 0;
+    std::ifstream text_in(dir + "/" + argv[2 + (a - 2 + shift) % (argc - 2)] + ".txt");
     std::stringstream text;
     text << text_in.rdbuf();
     const std::vector<Phone> truth = read_segs(base + ".segs");
@@ -241,7 +264,6 @@ int main(int argc, char** argv) {
     pfap::align::Alignment alignment;
     std::string error;
     const auto t0 = std::chrono::steady_clock::now();
-    const bool live = std::getenv("PFAP_ALIGN_EVAL_LIVE") != nullptr;
     if (!(live ? align_live(utterance, voice, samples, rate, alignment, error)
                : pfap::align::align(utterance, voice, samples, rate, alignment, error))) {
       std::fprintf(stderr, "%s\n", error.c_str());
@@ -309,6 +331,33 @@ int main(int argc, char** argv) {
           pfap::align::viseme_frames(timed(recognition.phonemes, rate), duration);
       recognized_agreement.add(visemes, truth_visemes);
       recognized_share = pfap::align::viseme_agreement(visemes, truth_visemes);
+      if (live) {
+        pfap::align::Recognition live_recognition;
+        size_t lag = 0;
+        const auto l0 = std::chrono::steady_clock::now();
+        const std::clock_t lc0 = std::clock();
+        if (!recognize_live(samples, rate, live_recognition, lag, error)) {
+          std::fprintf(stderr, "%s\n", error.c_str());
+          return 1;
+        }
+        live_seconds +=
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - l0).count();
+        live_cpu_seconds += static_cast<double>(std::clock() - lc0) / CLOCKS_PER_SEC;
+        live_lag = std::max(live_lag, lag * 1000 / rate);
+        const std::vector<pfap::Viseme> live_visemes =
+            pfap::align::viseme_frames(timed(live_recognition.phonemes, rate), duration);
+        live_agreement.add(live_visemes, truth_visemes);
+        live_offline_agreement.add(live_visemes, visemes);
+        if (std::getenv("PFAP_ALIGN_EVAL_VERBOSE") != nullptr) {
+          for (const pfap::tts::SpokenPhoneme& p : live_recognition.phonemes) {
+            std::printf(
+                " %s@%zu",
+                std::string(pfap::find_phoneme(arpabet, p.event.phoneme.symbol)->name).c_str(),
+                p.start * 1000 / rate);
+          }
+          std::printf("\n");
+        }
+      }
       if (std::getenv("PFAP_ALIGN_EVAL_VERBOSE") != nullptr) {
         for (const pfap::tts::SpokenPhoneme& p : recognition.phonemes) {
           std::printf(
@@ -320,11 +369,12 @@ int main(int argc, char** argv) {
       }
     }
     std::printf(
-        "%s: %.2f s, %zu of %zu phonemes matched, median %.1f ms, p90 %.1f ms, cost %.2f%s; "
-        "without text %.0f %% of viseme frames\n",
+        "%s: %.2f s, %zu of %zu phonemes matched, median %.1f ms, p90 %.1f ms, cost %.2f, "
+        "heard %.2f%s; without text %.0f %% of viseme frames\n",
         argv[a], duration, matched, truth.size(), percentile(e, 0.5) * 1000,
-        percentile(e, 0.9) * 1000, alignment.relative_cost,
+        percentile(e, 0.9) * 1000, alignment.relative_cost, alignment.heard_agreement,
         alignment.problem == pfap::align::Problem::kNone ? "" : " (poor)", recognized_share * 100);
+    poor += alignment.problem != pfap::align::Problem::kNone;
   }
   std::printf("\n%d sentences, %.1f s of audio, %zu boundaries (%zu of %zu phonemes matched)\n",
               argc - 2, audio_seconds, aligned_errors.size(), matched_total, truth_total);
@@ -334,8 +384,8 @@ int main(int argc, char** argv) {
               percentile(equal_errors, 0.5) * 1000, percentile(equal_errors, 0.9) * 1000);
   std::printf("%-36s median %6.1f ms   p90 %6.1f ms\n", "baseline: espeak-ng times stretched",
               percentile(scaled_errors, 0.5) * 1000, percentile(scaled_errors, 0.9) * 1000);
-  std::printf("relative warp cost: min %.2f, median %.2f, max %.2f\n", percentile(costs, 0),
-              percentile(costs, 0.5), percentile(costs, 1));
+  std::printf("relative warp cost: min %.2f, median %.2f, max %.2f; %zu of %d flagged poor\n",
+              percentile(costs, 0), percentile(costs, 0.5), percentile(costs, 1), poor, argc - 2);
   std::printf("real-time factor: %.3f (%.2f s to align %.1f s, with espeak-ng's synthesis)\n",
               align_seconds / audio_seconds, align_seconds, audio_seconds);
 
@@ -349,6 +399,10 @@ int main(int argc, char** argv) {
   std::printf("\nviseme agreement per 10 ms frame (%zu frames, %zu of them speech):\n",
               truth_frames.size(), speech_total);
   if (recognize) recognized_agreement.print("without text (pocketsphinx phones)");
+  if (recognize && live) {
+    live_agreement.print("without text, live");
+    live_offline_agreement.print("live against offline (not Festival)");
+  }
   aligned_agreement.print("with text (pfapalign)");
   const auto commonest = std::max_element(count.begin(), count.end());
   const auto commonest_speech = std::max_element(speech_count.begin(), speech_count.end());
@@ -365,6 +419,13 @@ int main(int argc, char** argv) {
         "processor time, %.3f)\n",
         recognize_seconds / audio_seconds, recognize_seconds, audio_seconds, recognize_cpu_seconds,
         recognize_cpu_seconds / audio_seconds);
+    if (live) {
+      std::printf(
+          "real-time factor without text, live: %.3f (%.2f s; %.2f s of processor time, %.3f); "
+          "at most %zu ms of audio not yet given out\n",
+          live_seconds / audio_seconds, live_seconds, live_cpu_seconds,
+          live_cpu_seconds / audio_seconds, live_lag);
+    }
   } else {
     std::printf("without text: this build has no recognizer (-Drecognition)\n");
   }

@@ -32,9 +32,9 @@
  *
  * The phonemes come when the audio ends (EOS, a new segment or sample rate), after the text
  * pad's EOS; with #GstPfapAlign:live, for live sources, as the audio comes, each within the
- * latency the element declares (docs/align.md, "Live"), with a text or without. Silence, noise, a text that does not
- * match, an empty text or none, bad bookmarks and
- * unsupported rates each give a warning (rate-limited), and the stream goes on: an utterance
+ * latency the element declares (docs/align.md, "Live"), with a text or without. Silence,
+ * noise, a text that does not match, an empty text or none, bad bookmarks and unsupported
+ * rates each give a warning (rate-limited), and the stream goes on: an utterance
  * that cannot be aligned is one pause carrying its bookmarks.
  *
  * ## Example pipelines
@@ -179,8 +179,9 @@ static void reset(GstPfapAlign* self) {
   gst_flow_combiner_reset(self->flow_combiner);
 }
 
+// `cost` and `heard` as pfap::align::Alignment's relative_cost and heard_agreement.
 static void warn_problem(GstPfapAlign* self, pfap::align::Problem problem, GstClockTime at,
-                         double cost) {
+                         double cost, double heard) {
   Stream& s = *self->stream;
   if (problem == pfap::align::Problem::kNone) return;
   if (!pfap_warn_at(++s.problems[static_cast<size_t>(problem)])) return;
@@ -188,8 +189,10 @@ static void warn_problem(GstPfapAlign* self, pfap::align::Problem problem, GstCl
       self, STREAM, DECODE,
       ("Utterance at %" GST_TIME_FORMAT ": %s", GST_TIME_ARGS(at),
        pfap::align::problem_text(problem)),
-      ("relative warp cost %.2f (poor from %.2f); %" G_GUINT64_FORMAT " so far", cost,
-       pfap::align::kPoorMatchCost, s.problems[static_cast<size_t>(problem)]));
+      ("relative warp cost %.2f (poor from %.2f), visemes heard on %.0f %% of "
+       "frames (poor below %.0f %%; -1: not measured); %" G_GUINT64_FORMAT " so far",
+       cost, pfap::align::kPoorMatchCost, heard * 100, pfap::align::kPoorHeardAgreement * 100,
+       s.problems[static_cast<size_t>(problem)]));
 }
 
 // Pushes `phonemes`, whose starts count from sample `from` of the audio kept, on `pfap`.
@@ -326,7 +329,9 @@ static GstFlowReturn align_utterance(GstPfapAlign* self, const std::string& byte
   GST_DEBUG_OBJECT(self, "utterance at %" GST_TIME_FORMAT ": %zu phonemes, %zu samples, cost %.2f",
                    GST_TIME_ARGS(at), alignment.phonemes.size(), audio.size(),
                    alignment.relative_cost);
-  if (is_text) warn_problem(self, alignment.problem, at, alignment.relative_cost);
+  if (is_text) {
+    warn_problem(self, alignment.problem, at, alignment.relative_cost, alignment.heard_agreement);
+  }
   warn_inexact(self, alignment.inexact, voice);
 
   return push_phonemes(self, alignment.phonemes, from);
@@ -447,7 +452,7 @@ static GstFlowReturn live_start_utterance(GstPfapAlign* self, const std::string&
     GST_ELEMENT_ERROR(self, LIBRARY, FAILED, ("%s", error.c_str()), (nullptr));
     return GST_FLOW_ERROR;
   }
-  if (is_text) warn_problem(self, s.aligner.problem(), at, 0);
+  if (is_text) warn_problem(self, s.aligner.problem(), at, 0, -1);
   warn_inexact(self, s.aligner.inexact(), voice);
   s.utterance_open = true;
   s.recognizing = false;

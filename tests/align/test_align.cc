@@ -17,6 +17,7 @@
 #include "dtw.h"
 #include "f0.h"
 #include "features.h"
+#include "recognizer.h"
 #include "speech_fixtures.h"
 
 namespace pfap::align {
@@ -298,29 +299,63 @@ TEST(Aligner, RateOutsideTheFeaturesIsOnePause) {
   expect_tiles(a, audio.size(), 8000);
 }
 
+// White noise, `n` samples at about -15 dBFS.
+std::vector<int16_t> white_noise(size_t n, uint32_t seed) {
+  std::vector<int16_t> noise(n);
+  for (int16_t& v : noise) {
+    seed = seed * 1664525 + 1013904223;
+    v = static_cast<int16_t>(static_cast<int>((seed >> 16) % 16000) - 8000);
+  }
+  return noise;
+}
+
 TEST(Aligner, NoiseAndAnotherTextMatchPoorly) {
   const tts::Speech s = say(kSentences[0], {"en", 150, 40, 100});
-  // The right text matches well; another text, or noise, does not, yet still tiles the audio.
+  // The right text matches; another text, or noise, does not, yet still tiles the audio.
   const Alignment right = aligned(kSentences[0], s.samples, s.sample_rate);
   EXPECT_EQ(right.problem, Problem::kNone);
-  // A text of three other sentences: what the cost tells apart (a text of one other sentence,
-  // of about the same length, mostly is not: docs/align.md).
-  const Alignment wrong =
+  // A text of three other sentences: much longer than the speech.
+  const Alignment longer =
       aligned(std::string(kSentences[1]) + " " + kSentences[2] + " " + kSentences[3], s.samples,
               s.sample_rate);
-  std::vector<int16_t> noise(s.samples.size());
-  uint32_t x = 12345;
-  for (int16_t& v : noise) {
-    x = x * 1664525 + 1013904223;
-    v = static_cast<int16_t>((x >> 16) % 16000) - 8000;
+  const Alignment noisy =
+      aligned(kSentences[0], white_noise(s.samples.size(), 12345), s.sample_rate);
+  std::printf("relative cost: right %.2f, three other sentences %.2f, noise %.2f\n",
+              right.relative_cost, longer.relative_cost, noisy.relative_cost);
+  EXPECT_EQ(longer.problem, Problem::kPoorMatch);  // the speech ratio
+  // Noise's cost (0.96) is below kPoorMatchCost, above Festival's slt voice's right texts
+  // (0.963): without the recognizer, which hears no speech, noise is not told from speech.
+  if (recognition_available()) {
+    EXPECT_EQ(noisy.problem, Problem::kPoorMatch);
   }
-  const Alignment noisy = aligned(kSentences[0], noise, s.sample_rate);
-  std::printf("relative cost: right %.2f, other text %.2f, noise %.2f\n", right.relative_cost,
-              wrong.relative_cost, noisy.relative_cost);
-  EXPECT_EQ(wrong.problem, Problem::kPoorMatch);
-  EXPECT_EQ(noisy.problem, Problem::kPoorMatch);
+  expect_tiles(longer, s.samples.size(), s.sample_rate);
+  expect_tiles(noisy, s.samples.size(), s.sample_rate);
+}
+
+// The poor-match rule on texts of about the audio's length (docs/align.md, "Bad input"): the
+// right text in a voice unlike espeak-ng's default, and with noise over it (cost 0.65 when
+// measured), is not flagged; another sentence's text (cost 0.78, its visemes heard on 10 % of
+// frames) is, where the build has the recognizer (without it, the warp's cost alone cannot
+// tell them apart: not checked).
+TEST(Aligner, OnlyTheWrongTextOfTheSameLengthMatchesPoorly) {
+  const tts::Speech s = say(kSentences[1], {"en-us", 140, 70, 100});
+  std::vector<int16_t> noisy = white_noise(s.samples.size(), 7);
+  for (size_t k = 0; k < noisy.size(); ++k) {
+    noisy[k] = static_cast<int16_t>(std::clamp(s.samples[k] + noisy[k] / 8, -32768, 32767));
+  }
+  for (const std::vector<int16_t>* audio :
+       {&s.samples, static_cast<const std::vector<int16_t>*>(&noisy)}) {
+    const Alignment right = aligned(kSentences[1], *audio, s.sample_rate);
+    std::printf("right text: cost %.2f, heard %.2f\n", right.relative_cost, right.heard_agreement);
+    EXPECT_EQ(right.problem, Problem::kNone) << right.relative_cost << " " << right.heard_agreement;
+  }
+  const Alignment wrong = aligned(kSentences[2], s.samples, s.sample_rate);
+  std::printf("another sentence: cost %.2f, heard %.2f\n", wrong.relative_cost,
+              wrong.heard_agreement);
   expect_tiles(wrong, s.samples.size(), s.sample_rate);
-  expect_tiles(noisy, noise.size(), s.sample_rate);
+  if (!recognition_available()) return;
+  EXPECT_EQ(wrong.problem, Problem::kPoorMatch)
+      << wrong.relative_cost << " " << wrong.heard_agreement;
 }
 
 TEST(Aligner, ShortAudioAndLongText) {
