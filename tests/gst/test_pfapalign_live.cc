@@ -166,7 +166,8 @@ TEST(PfapAlignLive, DeclaresItsLatencyAndKeepsThePhonemesInSyncWithinIt) {
   g_object_get(p.find("fakesink"), "processing-deadline", &deadline, nullptr);
   EXPECT_EQ(latency_of(p.get()), 20 * GST_MSECOND + kDeclared + deadline);
 
-  g_signal_emit_by_name(src, "end-of-stream", nullptr);
+  GstFlowReturn eos_ret = GST_FLOW_OK;
+  g_signal_emit_by_name(src, "end-of-stream", &eos_ret);
   ASSERT_EQ(p.wait_eos(10s), "");
   gst_element_set_state(p.get(), GST_STATE_NULL);
 
@@ -256,7 +257,8 @@ TEST(PfapAlignLive, WithoutTheTextRecognizesWithinTheSameLatency) {
   GstPad* pfap_pad = gst_element_get_static_pad(align, "pfap");
   EXPECT_EQ(latency_of(nullptr, pfap_pad), 20 * GST_MSECOND + kDeclared);
   gst_object_unref(pfap_pad);
-  g_signal_emit_by_name(src, "end-of-stream", nullptr);
+  GstFlowReturn eos_ret = GST_FLOW_OK;
+  g_signal_emit_by_name(src, "end-of-stream", &eos_ret);
   ASSERT_EQ(p.wait_eos(20s, true), "");
   gst_element_set_state(p.get(), GST_STATE_NULL);
 
