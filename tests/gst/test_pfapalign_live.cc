@@ -259,7 +259,9 @@ TEST(PfapAlignLive, WithoutTheTextRecognizesWithinTheSameLatency) {
   gst_object_unref(pfap_pad);
   GstFlowReturn eos_ret = GST_FLOW_OK;
   g_signal_emit_by_name(src, "end-of-stream", &eos_ret);
-  ASSERT_EQ(p.wait_eos(20s, true), "");
+  // The recognition takes most of a core: on a loaded machine, or with the sanitizers, it
+  // falls behind the clock and ends well after the audio.
+  ASSERT_EQ(p.wait_eos(120s, true), "");
   gst_element_set_state(p.get(), GST_STATE_NULL);
 
   std::lock_guard lock(probes.mutex);
