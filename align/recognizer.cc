@@ -310,10 +310,10 @@ void StreamingRecognizer::release() {
 #if PFAP_HAVE_POCKETSPHINX
   if (decoder_ == nullptr) return;
   if (in_utterance_) ps_end_utt(decoder_->ps);
-  in_utterance_ = false;
   give_back(decoder_);
   decoder_ = nullptr;
 #endif
+  in_utterance_ = false;
 }
 
 bool StreamingRecognizer::start(unsigned rate, std::string& error) {
