@@ -175,7 +175,7 @@ size_t live_bound(unsigned rate) {
 // The sentences above, live, one after the other with half a second of silence before each,
 // as a microphone gives them (12 s: pocketsphinx's utterance restarts at the pauses): within
 // the bound, tiling the audio, and agreeing on visemes with espeak-ng's times about as well as
-// the recognition of the whole does (52.4..53.7 % and 50.8 % when measured; docs/align.md, "Live
+// the recognition of the whole does (51.6..55.2 % and 50.8 % when measured; docs/align.md, "Live
 // without the text").
 TEST(Recognizer, LiveKeepsItsBoundAndAgreesOnVisemesAsTheWhole) {
   const std::array<const char*, 3> sentences{
