@@ -23,6 +23,8 @@
 #include <json-glib/json-glib.h>
 #include <libsoup/soup.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -32,6 +34,7 @@
 #include <mutex>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "launch_value.h"
 #include "pfap/model.h"
@@ -86,6 +89,8 @@ struct Session : std::enable_shared_from_this<Session> {
   GstElement* speaker = nullptr;  // the pfaptts bin of the text being said
   GstPad* speaker_mixer_pad = nullptr;
   bool channel_open = false;
+  bool playing = false;  // the page says it plays the audio track
+  bool audio_flowing = false;
   bool closed = false;
   std::string pending_text;  // said when the channel opens or the current text ends
   uint32_t audio_ts_offset = 0;
@@ -339,9 +344,78 @@ GstPadProbeReturn on_sink_gap(GstPad*, GstPadProbeInfo* info, gpointer data) {
   return GST_PAD_PROBE_OK;
 }
 
+// The speech's level, sent to the page as it leaves the speaker (up to a second before it is
+// played): the RMS of each millisecond at its running time, which the page finds again in the
+// audio it plays to learn which running time it is hearing (docs/web.md, Timing).
+struct Envelope {
+  std::weak_ptr<Session> session;
+  GstClockTime offset = 0;  // the speaker's pad offset: its running time in the pipeline's
+  GstClockTime start = GST_CLOCK_TIME_NONE;  // running time of levels[0]
+  std::vector<int64_t> levels;  // RMS of each ms, S16 units
+  double sum = 0.0;
+  int count = 0;
+};
+
+constexpr int kSamplesPerLevel = 48;   // 1 ms at 48 kHz
+constexpr size_t kLevelsPerMessage = 50;
+
+void send_envelope(Envelope& e) {
+  if (e.levels.empty()) return;
+  const bool silent = std::all_of(e.levels.begin(), e.levels.end(), [](int64_t v) { return v == 0; });
+  std::shared_ptr<Session> session = e.session.lock();
+  if (!silent && session != nullptr) {
+    post(session, [start = e.start, levels = e.levels](Session& s) {
+      JsonBuilder* b = message("envelope");
+      member(b, "runningTimeNs", static_cast<int64_t>(start));
+      json_builder_set_member_name(b, "rms");
+      json_builder_begin_array(b);
+      for (int64_t v : levels) json_builder_add_int_value(b, v);
+      json_builder_end_array(b);
+      finish(s, b);
+    });
+  }
+  e.start += e.levels.size() * GST_MSECOND;
+  e.levels.clear();
+}
+
+GstPadProbeReturn on_speech(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
+  auto& e = *static_cast<Envelope*>(data);
+  if ((info->type & GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM) != 0) {
+    if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) == GST_EVENT_EOS) send_envelope(e);
+    return GST_PAD_PROBE_OK;
+  }
+  GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+  if (e.start == GST_CLOCK_TIME_NONE) {
+    GstEvent* event = gst_pad_get_sticky_event(pad, GST_EVENT_SEGMENT, 0);
+    if (event == nullptr || !GST_BUFFER_PTS_IS_VALID(buffer)) {
+      if (event != nullptr) gst_event_unref(event);
+      return GST_PAD_PROBE_OK;
+    }
+    const GstSegment* segment = nullptr;
+    gst_event_parse_segment(event, &segment);
+    e.start = gst_segment_to_running_time(segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer)) + e.offset;
+    gst_event_unref(event);
+    if (!GST_CLOCK_TIME_IS_VALID(e.start)) return GST_PAD_PROBE_OK;
+  }
+  GstMapInfo map;
+  if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) return GST_PAD_PROBE_OK;
+  const auto* samples = reinterpret_cast<const int16_t*>(map.data);
+  for (size_t i = 0; i < map.size / 2; ++i) {
+    e.sum += static_cast<double>(samples[i]) * samples[i];
+    if (++e.count == kSamplesPerLevel) {
+      e.levels.push_back(std::lround(std::sqrt(e.sum / kSamplesPerLevel)));
+      e.sum = 0.0;
+      e.count = 0;
+      if (e.levels.size() == kLevelsPerMessage) send_envelope(e);
+    }
+  }
+  gst_buffer_unmap(buffer, &map);
+  return GST_PAD_PROBE_OK;
+}
+
 // Starts saying `text` now, or after the text being said.
 void say(Session& s, const std::string& text) {
-  if (s.speaker != nullptr || !s.channel_open) {
+  if (s.speaker != nullptr || !s.audio_flowing) {
     s.pending_text = text;
     return;
   }
@@ -377,6 +451,17 @@ void say(Session& s, const std::string& text) {
   gst_object_unref(clock);
   gst_pad_set_offset(audio, static_cast<gint64>(now + kSpeakLead));
   gst_pad_set_offset(pfap, static_cast<gint64>(now + kSpeakLead));
+  // Its level, as early as the speaker makes it (the queue before the mixer fills ahead).
+  GstElement* queue = gst_bin_get_by_name(GST_BIN(speaker), "audio");
+  GstPad* queue_sink = gst_element_get_static_pad(queue, "sink");
+  auto* envelope = new Envelope;
+  envelope->session = s.weak_from_this();
+  envelope->offset = now + kSpeakLead;
+  gst_pad_add_probe(queue_sink,
+                    GstPadProbeType(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM),
+                    on_speech, envelope, [](gpointer data) { delete static_cast<Envelope*>(data); });
+  gst_object_unref(queue_sink);
+  gst_object_unref(queue);
 
   gst_bin_add(GST_BIN(s.pipeline), speaker);
   s.speaker = speaker;
@@ -393,18 +478,26 @@ void say(Session& s, const std::string& text) {
   finish(s, b);
 }
 
+// The audio flows, and the first text is said, once the data channel is open and the page
+// plays the audio track: what the pipeline made before would reach the browser's jitter
+// buffer before anything takes audio out of it, which then plays faster until it has caught
+// up (a first version lost 1 s of a 2.7 s text that way; docs/web.md).
+void start_when_ready(Session& s) {
+  if (!s.channel_open || !s.playing || s.audio_flowing) return;
+  s.audio_flowing = true;
+  GstElement* gate = gst_bin_get_by_name(GST_BIN(s.pipeline), "gate");
+  g_object_set(gate, "drop", FALSE, nullptr);
+  gst_object_unref(gate);
+  std::string text;
+  text.swap(s.pending_text);
+  if (!text.empty()) say(s, text);
+}
+
 void on_channel_open(GstWebRTCDataChannel*, gpointer data) {
   if (std::shared_ptr<Session> session = session_of(data)) {
     post(session, [](Session& s) {
       s.channel_open = true;
-      // The audio flows from now on: what came before the connection would reach the browser
-      // in a burst, which its jitter buffer then plays faster to catch up (lip sync lost).
-      GstElement* gate = gst_bin_get_by_name(GST_BIN(s.pipeline), "gate");
-      g_object_set(gate, "drop", FALSE, nullptr);
-      gst_object_unref(gate);
-      std::string text = s.pending_text.empty() ? std::string() : s.pending_text;
-      s.pending_text.clear();
-      if (!text.empty()) say(s, text);
+      start_when_ready(s);
     });
   }
 }
@@ -581,6 +674,9 @@ void on_ws_message(SoupWebsocketConnection*, gint type, GBytes* bytes, gpointer 
   } else if (std::strcmp(kind, "say") == 0) {
     const char* said = json_object_get_string_member_with_default(m, "text", "");
     if (*said != '\0') say(s, said);
+  } else if (std::strcmp(kind, "playing") == 0) {
+    s.playing = true;
+    start_when_ready(s);
   } else if (std::strcmp(kind, "complete") == 0) {
     request_complete(s);
   } else {

@@ -24,7 +24,7 @@ class Tap extends AudioWorkletProcessor {
           this.count = 0;
         }
       }
-      if (this.out.length >= 100) {
+      if (this.out.length >= 20) {
         this.port.postMessage(this.out);
         this.out = [];
       }
