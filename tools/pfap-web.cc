@@ -13,6 +13,7 @@
 // tells the page on the WebSocket, so the page maps the audio it plays to PFAP time. The
 // WebSocket also carries the SDP offer and answer, ICE candidates, the texts to say and, at
 // the end of each, the sender's FAP state and counts (the page compares them with its own).
+#include <glib-unix.h>
 #include <gst/app/gstappsink.h>
 #include <gst/gst.h>
 #include <gst/rtp/gstrtpbuffer.h>
@@ -25,6 +26,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -516,6 +518,7 @@ void request_complete(Session& s) {
 struct Server {
   Options options;
   int sessions = 0;
+  std::vector<std::weak_ptr<Session>> open;  // stopped when the server stops
 };
 
 gboolean on_bus(GstBus*, GstMessage* m, gpointer data) {
@@ -691,8 +694,11 @@ void on_ws_closed(SoupWebsocketConnection*, gpointer data) {
 
 void on_websocket(SoupServer*, SoupServerMessage*, const char*, SoupWebsocketConnection* ws,
                   gpointer data) {
-  std::shared_ptr<Session> session = open_session(*static_cast<Server*>(data), ws);
+  Server& server = *static_cast<Server*>(data);
+  std::shared_ptr<Session> session = open_session(server, ws);
   if (session == nullptr) return;
+  std::erase_if(server.open, [](const std::weak_ptr<Session>& s) { return s.expired(); });
+  server.open.push_back(session);
   // The connection's handlers own the session (released when they are disconnected).
   auto* holder = new std::shared_ptr<Session>(session);
   g_signal_connect_data(ws, "message", G_CALLBACK(on_ws_message), holder, nullptr,
@@ -783,6 +789,33 @@ int parse_options(int argc, char** argv, Options& o) {
   return 0;
 }
 
+// Ctrl-C or SIGTERM: each session's pipeline stops, its browser is told, and what the
+// sessions and the server hold is freed.
+void stop(Server& server, SoupServer* soup) {
+  for (const std::weak_ptr<Session>& weak : server.open) {
+    std::shared_ptr<Session> s = weak.lock();
+    if (s == nullptr) continue;
+    auto* ws = SOUP_WEBSOCKET_CONNECTION(g_object_ref(s->ws));
+    close_session(s);
+    s.reset();
+    // Its handlers hold the session: disconnecting them frees it.
+    g_signal_handlers_disconnect_matched(ws, G_SIGNAL_MATCH_FUNC, 0, 0, nullptr,
+                                         reinterpret_cast<gpointer>(on_ws_message), nullptr);
+    g_signal_handlers_disconnect_matched(ws, G_SIGNAL_MATCH_FUNC, 0, 0, nullptr,
+                                         reinterpret_cast<gpointer>(on_ws_closed), nullptr);
+    if (soup_websocket_connection_get_state(ws) == SOUP_WEBSOCKET_STATE_OPEN) {
+      soup_websocket_connection_close(ws, SOUP_WEBSOCKET_CLOSE_GOING_AWAY, "server stopped");
+    }
+    g_object_unref(ws);
+  }
+  server.open.clear();
+  soup_server_disconnect(soup);
+  g_object_unref(soup);
+  // What the closing left to do (the close frames, finalizing the connections).
+  while (g_main_context_iteration(nullptr, FALSE)) {
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -822,8 +855,18 @@ int main(int argc, char** argv) {
   g_free(uri);
   g_slist_free_full(uris, reinterpret_cast<GDestroyNotify>(g_uri_unref));
   GMainLoop* loop = g_main_loop_new(nullptr, FALSE);
+  auto quit = [](gpointer loop) -> gboolean {
+    g_main_loop_quit(static_cast<GMainLoop*>(loop));
+    return G_SOURCE_CONTINUE;  // removed below
+  };
+  const guint on_sigint = g_unix_signal_add(SIGINT, quit, loop);
+  const guint on_sigterm = g_unix_signal_add(SIGTERM, quit, loop);
   g_main_loop_run(loop);
+  g_source_remove(on_sigint);
+  g_source_remove(on_sigterm);
+  stop(server, soup);
   g_main_loop_unref(loop);
-  g_object_unref(soup);
+  gst_deinit();
+  g_print("pfap-web: stopped\n");
   return 0;
 }
