@@ -176,6 +176,13 @@ void free_weak(gpointer data, GClosure*) { delete static_cast<std::weak_ptr<Sess
 
 // -- Signalling ---------------------------------------------------------------------------
 
+// With a promise: given none, webrtcbin 1.22 leaks the reply it would have given it.
+void set_description(GstElement* webrtc, const char* signal, GstWebRTCSessionDescription* sdp) {
+  GstPromise* promise = gst_promise_new();
+  g_signal_emit_by_name(webrtc, signal, sdp, promise);
+  gst_promise_unref(promise);
+}
+
 void on_offer_created(GstPromise* promise, gpointer data) {
   std::shared_ptr<Session> session = session_of(data);
   delete static_cast<std::weak_ptr<Session>*>(data);
@@ -189,7 +196,7 @@ void on_offer_created(GstPromise* promise, gpointer data) {
     if (offer != nullptr) gst_webrtc_session_description_free(offer);
     return;
   }
-  g_signal_emit_by_name(session->webrtc, "set-local-description", offer, nullptr);
+  set_description(session->webrtc, "set-local-description", offer);
   gchar* sdp = gst_sdp_message_as_text(offer->sdp);
   std::string text = sdp;
   g_free(sdp);
@@ -229,7 +236,7 @@ void set_answer(Session& s, const char* sdp_text) {
   }
   GstWebRTCSessionDescription* answer =
       gst_webrtc_session_description_new(GST_WEBRTC_SDP_TYPE_ANSWER, sdp);
-  g_signal_emit_by_name(s.webrtc, "set-remote-description", answer, nullptr);
+  set_description(s.webrtc, "set-remote-description", answer);
   gst_webrtc_session_description_free(answer);
 }
 
@@ -849,11 +856,13 @@ int main(int argc, char** argv) {
     g_object_unref(soup);
     return 1;
   }
-  GSList* uris = soup_server_get_uris(soup);
-  gchar* uri = g_uri_to_string(static_cast<GUri*>(uris->data));
-  g_print("pfap-web: open %s in a browser (Ctrl-C stops)\n", uri);
-  g_free(uri);
-  g_slist_free_full(uris, reinterpret_cast<GDestroyNotify>(g_uri_unref));
+  // The port from the listening socket (libsoup 3.2's soup_server_get_uris leaks an address).
+  GSList* listeners = soup_server_get_listeners(soup);
+  GSocketAddress* local = g_socket_get_local_address(G_SOCKET(listeners->data), nullptr);
+  g_slist_free(listeners);
+  const guint16 port = local != nullptr ? g_inet_socket_address_get_port(G_INET_SOCKET_ADDRESS(local)) : 0;
+  if (local != nullptr) g_object_unref(local);
+  g_print("pfap-web: open http://127.0.0.1:%u/ in a browser (Ctrl-C stops)\n", port);
   GMainLoop* loop = g_main_loop_new(nullptr, FALSE);
   auto quit = [](gpointer loop) -> gboolean {
     g_main_loop_quit(static_cast<GMainLoop*>(loop));

@@ -143,10 +143,14 @@ test('every phoneme arrives, in lip sync with the sound', async () => {
   assert.ok(s.uncertain === 0 || s.late > 0, `uncertain ${s.uncertain}, late ${s.late}`);
   assert.equal(s.fapStateMatchesSender, true);
   // The lip-sync figures go to docs/web.md (PFAP_LIPSYNC_OUT collects them); here only
-  // sanity: most onsets found, none beyond the pairing window.
+  // sanity: most onsets found, none beyond the pairing window, and their median no further
+  // than a few frames from the sound (per run it was +3 to +11 ms, docs/web.md).
   if (process.env.PFAP_LIPSYNC_OUT) writeFileSync(process.env.PFAP_LIPSYNC_OUT, JSON.stringify(s));
-  assert.ok(s.lipSyncErrorsMs.length >= 5, `onsets paired (of 10): ${JSON.stringify(s.lipSyncErrorsMs)}`);
-  for (const e of s.lipSyncErrorsMs) assert.ok(Math.abs(e) <= 150, `lip sync error ${e} ms`);
+  const errors = s.lipSyncErrorsMs;
+  assert.ok(errors.length >= 5, `onsets paired (of 10): ${JSON.stringify(errors)}`);
+  for (const e of errors) assert.ok(Math.abs(e) <= 150, `lip sync error ${e} ms`);
+  const median = [...errors].sort((a, b) => a - b)[Math.floor(errors.length / 2)];
+  assert.ok(median >= -20 && median <= 40, `median lip sync error ${median} ms: ${JSON.stringify(errors)}`);
 });
 
 test('with a tenth of the PFAP messages dropped the FAP state is repaired', async () => {
