@@ -12,7 +12,8 @@
 // their packets from the same running time, with timestamp offsets the server chooses and
 // tells the page on the WebSocket, so the page maps the audio it plays to PFAP time. The
 // WebSocket also carries the SDP offer and answer, ICE candidates, the texts to say and, at
-// the end of each, the sender's FAP state and counts (the page compares them with its own).
+// the end of each, the sender's FAP state and counts (the page compares them with its own),
+// and the speech's level, which the page finds in the audio it plays to know what it hears.
 #include <glib-unix.h>
 #include <gst/app/gstappsink.h>
 #include <gst/gst.h>
@@ -94,7 +95,7 @@ struct Session : std::enable_shared_from_this<Session> {
   bool playing = false;  // the page says it plays the audio track
   bool audio_flowing = false;
   bool closed = false;
-  std::string pending_text;  // said when the channel opens or the current text ends
+  std::string pending_text;  // said when the audio starts or the current text ends
   uint32_t audio_ts_offset = 0;
   uint32_t pfap_ts_offset = 0;
 
@@ -360,17 +361,18 @@ struct Envelope {
   std::weak_ptr<Session> session;
   GstClockTime offset = 0;  // the speaker's pad offset: its running time in the pipeline's
   GstClockTime start = GST_CLOCK_TIME_NONE;  // running time of levels[0]
-  std::vector<int64_t> levels;  // RMS of each ms, S16 units
+  std::vector<int64_t> levels;               // RMS of each ms, S16 units
   double sum = 0.0;
   int count = 0;
 };
 
-constexpr int kSamplesPerLevel = 48;   // 1 ms at 48 kHz
+constexpr int kSamplesPerLevel = 48;  // 1 ms of the speaker's S16 mono at 48 kHz
 constexpr size_t kLevelsPerMessage = 50;
 
 void send_envelope(Envelope& e) {
   if (e.levels.empty()) return;
-  const bool silent = std::all_of(e.levels.begin(), e.levels.end(), [](int64_t v) { return v == 0; });
+  const bool silent =
+      std::all_of(e.levels.begin(), e.levels.end(), [](int64_t v) { return v == 0; });
   std::shared_ptr<Session> session = e.session.lock();
   if (!silent && session != nullptr) {
     post(session, [start = e.start, levels = e.levels](Session& s) {
@@ -402,9 +404,11 @@ GstPadProbeReturn on_speech(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
     }
     const GstSegment* segment = nullptr;
     gst_event_parse_segment(event, &segment);
-    e.start = gst_segment_to_running_time(segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer)) + e.offset;
+    const GstClockTime running =
+        gst_segment_to_running_time(segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
     gst_event_unref(event);
-    if (!GST_CLOCK_TIME_IS_VALID(e.start)) return GST_PAD_PROBE_OK;
+    if (!GST_CLOCK_TIME_IS_VALID(running)) return GST_PAD_PROBE_OK;
+    e.start = running + e.offset;
   }
   GstMapInfo map;
   if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) return GST_PAD_PROBE_OK;
@@ -466,9 +470,9 @@ void say(Session& s, const std::string& text) {
   auto* envelope = new Envelope;
   envelope->session = s.weak_from_this();
   envelope->offset = now + kSpeakLead;
-  gst_pad_add_probe(queue_sink,
-                    GstPadProbeType(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM),
-                    on_speech, envelope, [](gpointer data) { delete static_cast<Envelope*>(data); });
+  gst_pad_add_probe(
+      queue_sink, GstPadProbeType(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM),
+      on_speech, envelope, [](gpointer data) { delete static_cast<Envelope*>(data); });
   gst_object_unref(queue_sink);
   gst_object_unref(queue);
 
@@ -860,7 +864,8 @@ int main(int argc, char** argv) {
   GSList* listeners = soup_server_get_listeners(soup);
   GSocketAddress* local = g_socket_get_local_address(G_SOCKET(listeners->data), nullptr);
   g_slist_free(listeners);
-  const guint16 port = local != nullptr ? g_inet_socket_address_get_port(G_INET_SOCKET_ADDRESS(local)) : 0;
+  const guint16 port =
+      local != nullptr ? g_inet_socket_address_get_port(G_INET_SOCKET_ADDRESS(local)) : 0;
   if (local != nullptr) g_object_unref(local);
   g_print("pfap-web: open http://127.0.0.1:%u/ in a browser (Ctrl-C stops)\n", port);
   GMainLoop* loop = g_main_loop_new(nullptr, FALSE);

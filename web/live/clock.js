@@ -16,6 +16,7 @@ export class SentLevel {
   constructor({ keepMs = 30000 } = {}) {
     this.keepMs = keepMs;
     this.segments = [];  // {startMs, levels}, in running time order
+    this.found = null;  // the index of the segment found last
   }
 
   /** A message: `levels[i]` is the RMS of the ms from runningTimeNs / 1e6 + i. */
@@ -25,20 +26,24 @@ export class SentLevel {
     this.segments.sort((a, b) => a.startMs - b.startMs);
     const newest = this.segments.at(-1).startMs;
     while (this.segments.length > 1 && this.segments[0].startMs < newest - this.keepMs) this.segments.shift();
+    this.found = null;
   }
 
   /** The level at running time `ms` (between two blocks' starts, interpolated), 0 where none was sent. */
   at(ms) {
-    for (let i = this.segments.length - 1; i >= 0; --i) {
-      const { startMs, levels } = this.segments[i];
-      if (ms < startMs) continue;
-      const x = ms - startMs;
-      const k = Math.floor(x);
-      if (k >= levels.length) return 0;
-      const next = k + 1 < levels.length ? levels[k + 1] : 0;
-      return levels[k] + (next - levels[k]) * (x - k);
-    }
-    return 0;
+    // Lookups come in runs of nearby times: the segment found last first.
+    const near = this.found ?? this.segments.length - 1;
+    const i = this.segments[near] && this.segments[near].startMs <= ms &&
+      (near + 1 >= this.segments.length || ms < this.segments[near + 1].startMs)
+      ? near : this.segments.findLastIndex((seg) => seg.startMs <= ms);
+    if (i < 0) return 0;
+    this.found = i;
+    const { startMs, levels } = this.segments[i];
+    const x = ms - startMs;
+    const k = Math.floor(x);
+    if (k >= levels.length) return 0;
+    const next = k + 1 < levels.length ? levels[k + 1] : 0;
+    return levels[k] + (next - levels[k]) * (x - k);
   }
 }
 
