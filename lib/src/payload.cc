@@ -57,14 +57,15 @@ unsigned coverage_code(unsigned covered_packets) {
   return 0;
 }
 
-// Big-endian fields as one copy and a byte swap: GCC made six shifts and stores of the byte
-// loops, and every descriptor goes through these.
+// Big-endian fields as whole-word copies and byte swaps: GCC made six shifts and stores of
+// byte loops, and every descriptor goes through these. A 48-bit field is a 32-bit and a
+// 16-bit word: a 6-byte copy went through the stack.
 constexpr bool kLittleEndian = std::endian::native == std::endian::little;
 
-uint64_t read_be48(const uint8_t* p) {
-  uint64_t v = 0;
-  std::memcpy(&v, p, 6);  // the field's bytes first in memory, so at the top on big-endian
-  return (kLittleEndian ? __builtin_bswap64(v) : v) >> 16;
+uint16_t read_be16(const uint8_t* p) {
+  uint16_t v;
+  std::memcpy(&v, p, 2);
+  return kLittleEndian ? __builtin_bswap16(v) : v;
 }
 
 uint32_t read_be32(const uint8_t* p) {
@@ -73,15 +74,21 @@ uint32_t read_be32(const uint8_t* p) {
   return kLittleEndian ? __builtin_bswap32(v) : v;
 }
 
-void write_be48(uint8_t* p, uint64_t v) {
-  const uint64_t shifted = v << 16;  // the 48 bits at the top, so they are the first 6 bytes
-  const uint64_t be = kLittleEndian ? __builtin_bswap64(shifted) : shifted;
-  std::memcpy(p, &be, 6);
+uint64_t read_be48(const uint8_t* p) { return uint64_t{read_be32(p)} << 16 | read_be16(p + 4); }
+
+void write_be16(uint8_t* p, uint16_t v) {
+  const uint16_t be = kLittleEndian ? __builtin_bswap16(v) : v;
+  std::memcpy(p, &be, 2);
 }
 
 void write_be32(uint8_t* p, uint32_t v) {
   const uint32_t be = kLittleEndian ? __builtin_bswap32(v) : v;
   std::memcpy(p, &be, 4);
+}
+
+void write_be48(uint8_t* p, uint64_t v) {
+  write_be32(p, static_cast<uint32_t>(v >> 16));
+  write_be16(p + 4, static_cast<uint16_t>(v));
 }
 
 // FAP descriptor and recovery entry without their InfoBits: FAPind 7, s 1, amplitude 22,
