@@ -316,11 +316,11 @@ static void request_complete_state(GstRtpPfapDepay* self, guint16 seqnum) {
 // socket or from rtppfappay). A payload spread over memories takes the range path.
 static pfap::DecodeResult decode(GstRtpPfapDepay* self, GstRTPBuffer* rtp, size_t& size) {
   size = gst_rtp_buffer_get_payload_len(rtp);
+  const guint offset = gst_rtp_buffer_get_header_len(rtp);
   guint index = 0, count = 0;
   gsize skip = 0;
   GstMapInfo map;
-  if (size > 0 && gst_buffer_find_memory(rtp->buffer, gst_rtp_buffer_get_header_len(rtp), size,
-                                         &index, &count, &skip) &&
+  if (size > 0 && gst_buffer_find_memory(rtp->buffer, offset, size, &index, &count, &skip) &&
       count == 1) {
     GstMemory* memory = gst_buffer_peek_memory(rtp->buffer, index);
     if (gst_memory_map(memory, &map, GST_MAP_READ)) {
@@ -330,8 +330,8 @@ static pfap::DecodeResult decode(GstRtpPfapDepay* self, GstRTPBuffer* rtp, size_
       return result;
     }
   }
-  return pfap::decode_payload(
-      {static_cast<const uint8_t*>(gst_rtp_buffer_get_payload(rtp)), size}, self->stream->packet);
+  const auto* payload = static_cast<const uint8_t*>(gst_rtp_buffer_get_payload(rtp));
+  return pfap::decode_payload({payload, size}, self->stream->packet);
 }
 
 static GstBuffer* gst_rtp_pfap_depay_process_rtp_packet(GstRTPBaseDepayload* depay,
