@@ -35,9 +35,9 @@ void to_phonetic_boundaries(tts::Speech& syn) {
 
 void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
                      std::span<const int16_t> audio, unsigned rate, std::vector<double>& starts) {
-  constexpr long kRadiusBlocks = 20;     // 100 ms
-  constexpr size_t kMinQuietBlocks = 4;  // 20 ms
-  const size_t block = rate / 200;       // 5 ms
+  constexpr long kRadiusBlocks = kSnapRadiusMs / 5;
+  constexpr size_t kMinQuietBlocks = kMinSilenceMs / 5;
+  const size_t block = rate / 200;  // 5 ms
   const size_t n = block > 0 ? audio.size() / block : 0;
   if (n < 2 * kMinQuietBlocks) return;
   std::vector<float> db(n);
