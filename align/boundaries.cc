@@ -33,6 +33,22 @@ void to_phonetic_boundaries(tts::Speech& syn) {
   }
 }
 
+std::vector<bool> pause_frames(const std::vector<tts::SpokenPhoneme>& phonemes, size_t offset,
+                               const Features& features) {
+  std::vector<bool> rest(features.n_frames, false);
+  for (size_t k = 1; k < phonemes.size(); ++k) {
+    if (!phonemes[k].event.phoneme.word_begin || is_pause(phonemes[k]) ||
+        is_pause(phonemes[k - 1])) {
+      continue;
+    }
+    // The frame whose centre is the last before the start (as the warp's boundaries map).
+    const size_t at = phonemes[k].start + offset;
+    const size_t i = features.frame_at(at);
+    rest[features.centre(i) >= at && i > 0 ? i - 1 : i] = true;
+  }
+  return rest;
+}
+
 void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
                      std::span<const int16_t> audio, unsigned rate, std::vector<double>& starts) {
   constexpr long kRadiusBlocks = kSnapRadiusMs / 5;

@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include "mfcc.h"
 #include "speech.h"
 
 namespace pfap::align {
@@ -26,6 +27,14 @@ inline constexpr double kPhoneticLeadSeconds = 0.010;
 //  - then every start after the first moves kPhoneticLeadSeconds earlier, never before the
 //    start before it.
 void to_phonetic_boundaries(tts::Speech& syn);
+
+// Per frame of `features` (the synthetic speech of `phonemes`, whose starts are `offset`
+// samples earlier), whether a pause the speaker makes and the synthesis lacks may be matched
+// there: the last frame before each word that follows speech, so that the word's start maps
+// to the pause's end and the word before holds over it. Speakers pause between words; at
+// every phoneme boundary it did worse (docs/align.md, "Live").
+std::vector<bool> pause_frames(const std::vector<tts::SpokenPhoneme>& phonemes, size_t offset,
+                               const Features& features);
 
 // How far snap_to_silence() moves a boundary at most, and how much silence it takes for an
 // edge, in ms.

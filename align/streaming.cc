@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "boundaries.h"
+#include "dtw.h"  // from_silence
 #include "f0.h"
 
 namespace pfap::align {
@@ -49,14 +50,6 @@ void silence_quiet_frames(Features& f) {
     std::fill(x, x + Features::kMfccs, 0.0f);
     x[Features::kMfccs] = -kLevelWeight;
   }
-}
-
-// The distance of `x` from silence as silence_quiet_frames() makes it.
-float from_silence(std::span<const float> x) {
-  float sum = 0;
-  for (size_t k = 0; k < Features::kMfccs; ++k) sum += x[k] * x[k];
-  const float level = x[Features::kMfccs] + kLevelWeight;
-  return std::sqrt(sum + level * level);
 }
 
 OpenWarp open_warp(const Features& rec, size_t r0, size_t rows, const Features& syn, size_t s0,
@@ -134,19 +127,7 @@ bool StreamingAligner::start(const tts::Utterance& utterance, const tts::VoiceSe
   for (size_t k = 1; k < syn_.phonemes.size(); ++k) syn_.phonemes[k].start += pad;
   synf_ = mfcc(syn_.samples, syn_.sample_rate);
   silence_quiet_frames(synf_);
-  rest_.assign(synf_.n_frames, false);
-  for (size_t k = 1; k < syn_.phonemes.size(); ++k) {
-    const tts::SpokenPhoneme& p = syn_.phonemes[k];
-    if (!p.event.phoneme.word_begin || p.event.phoneme.symbol == 0 ||
-        syn_.phonemes[k - 1].event.phoneme.symbol == 0) {
-      continue;
-    }
-    // The last frame before the word's start, so that the word's start maps to the end of
-    // the pause (step()'s map) and the word before holds over it.
-    const size_t i = synf_.frame_at(p.start);
-    const size_t before = synf_.centre(i) >= p.start && i > 0 ? i - 1 : i;
-    rest_[before] = true;
-  }
+  rest_ = pause_frames(syn_.phonemes, 0, synf_);
   return true;
 }
 

@@ -73,7 +73,7 @@ class StreamingAligner {
   Problem problem_ = Problem::kNone;
   tts::Speech syn_;  // padded with silence at its start, as align() does
   Features synf_;
-  std::vector<bool> rest_;  // per frame of synf_: a pause may be matched here (open_warp)
+  std::vector<bool> rest_;    // per frame of synf_: a pause may be matched here (open_warp)
   std::vector<int16_t> rec_;  // the utterance's audio from sample rec_first_ (what is needed)
   size_t rec_first_ = 0;
   float loudest_db_ = -100;    // the utterance's loudest frame so far

@@ -218,8 +218,8 @@ int main(int argc, char** argv) {
   std::vector<double> aligned_errors, equal_errors, scaled_errors, costs;
   size_t matched_total = 0, truth_total = 0;
   double audio_seconds = 0, align_seconds = 0, recognize_seconds = 0, recognize_cpu_seconds = 0;
-  const bool recognize = pfap::align::recognition_available() &&
-                         std::getenv("PFAP_ALIGN_EVAL_TEXT_ONLY") == nullptr;
+  const bool recognize =
+      pfap::align::recognition_available() && std::getenv("PFAP_ALIGN_EVAL_TEXT_ONLY") == nullptr;
   Agreement recognized_agreement, aligned_agreement;
   std::vector<pfap::Viseme> truth_frames;  // every sentence's, for the baseline
   for (int a = 2; a < argc; ++a) {
