@@ -23,7 +23,8 @@ float from_silence(std::span<const float> x) {
   float sum = 0;
   for (size_t k = 0; k < Features::kMfccs; ++k) sum += x[k] * x[k];
   const float level = x[Features::kMfccs] + kLevelWeight;
-  return std::sqrt(sum + level * level);
+  const float r = std::sqrt(sum + level * level);
+  return std::isfinite(r) ? r : 1e6f;  // as distance()
 }
 
 namespace {
@@ -47,7 +48,9 @@ Warp warp(const Features& a, const Features& b, size_t max_cells, const std::vec
   lo[0] = 0;
   hi[n - 1] = m;
 
-  std::vector<float> silence(rest != nullptr ? m : 0);
+  // Each frame of `b`'s cost where `a` may hold a pause.
+  const bool pauses = rest != nullptr && rest->size() == n;
+  std::vector<float> silence(pauses ? m : 0);
   for (size_t j = 0; j < silence.size(); ++j) silence[j] = from_silence(b.frame(j));
 
   constexpr float kInf = std::numeric_limits<float>::infinity();
@@ -68,7 +71,7 @@ Warp warp(const Features& a, const Features& b, size_t max_cells, const std::vec
         if (j > 0 && cur[j - 1] < best) best = cur[j - 1], step = kLeft;
       }
       cur[j] = best + d;
-      if (rest != nullptr && (*rest)[i] && j > lo[i] && cur[j - 1] + silence[j] < cur[j]) {
+      if (pauses && (*rest)[i] && j > lo[i] && cur[j - 1] + silence[j] < cur[j]) {
         cur[j] = cur[j - 1] + silence[j];
         steps[i][j - lo[i]] = kLeft;
       }
@@ -98,7 +101,7 @@ Warp warp(const Features& a, const Features& b, size_t max_cells, const std::vec
                                                 : kUp;
     // What the search counted: a pause held on a `rest` frame at its distance from silence.
     const float d = distance(a.frame(i), b.frame(j));
-    path_cost += rest != nullptr && (*rest)[i] && step == kLeft ? std::min(d, silence[j]) : d;
+    path_cost += pauses && (*rest)[i] && step == kLeft ? std::min(d, silence[j]) : d;
     if (step == kLeft) {
       --j;
     } else {
