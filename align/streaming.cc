@@ -185,7 +185,7 @@ void StreamingAligner::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
       const size_t b = syn_.phonemes[next_ + 1].start;
       size_t at = map(b);
       if (at == kNone || at > horizon) break;
-      at = snap(next_ + 1, at);
+      at = snap(next_ + 1, at);  // the lookahead holds the audio it looks at (streaming.h)
       syn_settled_ = b;
       emit(std::clamp(at, rec_settled_, n), true, out);
     }
@@ -218,6 +218,8 @@ void StreamingAligner::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
 }
 
 size_t StreamingAligner::snap(size_t k, size_t at) const {
+  const bool pause_before = syn_.phonemes[k - 1].event.phoneme.symbol == 0;
+  if (pause_before == (syn_.phonemes[k].event.phoneme.symbol == 0)) return at;  // no edge
   const std::vector<tts::SpokenPhoneme> pair = {syn_.phonemes[k - 1], syn_.phonemes[k]};
   std::vector<double> starts = {static_cast<double>(std::max(at, rec_first_) - rec_first_)};
   snap_to_silence(pair, rec_, rate_, starts);
