@@ -14,7 +14,8 @@
 //   pfap-align-eval DIR NAME...      (tools/align-eval-festival makes DIR and runs this)
 // With PFAP_ALIGN_EVAL_VERBOSE set it prints both phoneme sequences with their starts in ms;
 // PFAP_ALIGN_EVAL_VOICE picks the espeak-ng voice (default "en"); with PFAP_ALIGN_EVAL_LIVE
-// set it aligns as pfapalign live=true does (align/streaming.h, the audio in 20 ms blocks).
+// set it aligns as pfapalign live=true does (align/streaming.h, the audio in 20 ms blocks);
+// with PFAP_ALIGN_EVAL_TEXT_ONLY set it leaves out the text-free mode (minutes of recognition).
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -217,7 +218,8 @@ int main(int argc, char** argv) {
   std::vector<double> aligned_errors, equal_errors, scaled_errors, costs;
   size_t matched_total = 0, truth_total = 0;
   double audio_seconds = 0, align_seconds = 0, recognize_seconds = 0, recognize_cpu_seconds = 0;
-  const bool recognize = pfap::align::recognition_available();
+  const bool recognize =
+      pfap::align::recognition_available() && std::getenv("PFAP_ALIGN_EVAL_TEXT_ONLY") == nullptr;
   Agreement recognized_agreement, aligned_agreement;
   std::vector<pfap::Viseme> truth_frames;  // every sentence's, for the baseline
   for (int a = 2; a < argc; ++a) {
@@ -366,7 +368,7 @@ int main(int argc, char** argv) {
         recognize_seconds / audio_seconds, recognize_seconds, audio_seconds, recognize_cpu_seconds,
         recognize_cpu_seconds / audio_seconds);
   } else {
-    std::printf("without text: this build has no recognizer (-Drecognition)\n");
+    std::printf("without text: not measured (PFAP_ALIGN_EVAL_TEXT_ONLY, or no -Drecognition)\n");
   }
   return 0;
 }

@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "boundaries.h"
 #include "documented_commands.h"
 #include "markupbuffer.h"
 #include "pipeline.h"
@@ -103,8 +104,10 @@ GstClockTime latency_of(GstElement* element_or_pipeline, GstPad* pad = nullptr) 
 }
 
 TEST(PfapAlignLive, DeclaresItsLatencyAndKeepsThePhonemesInSyncWithinIt) {
-  // 400 ms of silence, the utterance, 300 ms of silence.
-  const pfap::tts::Speech truth = say(kText, 130, 25);
+  // 400 ms of silence, the utterance, 300 ms of silence; its phoneme starts in the aligner's
+  // phonetic convention (align/boundaries.h).
+  pfap::tts::Speech truth = say(kText, 130, 25);
+  pfap::align::to_phonetic_boundaries(truth);
   const unsigned rate = truth.sample_rate;
   const size_t lead = rate * 2 / 5;
   std::vector<int16_t> audio(lead, 0);
@@ -157,7 +160,8 @@ TEST(PfapAlignLive, DeclaresItsLatencyAndKeepsThePhonemesInSyncWithinIt) {
   g_object_get(p.find("fakesink"), "processing-deadline", &deadline, nullptr);
   EXPECT_EQ(latency_of(p.get()), 20 * GST_MSECOND + kDeclared + deadline);
 
-  g_signal_emit_by_name(src, "end-of-stream", nullptr);
+  GstFlowReturn flow = GST_FLOW_OK;
+  g_signal_emit_by_name(src, "end-of-stream", &flow);
   ASSERT_EQ(p.wait_eos(10s), "");
   gst_element_set_state(p.get(), GST_STATE_NULL);
 
