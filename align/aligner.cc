@@ -130,7 +130,9 @@ bool align(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
   padded.insert(padded.end(), syn.samples.begin(), syn.samples.end());
   padded.resize(padded.size() + pad, 0);
   const Features synf = mfcc(padded, syn.sample_rate);
-  const Warp w = warp(synf, rec);
+  // A pause the speaker makes between words and espeak-ng does not is held at the word's end.
+  const std::vector<bool> rest = pause_frames(syn.phonemes, pad, synf);
+  const Warp w = warp(synf, rec, kMaxWarpCells, &rest);
   out.relative_cost = w.relative_cost;
   const double ratio = speech_seconds(rec) / std::max(speech_seconds(synf), 0.01);
   if (w.relative_cost >= kPoorMatchCost || ratio < 1 / kMaxSpeechRatio || ratio > kMaxSpeechRatio) {

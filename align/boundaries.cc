@@ -33,11 +33,27 @@ void to_phonetic_boundaries(tts::Speech& syn) {
   }
 }
 
+std::vector<bool> pause_frames(const std::vector<tts::SpokenPhoneme>& phonemes, size_t offset,
+                               const Features& features) {
+  std::vector<bool> rest(features.n_frames, false);
+  for (size_t k = 1; k < phonemes.size(); ++k) {
+    if (!phonemes[k].event.phoneme.word_begin || is_pause(phonemes[k]) ||
+        is_pause(phonemes[k - 1])) {
+      continue;
+    }
+    // The frame whose centre is the last before the start (as the warp's boundaries map).
+    const size_t at = phonemes[k].start + offset;
+    const size_t i = features.frame_at(at);
+    rest[features.centre(i) >= at && i > 0 ? i - 1 : i] = true;
+  }
+  return rest;
+}
+
 void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
                      std::span<const int16_t> audio, unsigned rate, std::vector<double>& starts) {
-  constexpr long kRadiusBlocks = 20;     // 100 ms
-  constexpr size_t kMinQuietBlocks = 4;  // 20 ms
-  const size_t block = rate / 200;       // 5 ms
+  constexpr long kRadiusBlocks = kSnapRadiusMs / 5;
+  constexpr size_t kMinQuietBlocks = kMinSilenceMs / 5;
+  const size_t block = rate / 200;  // 5 ms
   const size_t n = block > 0 ? audio.size() / block : 0;
   if (n < 2 * kMinQuietBlocks) return;
   std::vector<float> db(n);

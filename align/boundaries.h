@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include "mfcc.h"
 #include "speech.h"
 
 namespace pfap::align {
@@ -27,12 +28,25 @@ inline constexpr double kPhoneticLeadSeconds = 0.010;
 //    start before it.
 void to_phonetic_boundaries(tts::Speech& syn);
 
+// Per frame of `features` (the synthetic speech of `phonemes`, whose starts are `offset`
+// samples earlier), whether a pause the speaker makes and the synthesis lacks may be matched
+// there: the last frame before each word that follows speech, so that the word's start maps
+// to the pause's end and the word before holds over it. Speakers pause between words; at
+// every phoneme boundary it did worse (docs/align.md, "Live").
+std::vector<bool> pause_frames(const std::vector<tts::SpokenPhoneme>& phonemes, size_t offset,
+                               const Features& features);
+
+// How far snap_to_silence() moves a boundary at most, and how much silence it takes for an
+// edge, in ms.
+inline constexpr unsigned kSnapRadiusMs = 100;
+inline constexpr unsigned kMinSilenceMs = 20;
+
 // Moves each boundary next to a pause in `phonemes` (a start into a pause: speech ends; a
-// start out of one: speech begins) onto the nearest edge of silence in `audio` within 100 ms:
-// the warp matches a fading end of speech with the synthetic pause. `starts[k]` is phoneme
-// k + 1's start in samples of `audio` (phoneme 0 starts at 0). Silence: 5 ms blocks below the
-// recording's floor (its 10th-percentile block) + 20 dB, or below its loudest - 20 dB if that
-// is lower, for at least 20 ms.
+// start out of one: speech begins) onto the nearest edge of silence in `audio` within
+// kSnapRadiusMs: the warp matches a fading end of speech with the synthetic pause. `starts[k]`
+// is phoneme k + 1's start in samples of `audio` (phoneme 0 starts at 0). Silence: 5 ms
+// blocks below the recording's floor (its 10th-percentile block) + 20 dB, or below its
+// loudest - 20 dB if that is lower, for at least kMinSilenceMs.
 void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
                      std::span<const int16_t> audio, unsigned rate, std::vector<double>& starts);
 

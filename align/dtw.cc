@@ -17,11 +17,23 @@ float distance(std::span<const float> x, std::span<const float> y) {
   return std::isfinite(r) ? r : 1e6f;
 }
 
+}  // namespace
+
+float from_silence(std::span<const float> x) {
+  float sum = 0;
+  for (size_t k = 0; k < Features::kMfccs; ++k) sum += x[k] * x[k];
+  const float level = x[Features::kMfccs] + kLevelWeight;
+  const float r = std::sqrt(sum + level * level);
+  return std::isfinite(r) ? r : 1e6f;  // as distance()
+}
+
+namespace {
+
 enum Step : uint8_t { kDiagonal, kUp, kLeft };  // from (i-1, j-1), (i-1, j), (i, j-1)
 
 }  // namespace
 
-Warp warp(const Features& a, const Features& b, size_t max_cells) {
+Warp warp(const Features& a, const Features& b, size_t max_cells, const std::vector<bool>* rest) {
   const size_t n = a.n_frames, m = b.n_frames;
   // Row i covers columns [lo[i], hi[i]) about the diagonal's column i * m / n.
   size_t radius = std::max(n, m) / 2 + 1;
@@ -35,6 +47,11 @@ Warp warp(const Features& a, const Features& b, size_t max_cells) {
   }
   lo[0] = 0;
   hi[n - 1] = m;
+
+  // Each frame of `b`'s cost where `a` may hold a pause.
+  const bool pauses = rest != nullptr && rest->size() == n;
+  std::vector<float> silence(pauses ? m : 0);
+  for (size_t j = 0; j < silence.size(); ++j) silence[j] = from_silence(b.frame(j));
 
   constexpr float kInf = std::numeric_limits<float>::infinity();
   std::vector<std::vector<uint8_t>> steps(n);
@@ -54,6 +71,10 @@ Warp warp(const Features& a, const Features& b, size_t max_cells) {
         if (j > 0 && cur[j - 1] < best) best = cur[j - 1], step = kLeft;
       }
       cur[j] = best + d;
+      if (pauses && (*rest)[i] && j > lo[i] && cur[j - 1] + silence[j] < cur[j]) {
+        cur[j] = cur[j - 1] + silence[j];
+        steps[i][j - lo[i]] = kLeft;
+      }
       steps[i][j - lo[i]] = step;
     }
     std::swap(prev, cur);
@@ -68,14 +89,19 @@ Warp warp(const Features& a, const Features& b, size_t max_cells) {
   w.last[i] = j;
   for (;;) {
     w.first[i] = j;
-    path_cost += distance(a.frame(i), b.frame(j));
     ++path_length;
-    if (i == 0 && j == 0) break;
+    if (i == 0 && j == 0) {
+      path_cost += distance(a.frame(i), b.frame(j));
+      break;
+    }
     // Along the first row or column only one step leads back to (0, 0), whatever was stored.
     const Step step = i == 0                    ? kLeft
                       : j == 0                  ? kUp
                       : j >= lo[i] && j < hi[i] ? static_cast<Step>(steps[i][j - lo[i]])
                                                 : kUp;
+    // What the search counted: a pause held on a `rest` frame at its distance from silence.
+    const float d = distance(a.frame(i), b.frame(j));
+    path_cost += pauses && (*rest)[i] && step == kLeft ? std::min(d, silence[j]) : d;
     if (step == kLeft) {
       --j;
     } else {

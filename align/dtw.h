@@ -20,11 +20,18 @@ struct Warp {
   double relative_cost = 0;
 };
 
+// The distance of frame `x` from silence: MFCCs 0 (their mean), the level at its lowest.
+float from_silence(std::span<const float> x);
+
 // The path of least summed Euclidean distance from (0, 0) to (a.n_frames - 1,
 // b.n_frames - 1) with steps (1, 0), (0, 1) and (1, 1), searched within a band about the
 // diagonal wide enough for one sequence to run twice as fast as the other in places; the band
 // narrows for long inputs so that the search stays within max_cells cells (memory: one byte
-// each).
-Warp warp(const Features& a, const Features& b, size_t max_cells = size_t{64} << 20);
+// each). Where `rest` (one flag per frame of `a`; ignored if not as many) is true, the path
+// may stay on that frame of `a` over frames of `b` at their distance from silence instead: a
+// pause in `b` that `a` lacks (at the ends of `a`'s words: pause_frames() in boundaries.h).
+inline constexpr size_t kMaxWarpCells = size_t{64} << 20;
+Warp warp(const Features& a, const Features& b, size_t max_cells = kMaxWarpCells,
+          const std::vector<bool>* rest = nullptr);
 
 }  // namespace pfap::align

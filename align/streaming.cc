@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "boundaries.h"
+#include "dtw.h"  // from_silence
 #include "f0.h"
 
 namespace pfap::align {
@@ -27,8 +29,11 @@ size_t samples_of(unsigned ms, unsigned rate) { return size_t{ms} * rate / 1000;
 // last frame and at the synthetic frame j where the summed distance over rows + j is least (the
 // last frame when `closed`). Of the ends tried (docs/align.md, "Live"), this one gave the
 // least error: the mean over the path's own steps ran ahead into the speech, the plain sum
-// lagged behind it. For each synthetic frame up to `end`, the first and last recording frame
-// on the path (counted from r0, s0).
+// lagged behind it. On a synthetic frame where `rest` is true (the last before a word), the
+// path may stay over recording frames at their distance from silence: a pause the speaker
+// makes and the text's synthesis lacks costs nothing there, where without it the open end ran
+// on into the next words. For each synthetic frame up to `end`, the first and last recording
+// frame on the path (counted from r0, s0).
 struct OpenWarp {
   size_t end = 0;
   std::vector<size_t> first, last;
@@ -48,12 +53,13 @@ void silence_quiet_frames(Features& f) {
 }
 
 OpenWarp open_warp(const Features& rec, size_t r0, size_t rows, const Features& syn, size_t s0,
-                   size_t cols, bool closed) {
+                   size_t cols, const std::vector<bool>& rest, bool closed) {
   std::vector<float> d(rows * cols);      // the least summed distance from (0, 0) to each cell
   std::vector<size_t> back(rows * cols);  // the cell it came from
   constexpr float kInf = std::numeric_limits<float>::infinity();
   for (size_t r = 0; r < rows; ++r) {
     const std::span<const float> x = rec.frame(r0 + r);
+    const float silence = from_silence(x);
     for (size_t j = 0; j < cols; ++j) {
       const std::span<const float> y = syn.frame(s0 + j);
       float sum = 0;
@@ -68,6 +74,10 @@ OpenWarp open_warp(const Features& rec, size_t r0, size_t rows, const Features& 
       if (j > 0) consider(r * cols + j - 1);
       d[r * cols + j] = best + std::sqrt(sum);
       back[r * cols + j] = from;
+      if (r > 0 && rest[s0 + j] && d[(r - 1) * cols + j] + silence < d[r * cols + j]) {
+        d[r * cols + j] = d[(r - 1) * cols + j] + silence;
+        back[r * cols + j] = (r - 1) * cols + j;
+      }
     }
   }
   OpenWarp w;
@@ -108,6 +118,7 @@ bool StreamingAligner::start(const tts::Utterance& utterance, const tts::VoiceSe
     syn_.phonemes.assign(1, tts::SpokenPhoneme{pause_event(utterance), 0, 0});
     return true;
   }
+  to_phonetic_boundaries(syn_);
   // As align() does: silence before the synthetic speech matches the recording's lead-in;
   // the first phoneme (espeak-ng's short pause) takes it.
   const size_t pad = syn_.sample_rate / 10;
@@ -116,6 +127,7 @@ bool StreamingAligner::start(const tts::Utterance& utterance, const tts::VoiceSe
   for (size_t k = 1; k < syn_.phonemes.size(); ++k) syn_.phonemes[k].start += pad;
   synf_ = mfcc(syn_.samples, syn_.sample_rate);
   silence_quiet_frames(synf_);
+  rest_ = pause_frames(syn_.phonemes, 0, synf_);
   return true;
 }
 
@@ -153,7 +165,7 @@ void StreamingAligner::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
     const size_t rows = rec.n_frames - r0;
     const size_t s0 = synf_.frame_at(syn_settled_);
     const size_t cols = at_end ? synf_.n_frames - s0 : std::min(synf_.n_frames - s0, 3 * rows + 40);
-    const OpenWarp w = open_warp(rec, r0, rows, synf_, s0, cols, at_end);
+    const OpenWarp w = open_warp(rec, r0, rows, synf_, s0, cols, rest_, at_end);
     auto rec_centre = [&](size_t r) { return w0 + rec.centre(r0 + r); };
 
     // Where the synthetic sample `b` falls in the recording, as align()'s map_boundary; kNone
@@ -171,8 +183,9 @@ void StreamingAligner::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
     };
     while (next_ + 1 < syn_.phonemes.size()) {
       const size_t b = syn_.phonemes[next_ + 1].start;
-      const size_t at = map(b);
+      size_t at = map(b);
       if (at == kNone || at > horizon) break;
+      at = snap(next_ + 1, at);  // the lookahead holds the audio it looks at (streaming.h)
       syn_settled_ = b;
       emit(std::clamp(at, rec_settled_, n), true, out);
     }
@@ -202,6 +215,15 @@ void StreamingAligner::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
     rec_.erase(rec_.begin(), rec_.begin() + static_cast<std::ptrdiff_t>(keep_from - rec_first_));
     rec_first_ = keep_from;
   }
+}
+
+size_t StreamingAligner::snap(size_t k, size_t at) const {
+  const bool pause_before = syn_.phonemes[k - 1].event.phoneme.symbol == 0;
+  if (pause_before == (syn_.phonemes[k].event.phoneme.symbol == 0)) return at;  // no edge
+  const std::vector<tts::SpokenPhoneme> pair = {syn_.phonemes[k - 1], syn_.phonemes[k]};
+  std::vector<double> starts = {static_cast<double>(std::max(at, rec_first_) - rec_first_)};
+  snap_to_silence(pair, rec_, rate_, starts);
+  return rec_first_ + static_cast<size_t>(std::lround(starts[0]));
 }
 
 void StreamingAligner::emit(size_t to, bool whole, std::vector<tts::SpokenPhoneme>& out) {

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // Alignment of one utterance while its audio arrives, for live sources: the text is spoken by
-// espeak-ng once, and each time more audio has come, dynamic time warping with an open end
-// matches the audio since the last settled boundary to the synthetic speech that follows it.
+// espeak-ng once, its phoneme starts put in phonetic convention as align() puts them, and each
+// time more audio has come, dynamic time warping with an open end matches the audio since the
+// last settled boundary to the synthetic speech that follows it, a pause allowed between
+// words; boundaries next to a pause move onto the recording's edge of silence as in align().
 // A boundary is settled once kLookahead of audio follows it; a phoneme still going on
 // kLookahead + kHold before the newest audio is sent in pieces. So every phoneme (or piece)
 // is given out by the time kLookahead + kHold + kStep and one block of push() more audio
@@ -16,14 +18,18 @@
 #include <vector>
 
 #include "aligner.h"  // Problem
+#include "boundaries.h"
 #include "mfcc.h"
 #include "speech.h"
 #include "utterance.h"
 
 namespace pfap::align {
 
-// In ms. The audio after a boundary that the warp sees before the boundary is settled.
+// In ms. The audio after a boundary that the warp sees before the boundary is settled; it
+// holds the audio snap_to_silence() looks at after a boundary, so that a boundary is refined
+// as align() refines it before it is settled.
 inline constexpr unsigned kLookaheadMs = 200;
+static_assert(kLookaheadMs >= kSnapRadiusMs + kMinSilenceMs);
 // How long a phoneme still going on may wait past the settled point before a piece is sent.
 inline constexpr unsigned kHoldMs = 100;
 // The warp runs again once this much new audio has come.
@@ -57,6 +63,9 @@ class StreamingAligner {
 
  private:
   void step(bool at_end, std::vector<tts::SpokenPhoneme>& out);
+  // Phoneme k's start `at` (a sample of the utterance) moved as align() moves it next to a
+  // pause (snap_to_silence), on the audio kept.
+  size_t snap(size_t k, size_t at) const;
   // Gives out phoneme `next_` (or the rest of it) over [rec_settled_, to).
   void emit(size_t to, bool whole, std::vector<tts::SpokenPhoneme>& out);
 
@@ -64,6 +73,7 @@ class StreamingAligner {
   Problem problem_ = Problem::kNone;
   tts::Speech syn_;  // padded with silence at its start, as align() does
   Features synf_;
+  std::vector<bool> rest_;    // per frame of synf_: a pause may be matched here (open_warp)
   std::vector<int16_t> rec_;  // the utterance's audio from sample rec_first_ (what is needed)
   size_t rec_first_ = 0;
   float loudest_db_ = -100;    // the utterance's loudest frame so far

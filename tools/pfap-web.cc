@@ -12,7 +12,9 @@
 // their packets from the same running time, with timestamp offsets the server chooses and
 // tells the page on the WebSocket, so the page maps the audio it plays to PFAP time. The
 // WebSocket also carries the SDP offer and answer, ICE candidates, the texts to say and, at
-// the end of each, the sender's FAP state and counts (the page compares them with its own).
+// the end of each, the sender's FAP state and counts (the page compares them with its own),
+// and the speech's level, which the page finds in the audio it plays to know what it hears.
+#include <glib-unix.h>
 #include <gst/app/gstappsink.h>
 #include <gst/gst.h>
 #include <gst/rtp/gstrtpbuffer.h>
@@ -23,6 +25,9 @@
 #include <json-glib/json-glib.h>
 #include <libsoup/soup.h>
 
+#include <algorithm>
+#include <cmath>
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -32,6 +37,7 @@
 #include <mutex>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "launch_value.h"
 #include "pfap/model.h"
@@ -86,8 +92,10 @@ struct Session : std::enable_shared_from_this<Session> {
   GstElement* speaker = nullptr;  // the pfaptts bin of the text being said
   GstPad* speaker_mixer_pad = nullptr;
   bool channel_open = false;
+  bool playing = false;  // the page says it plays the audio track
+  bool audio_flowing = false;
   bool closed = false;
-  std::string pending_text;  // said when the channel opens or the current text ends
+  std::string pending_text;  // said when the audio starts or the current text ends
   uint32_t audio_ts_offset = 0;
   uint32_t pfap_ts_offset = 0;
 
@@ -169,6 +177,13 @@ void free_weak(gpointer data, GClosure*) { delete static_cast<std::weak_ptr<Sess
 
 // -- Signalling ---------------------------------------------------------------------------
 
+// With a promise: given none, webrtcbin 1.22 leaks the reply it would have given it.
+void set_description(GstElement* webrtc, const char* signal, GstWebRTCSessionDescription* sdp) {
+  GstPromise* promise = gst_promise_new();
+  g_signal_emit_by_name(webrtc, signal, sdp, promise);
+  gst_promise_unref(promise);
+}
+
 void on_offer_created(GstPromise* promise, gpointer data) {
   std::shared_ptr<Session> session = session_of(data);
   delete static_cast<std::weak_ptr<Session>*>(data);
@@ -182,7 +197,7 @@ void on_offer_created(GstPromise* promise, gpointer data) {
     if (offer != nullptr) gst_webrtc_session_description_free(offer);
     return;
   }
-  g_signal_emit_by_name(session->webrtc, "set-local-description", offer, nullptr);
+  set_description(session->webrtc, "set-local-description", offer);
   gchar* sdp = gst_sdp_message_as_text(offer->sdp);
   std::string text = sdp;
   g_free(sdp);
@@ -222,7 +237,7 @@ void set_answer(Session& s, const char* sdp_text) {
   }
   GstWebRTCSessionDescription* answer =
       gst_webrtc_session_description_new(GST_WEBRTC_SDP_TYPE_ANSWER, sdp);
-  g_signal_emit_by_name(s.webrtc, "set-remote-description", answer, nullptr);
+  set_description(s.webrtc, "set-remote-description", answer);
   gst_webrtc_session_description_free(answer);
 }
 
@@ -339,9 +354,81 @@ GstPadProbeReturn on_sink_gap(GstPad*, GstPadProbeInfo* info, gpointer data) {
   return GST_PAD_PROBE_OK;
 }
 
+// The speech's level, sent to the page as it leaves the speaker (up to a second before it is
+// played): the RMS of each millisecond at its running time, which the page finds again in the
+// audio it plays to learn which running time it is hearing (docs/web.md, Timing).
+struct Envelope {
+  std::weak_ptr<Session> session;
+  GstClockTime offset = 0;  // the speaker's pad offset: its running time in the pipeline's
+  GstClockTime start = GST_CLOCK_TIME_NONE;  // running time of levels[0]
+  std::vector<int64_t> levels;               // RMS of each ms, S16 units
+  double sum = 0.0;
+  int count = 0;
+};
+
+constexpr int kSamplesPerLevel = 48;  // 1 ms of the speaker's S16 mono at 48 kHz
+constexpr size_t kLevelsPerMessage = 50;
+
+void send_envelope(Envelope& e) {
+  if (e.levels.empty()) return;
+  const bool silent =
+      std::all_of(e.levels.begin(), e.levels.end(), [](int64_t v) { return v == 0; });
+  std::shared_ptr<Session> session = e.session.lock();
+  if (!silent && session != nullptr) {
+    post(session, [start = e.start, levels = e.levels](Session& s) {
+      JsonBuilder* b = message("envelope");
+      member(b, "runningTimeNs", static_cast<int64_t>(start));
+      json_builder_set_member_name(b, "rms");
+      json_builder_begin_array(b);
+      for (int64_t v : levels) json_builder_add_int_value(b, v);
+      json_builder_end_array(b);
+      finish(s, b);
+    });
+  }
+  e.start += e.levels.size() * GST_MSECOND;
+  e.levels.clear();
+}
+
+GstPadProbeReturn on_speech(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
+  auto& e = *static_cast<Envelope*>(data);
+  if ((info->type & GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM) != 0) {
+    if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) == GST_EVENT_EOS) send_envelope(e);
+    return GST_PAD_PROBE_OK;
+  }
+  GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+  if (e.start == GST_CLOCK_TIME_NONE) {
+    GstEvent* event = gst_pad_get_sticky_event(pad, GST_EVENT_SEGMENT, 0);
+    if (event == nullptr || !GST_BUFFER_PTS_IS_VALID(buffer)) {
+      if (event != nullptr) gst_event_unref(event);
+      return GST_PAD_PROBE_OK;
+    }
+    const GstSegment* segment = nullptr;
+    gst_event_parse_segment(event, &segment);
+    const GstClockTime running =
+        gst_segment_to_running_time(segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
+    gst_event_unref(event);
+    if (!GST_CLOCK_TIME_IS_VALID(running)) return GST_PAD_PROBE_OK;
+    e.start = running + e.offset;
+  }
+  GstMapInfo map;
+  if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) return GST_PAD_PROBE_OK;
+  const auto* samples = reinterpret_cast<const int16_t*>(map.data);
+  for (size_t i = 0; i < map.size / 2; ++i) {
+    e.sum += static_cast<double>(samples[i]) * samples[i];
+    if (++e.count == kSamplesPerLevel) {
+      e.levels.push_back(std::lround(std::sqrt(e.sum / kSamplesPerLevel)));
+      e.sum = 0.0;
+      e.count = 0;
+      if (e.levels.size() == kLevelsPerMessage) send_envelope(e);
+    }
+  }
+  gst_buffer_unmap(buffer, &map);
+  return GST_PAD_PROBE_OK;
+}
+
 // Starts saying `text` now, or after the text being said.
 void say(Session& s, const std::string& text) {
-  if (s.speaker != nullptr || !s.channel_open) {
+  if (s.speaker != nullptr || !s.audio_flowing) {
     s.pending_text = text;
     return;
   }
@@ -377,6 +464,17 @@ void say(Session& s, const std::string& text) {
   gst_object_unref(clock);
   gst_pad_set_offset(audio, static_cast<gint64>(now + kSpeakLead));
   gst_pad_set_offset(pfap, static_cast<gint64>(now + kSpeakLead));
+  // Its level, as early as the speaker makes it (the queue before the mixer fills ahead).
+  GstElement* queue = gst_bin_get_by_name(GST_BIN(speaker), "audio");
+  GstPad* queue_sink = gst_element_get_static_pad(queue, "sink");
+  auto* envelope = new Envelope;
+  envelope->session = s.weak_from_this();
+  envelope->offset = now + kSpeakLead;
+  gst_pad_add_probe(
+      queue_sink, GstPadProbeType(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM),
+      on_speech, envelope, [](gpointer data) { delete static_cast<Envelope*>(data); });
+  gst_object_unref(queue_sink);
+  gst_object_unref(queue);
 
   gst_bin_add(GST_BIN(s.pipeline), speaker);
   s.speaker = speaker;
@@ -393,18 +491,26 @@ void say(Session& s, const std::string& text) {
   finish(s, b);
 }
 
+// The audio flows, and the first text is said, once the data channel is open and the page
+// plays the audio track: what the pipeline made before would reach the browser's jitter
+// buffer before anything takes audio out of it, which then plays faster until it has caught
+// up (a first version lost 1 s of a 2.7 s text that way; docs/web.md).
+void start_when_ready(Session& s) {
+  if (!s.channel_open || !s.playing || s.audio_flowing) return;
+  s.audio_flowing = true;
+  GstElement* gate = gst_bin_get_by_name(GST_BIN(s.pipeline), "gate");
+  g_object_set(gate, "drop", FALSE, nullptr);
+  gst_object_unref(gate);
+  std::string text;
+  text.swap(s.pending_text);
+  if (!text.empty()) say(s, text);
+}
+
 void on_channel_open(GstWebRTCDataChannel*, gpointer data) {
   if (std::shared_ptr<Session> session = session_of(data)) {
     post(session, [](Session& s) {
       s.channel_open = true;
-      // The audio flows from now on: what came before the connection would reach the browser
-      // in a burst, which its jitter buffer then plays faster to catch up (lip sync lost).
-      GstElement* gate = gst_bin_get_by_name(GST_BIN(s.pipeline), "gate");
-      g_object_set(gate, "drop", FALSE, nullptr);
-      gst_object_unref(gate);
-      std::string text = s.pending_text.empty() ? std::string() : s.pending_text;
-      s.pending_text.clear();
-      if (!text.empty()) say(s, text);
+      start_when_ready(s);
     });
   }
 }
@@ -423,6 +529,7 @@ void request_complete(Session& s) {
 struct Server {
   Options options;
   int sessions = 0;
+  std::vector<std::weak_ptr<Session>> open;  // stopped when the server stops
 };
 
 gboolean on_bus(GstBus*, GstMessage* m, gpointer data) {
@@ -581,6 +688,9 @@ void on_ws_message(SoupWebsocketConnection*, gint type, GBytes* bytes, gpointer 
   } else if (std::strcmp(kind, "say") == 0) {
     const char* said = json_object_get_string_member_with_default(m, "text", "");
     if (*said != '\0') say(s, said);
+  } else if (std::strcmp(kind, "playing") == 0) {
+    s.playing = true;
+    start_when_ready(s);
   } else if (std::strcmp(kind, "complete") == 0) {
     request_complete(s);
   } else {
@@ -595,8 +705,11 @@ void on_ws_closed(SoupWebsocketConnection*, gpointer data) {
 
 void on_websocket(SoupServer*, SoupServerMessage*, const char*, SoupWebsocketConnection* ws,
                   gpointer data) {
-  std::shared_ptr<Session> session = open_session(*static_cast<Server*>(data), ws);
+  Server& server = *static_cast<Server*>(data);
+  std::shared_ptr<Session> session = open_session(server, ws);
   if (session == nullptr) return;
+  std::erase_if(server.open, [](const std::weak_ptr<Session>& s) { return s.expired(); });
+  server.open.push_back(session);
   // The connection's handlers own the session (released when they are disconnected).
   auto* holder = new std::shared_ptr<Session>(session);
   g_signal_connect_data(ws, "message", G_CALLBACK(on_ws_message), holder, nullptr,
@@ -687,6 +800,33 @@ int parse_options(int argc, char** argv, Options& o) {
   return 0;
 }
 
+// Ctrl-C or SIGTERM: each session's pipeline stops, its browser is told, and what the
+// sessions and the server hold is freed.
+void stop(Server& server, SoupServer* soup) {
+  for (const std::weak_ptr<Session>& weak : server.open) {
+    std::shared_ptr<Session> s = weak.lock();
+    if (s == nullptr) continue;
+    auto* ws = SOUP_WEBSOCKET_CONNECTION(g_object_ref(s->ws));
+    close_session(s);
+    s.reset();
+    // Its handlers hold the session: disconnecting them frees it.
+    g_signal_handlers_disconnect_matched(ws, G_SIGNAL_MATCH_FUNC, 0, 0, nullptr,
+                                         reinterpret_cast<gpointer>(on_ws_message), nullptr);
+    g_signal_handlers_disconnect_matched(ws, G_SIGNAL_MATCH_FUNC, 0, 0, nullptr,
+                                         reinterpret_cast<gpointer>(on_ws_closed), nullptr);
+    if (soup_websocket_connection_get_state(ws) == SOUP_WEBSOCKET_STATE_OPEN) {
+      soup_websocket_connection_close(ws, SOUP_WEBSOCKET_CLOSE_GOING_AWAY, "server stopped");
+    }
+    g_object_unref(ws);
+  }
+  server.open.clear();
+  soup_server_disconnect(soup);
+  g_object_unref(soup);
+  // What the closing left to do (the close frames, finalizing the connections).
+  while (g_main_context_iteration(nullptr, FALSE)) {
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -720,14 +860,27 @@ int main(int argc, char** argv) {
     g_object_unref(soup);
     return 1;
   }
-  GSList* uris = soup_server_get_uris(soup);
-  gchar* uri = g_uri_to_string(static_cast<GUri*>(uris->data));
-  g_print("pfap-web: open %s in a browser (Ctrl-C stops)\n", uri);
-  g_free(uri);
-  g_slist_free_full(uris, reinterpret_cast<GDestroyNotify>(g_uri_unref));
+  // The port from the listening socket (libsoup 3.2's soup_server_get_uris leaks an address).
+  GSList* listeners = soup_server_get_listeners(soup);
+  GSocketAddress* local = g_socket_get_local_address(G_SOCKET(listeners->data), nullptr);
+  g_slist_free(listeners);
+  const guint16 port =
+      local != nullptr ? g_inet_socket_address_get_port(G_INET_SOCKET_ADDRESS(local)) : 0;
+  if (local != nullptr) g_object_unref(local);
+  g_print("pfap-web: open http://127.0.0.1:%u/ in a browser (Ctrl-C stops)\n", port);
   GMainLoop* loop = g_main_loop_new(nullptr, FALSE);
+  auto quit = [](gpointer loop) -> gboolean {
+    g_main_loop_quit(static_cast<GMainLoop*>(loop));
+    return G_SOURCE_CONTINUE;  // removed below
+  };
+  const guint on_sigint = g_unix_signal_add(SIGINT, quit, loop);
+  const guint on_sigterm = g_unix_signal_add(SIGTERM, quit, loop);
   g_main_loop_run(loop);
+  g_source_remove(on_sigint);
+  g_source_remove(on_sigterm);
+  stop(server, soup);
   g_main_loop_unref(loop);
-  g_object_unref(soup);
+  gst_deinit();
+  g_print("pfap-web: stopped\n");
   return 0;
 }

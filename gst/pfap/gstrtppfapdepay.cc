@@ -249,9 +249,9 @@ static void drop_malformed(GstRtpPfapDepay* self, pfap::DecodeResult result, gui
 // x-pfap counts an event's FAPs in 16 bits, and only a payload over 393 KB holds more in one
 // phoneme or recovery list. Such a packet is dropped before the receiver sees it, so that
 // it counts as lost, like a malformed one.
-static bool fits_x_pfap(GstRtpPfapDepay* self, guint16 seqnum, std::span<const uint8_t> payload) {
+static bool fits_x_pfap(GstRtpPfapDepay* self, guint16 seqnum, size_t payload_size) {
   // Every FAP takes a descriptor on the wire: a smaller payload cannot hold too many.
-  if (payload.size() < (G_MAXUINT16 + 1) * pfap::kFapDescriptorBytes) return true;
+  if (payload_size < (G_MAXUINT16 + 1) * pfap::kFapDescriptorBytes) return true;
   const pfap::Packet& packet = self->stream->packet;
   size_t most = packet.recovery.size();
   for (size_t i = 0; i < packet.phonemes.size(); ++i) {
@@ -310,20 +310,42 @@ static void request_complete_state(GstRtpPfapDepay* self, guint16 seqnum) {
   update_stats(self, [](Stats& s) { ++s.requests; });
 }
 
+// Decodes the payload of `rtp` into the stream's packet. The base class maps only the RTP
+// header; gst_rtp_buffer_get_payload maps the payload as a range of the buffer, which costs
+// about twice as much as mapping the one memory that holds it (as in every packet from a
+// socket or from rtppfappay). A payload spread over memories takes the range path.
+static pfap::DecodeResult decode(GstRtpPfapDepay* self, GstRTPBuffer* rtp, size_t& size) {
+  size = gst_rtp_buffer_get_payload_len(rtp);
+  const guint offset = gst_rtp_buffer_get_header_len(rtp);
+  guint index = 0, count = 0;
+  gsize skip = 0;
+  GstMapInfo map;
+  if (size > 0 && gst_buffer_find_memory(rtp->buffer, offset, size, &index, &count, &skip) &&
+      count == 1) {
+    GstMemory* memory = gst_buffer_peek_memory(rtp->buffer, index);
+    if (gst_memory_map(memory, &map, GST_MAP_READ)) {
+      const pfap::DecodeResult result =
+          pfap::decode_payload({map.data + skip, size}, self->stream->packet);
+      gst_memory_unmap(memory, &map);
+      return result;
+    }
+  }
+  const auto* payload = static_cast<const uint8_t*>(gst_rtp_buffer_get_payload(rtp));
+  return pfap::decode_payload({payload, size}, self->stream->packet);
+}
+
 static GstBuffer* gst_rtp_pfap_depay_process_rtp_packet(GstRTPBaseDepayload* depay,
                                                         GstRTPBuffer* rtp) {
   GstRtpPfapDepay* self = GST_RTP_PFAP_DEPAY(depay);
   const guint16 seqnum = gst_rtp_buffer_get_seq(rtp);
-  const std::span<const uint8_t> payload(
-      static_cast<const uint8_t*>(gst_rtp_buffer_get_payload(rtp)),
-      gst_rtp_buffer_get_payload_len(rtp));
-  const pfap::DecodeResult result = pfap::decode_payload(payload, self->stream->packet);
+  size_t payload_size = 0;
+  const pfap::DecodeResult result = decode(self, rtp, payload_size);
   // Each path counts the packet in its one update of the stats.
   if (!result.ok()) {
     drop_malformed(self, result, seqnum);
     return nullptr;
   }
-  if (!fits_x_pfap(self, seqnum, payload)) {
+  if (!fits_x_pfap(self, seqnum, payload_size)) {
     update_stats(self, [](Stats& s) { ++s.packets; });
     return nullptr;
   }

@@ -113,13 +113,7 @@ ReceiveResult RecoveryReceiver::receive(const Packet& packet, uint16_t seqnum, i
   last_seqnum_ = seqnum;
 
   if (packet.recovery_kind == RecoveryKind::kComplete) {
-    // Only the settled values are compared, so only they are kept, not the whole state.
-    std::array<int32_t, kFapCount> before{};
-    for (int f = kMinFapIndex; f <= kMaxFapIndex; ++f) before[f] = state_.settled(f);
-    state_.apply_complete(packet.recovery, time_ns);
-    for (int f = kMinFapIndex; f <= kMaxFapIndex && !result.changed; ++f) {
-      result.changed = state_.settled(f) != before[f];
-    }
+    result.changed = state_.apply_complete(packet.recovery, time_ns);
     whole_ = true;
     result.recovery = ReceiveResult::Recovery::kComplete;
   } else if (result.lost > 0) {

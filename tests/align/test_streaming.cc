@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "boundaries.h"
 #include "speech_fixtures.h"
 #include "streaming.h"
 
@@ -71,8 +72,10 @@ TEST(Streaming, BoundaryErrorWithinTheLatencyBound) {
   std::vector<double> errors;
   for (const char* text : kSentences) {
     SCOPED_TRACE(text);
-    // espeak-ng at another rate and pitch, after 400 ms of silence and before 300 ms more.
-    const tts::Speech truth = say(text, {"en", 130, 25, 100});
+    // espeak-ng at another rate and pitch, after 400 ms of silence and before 300 ms more;
+    // its starts in the aligner's phonetic convention (boundaries.h).
+    tts::Speech truth = say(text, {"en", 130, 25, 100});
+    to_phonetic_boundaries(truth);
     const unsigned rate = truth.sample_rate;
     const size_t lead = rate * 2 / 5;
     std::vector<int16_t> audio(lead, 0);
@@ -93,6 +96,57 @@ TEST(Streaming, BoundaryErrorWithinTheLatencyBound) {
   ASSERT_GT(errors.size(), 100u);
   EXPECT_LT(percentile(errors, 0.5), 30);
   EXPECT_LT(percentile(errors, 0.9), 80);
+}
+
+// A speaker pausing where the text's synthesis runs on: 300 ms of near silence spliced into
+// espeak-ng's speech before "lay" and before "cool". Without the pause in the warp, the open
+// end ran on into the next words in it and settled them hundreds of ms early.
+TEST(Streaming, APauseTheTextLacksIsWaitedOut) {
+  const std::string text = "The lazy cow lay in the cool grass.";
+  tts::Speech truth = say(text, {"en", 130, 25, 100});
+  to_phonetic_boundaries(truth);
+  const unsigned rate = truth.sample_rate;
+  const size_t lead = rate * 2 / 5, pause = rate * 3 / 10;
+  std::vector<size_t> splices;  // the starts of the 4th and 7th words
+  size_t words = 0;
+  for (const tts::SpokenPhoneme& p : truth.phonemes) {
+    words += p.event.phoneme.word_begin ? 1 : 0;
+    if (p.event.phoneme.word_begin && (words == 4 || words == 7)) splices.push_back(p.start);
+  }
+  ASSERT_EQ(splices.size(), 2u);
+  std::vector<int16_t> audio(lead, 0);
+  uint32_t x = 1;
+  auto hiss = [&] {  // about -65 dBFS, as a quiet room
+    x = x * 1664525 + 1013904223;
+    return static_cast<int16_t>(static_cast<int>((x >> 16) % 64) - 32);
+  };
+  for (size_t i = 0; i < truth.samples.size(); ++i) {
+    if (std::find(splices.begin(), splices.end(), i) != splices.end()) {
+      for (size_t k = 0; k < pause; ++k) audio.push_back(hiss());
+    }
+    audio.push_back(truth.samples[i]);
+  }
+  audio.resize(audio.size() + rate * 3 / 10, 0);
+  for (tts::SpokenPhoneme& p : truth.phonemes) {
+    p.start += pause * static_cast<size_t>(std::count_if(splices.begin(), splices.end(),
+                                                         [&](size_t s) { return s <= p.start; }));
+  }
+  const auto got = merged(live(text, audio, rate), rate);
+  auto want = merged(truth.phonemes, rate, lead);
+  ASSERT_EQ(got.size(), want.size());
+  const double first_pause = static_cast<double>(lead + splices[0]) / rate;
+  double worst = 0;
+  size_t after = 0;
+  for (size_t k = 1; k < got.size(); ++k) {
+    EXPECT_EQ(got[k].first, want[k].first) << k;
+    if (want[k].second < first_pause) continue;
+    ++after;
+    worst = std::max(worst, std::abs(got[k].second - want[k].second) * 1000);
+  }
+  std::printf("live, pauses spliced in: %zu boundaries from the first, worst %.1f ms\n", after,
+              worst);
+  EXPECT_GT(after, 10u);
+  EXPECT_LT(worst, 50);
 }
 
 TEST(Streaming, BookmarksWordStartsAndStressOnTheFirstPieceOnly) {

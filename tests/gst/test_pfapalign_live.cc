@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "boundaries.h"
 #include "documented_commands.h"
 #include "markupbuffer.h"
 #include "pipeline.h"
@@ -132,8 +133,10 @@ void push_in_real_time(GstElement* pipeline, GstElement* src, const std::vector<
 }
 
 TEST(PfapAlignLive, DeclaresItsLatencyAndKeepsThePhonemesInSyncWithinIt) {
-  // 400 ms of silence, the utterance, 300 ms of silence.
-  const pfap::tts::Speech truth = say(kText, 130, 25);
+  // 400 ms of silence, the utterance, 300 ms of silence; its phoneme starts in the aligner's
+  // phonetic convention (align/boundaries.h).
+  pfap::tts::Speech truth = say(kText, 130, 25);
+  pfap::align::to_phonetic_boundaries(truth);
   const unsigned rate = truth.sample_rate;
   const size_t lead = rate * 2 / 5;
   std::vector<int16_t> audio(lead, 0);
@@ -166,8 +169,8 @@ TEST(PfapAlignLive, DeclaresItsLatencyAndKeepsThePhonemesInSyncWithinIt) {
   g_object_get(p.find("fakesink"), "processing-deadline", &deadline, nullptr);
   EXPECT_EQ(latency_of(p.get()), 20 * GST_MSECOND + kDeclared + deadline);
 
-  GstFlowReturn eos_ret = GST_FLOW_OK;
-  g_signal_emit_by_name(src, "end-of-stream", &eos_ret);
+  GstFlowReturn flow = GST_FLOW_OK;
+  g_signal_emit_by_name(src, "end-of-stream", &flow);
   ASSERT_EQ(p.wait_eos(10s), "");
   gst_element_set_state(p.get(), GST_STATE_NULL);
 
@@ -257,8 +260,8 @@ TEST(PfapAlignLive, WithoutTheTextRecognizesWithinTheSameLatency) {
   GstPad* pfap_pad = gst_element_get_static_pad(align, "pfap");
   EXPECT_EQ(latency_of(nullptr, pfap_pad), 20 * GST_MSECOND + kDeclared);
   gst_object_unref(pfap_pad);
-  GstFlowReturn eos_ret = GST_FLOW_OK;
-  g_signal_emit_by_name(src, "end-of-stream", &eos_ret);
+  GstFlowReturn flow = GST_FLOW_OK;
+  g_signal_emit_by_name(src, "end-of-stream", &flow);
   // The recognition takes most of a core: on a loaded machine, or with the sanitizers, it
   // falls behind the clock and ends well after the audio.
   ASSERT_EQ(p.wait_eos(120s, true), "");

@@ -229,6 +229,27 @@ TEST_F(RtpPfapDepayTest, PacketWithOnlyADtsTimesEveryPhonemeFromIt) {
   EXPECT_EQ(got[1].pts, t + 100 * GST_MSECOND);
 }
 
+TEST_F(RtpPfapDepayTest, PayloadSpreadOverMemoriesDecodesAsOne) {
+  // The depayloader maps the one memory that holds the payload; a payload spread over two
+  // takes the other path.
+  const Phoneme a{.symbol = 42, .duration_ms = 100, .f0 = 60};
+  const std::vector<Fap> faps = {{19, -1, 1, Curve::kLinear}, {3, 700, 40, Curve::kSpline}};
+  Packet packet;
+  packet.add_phoneme(a, faps);
+  const GstClockTime t = 2 * GST_SECOND;
+  start_stream(h_, 0, t);
+  GstBuffer* whole = rtp_packet(encode(packet), 1, t);
+  const gsize header = 12, size = gst_buffer_get_size(whole), half = (size - header) / 2;
+  GstBuffer* split = gst_buffer_copy_region(whole, GST_BUFFER_COPY_ALL, 0, header);
+  split = gst_buffer_append(
+      split, gst_buffer_copy_region(whole, GST_BUFFER_COPY_MEMORY, header, half));
+  split = gst_buffer_append(split, gst_buffer_copy_region(whole, GST_BUFFER_COPY_MEMORY,
+                                                          header + half, size - header - half));
+  gst_buffer_unref(whole);
+  ASSERT_EQ(gst_buffer_n_memory(split), 3u);
+  EXPECT_EQ(push(h_, split), std::vector<Event>{phoneme_event(a, faps, 0, t)});
+}
+
 TEST_F(RtpPfapDepayTest, SentenceStartComesOnlyFromTheMarkerBitOnTheFirstPhoneme) {
   const Phoneme p{.symbol = 1, .duration_ms = 10};
   Packet packet;

@@ -1,11 +1,15 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <ostream>
+#include <random>
+#include <span>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "pfap/fap_state.h"
 
@@ -280,6 +284,76 @@ TEST(FapState, ResetBringsEveryFapBackToZero) {
   }
   state.apply(make_fap(3, 1000, 1000, Curve::kLinear), kStart + 500 * kMs);
   EXPECT_EQ(state.amplitude(3, kStart + 500 * kMs), 0);
+}
+
+// ---- Complete states ----
+
+// What apply_complete must do, written the plain way: the settled values before, a reset,
+// each entry applied as a bookmark, and whether any settled value moved.
+bool apply_complete_by_reset(FapState& state, std::span<const Fap> entries, int64_t time_ns) {
+  std::array<int32_t, kFapCount> before{};
+  for (int f = kMinFapIndex; f <= kMaxFapIndex; ++f) before[f] = state.settled(f);
+  state.reset();
+  for (const Fap& entry : entries) state.apply(entry, time_ns);
+  bool changed = false;
+  for (int f = kMinFapIndex; f <= kMaxFapIndex; ++f) changed |= state.settled(f) != before[f];
+  return changed;
+}
+
+void expect_same_state(const FapState& a, const FapState& b, int64_t from_ns) {
+  for (int f = kMinFapIndex; f <= kMaxFapIndex; ++f) {
+    EXPECT_EQ(a.settled(f), b.settled(f)) << "FAP " << f;
+    for (int64_t t = from_ns; t <= from_ns + 2'000 * kMs; t += 250 * kMs) {
+      EXPECT_EQ(a.amplitude(f, t), b.amplitude(f, t)) << "FAP " << f << " at " << t;
+    }
+  }
+}
+
+// apply_complete takes entries in index order, as senders list them, in one pass, and any
+// other order or a FAP given twice the plain way: both must end where the plain way ends,
+// from any state, with any entries (some left out, some 0, some still moving, triangles).
+TEST(FapState, CompleteStateEndsWhereResetAndApplyEnd) {
+  std::mt19937 random(15);
+  const auto uniform = [&](int lo, int hi) {
+    return std::uniform_int_distribution(lo, hi)(random);
+  };
+  const auto random_fap = [&](int index) {
+    return make_fap(index, uniform(-3, 3) * 1000, static_cast<uint16_t>(uniform(0, 2) * 400),
+                    static_cast<Curve>(uniform(1, 3)));
+  };
+  for (int round = 0; round < 300; ++round) {
+    SCOPED_TRACE(round);
+    FapState state;
+    int64_t t = kStart;
+    for (int i = uniform(0, 40); i > 0; --i) {
+      t += uniform(0, 300) * kMs;
+      state.apply(random_fap(uniform(kMinFapIndex, kMaxFapIndex)), t);
+    }
+    t += uniform(-100, 300) * kMs;  // the complete state may come before a running start
+    std::vector<Fap> entries;
+    for (int f = kMinFapIndex; f <= kMaxFapIndex; ++f) {
+      if (uniform(0, 2) != 0) entries.push_back(random_fap(f));
+    }
+    if (round % 3 == 1 && entries.size() > 1) std::shuffle(entries.begin(), entries.end(), random);
+    if (round % 3 == 2 && !entries.empty()) entries.push_back(random_fap(entries[0].index));
+
+    FapState expected = state;
+    const bool expected_changed = apply_complete_by_reset(expected, entries, t);
+    EXPECT_EQ(state.apply_complete(entries, t), expected_changed);
+    expect_same_state(state, expected, t - 200 * kMs);
+  }
+}
+
+TEST(FapState, CompleteStateThatChangesNothingSaysSo) {
+  FapState state;
+  state.apply(make_fap(5, 300, 0, Curve::kLinear), kStart);
+  state.apply(make_fap(9, -20, 0, Curve::kSpline), kStart);
+  const std::vector<Fap> same = {make_fap(5, 300, 0, Curve::kLinear),
+                                 make_fap(9, -20, 0, Curve::kLinear)};
+  EXPECT_FALSE(state.apply_complete(same, kStart + 1'000 * kMs));
+  const std::vector<Fap> without_9 = {make_fap(5, 300, 0, Curve::kLinear)};
+  EXPECT_TRUE(state.apply_complete(without_9, kStart + 2'000 * kMs));
+  EXPECT_EQ(state.settled(9), 0);
 }
 
 // ---- Indexes ----

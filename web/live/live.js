@@ -6,11 +6,14 @@
 // Timing: the server stamps the audio and the PFAP packets from one running time r, as
 // audioTimestampOffset + r * 48000 and pfapTimestampOffset + r * 44100 (mod 2^32), and says
 // both offsets once ('timing'). The audio receiver's synchronization source gives the RTP
-// timestamp of the audio last played and when; from it the running time being played now,
-// and from that the PfapReceiver's stream time (ns since the first PFAP packet's timestamp).
+// timestamp of the audio last played and when, which says roughly which running time is heard
+// now; the level of the audio played, found in the level the server sends ('envelope',
+// clock.js), says exactly. From it the PfapReceiver's stream time (ns since the first PFAP
+// packet's timestamp).
 //
 // window.pfapStats holds the figures the browser test reads.
 import { PfapReceiver, Viseme, parseRtp } from '../src/index.js';
+import { SentLevel, matchLevels } from './clock.js';
 
 /**
  * Lip sync measured against the sound: each speech onset (the level passing 3 % of the
@@ -68,6 +71,13 @@ export function start({ canvas, audio, form, input, status, saying }) {
   let lastSequenceNumber = null;
   let audioReceiver = null;
   let audioContext = null;
+  // The running time (ms) heard at performance time t is t + mappingAt(t): from the
+  // synchronization source's readings until the played audio's level has been found in the
+  // sender's, then from that match and the jitter buffer's stretching since (docs/web.md).
+  const sent = new SentLevel();
+  const readings = [];  // [heard from, running time less heard time]
+  const stretches = [];  // [heard from, samples removed less inserted]
+  let matched = null;  // {m: running time less heard time, stretch: the stretch then}
   const phonemes = [];  // {timeNs, pressed}: which phoneme is drawn when (lip-sync measurement)
   let drawn = 0;  // the phoneme drawn last
 
@@ -120,8 +130,15 @@ export function start({ canvas, audio, form, input, status, saying }) {
     // Chromium feeds a remote track to Web Audio only while a media element plays it; the
     // element is muted, the speech heard through the AudioContext, whose tap sees it too.
     audio.srcObject = stream;
-    audio.play().catch(() => {});
     playThroughWebAudio(stream);
+    // The server starts the audio when it is played (tools/pfap-web.cc, start_when_ready).
+    // Browsers start an AudioContext only after a gesture on the page, unless allowed to.
+    const running = new Promise((resolve) => {
+      if (audioContext.state === 'running') resolve();
+      audioContext.onstatechange = () => audioContext.state === 'running' && resolve();
+    });
+    for (const gesture of ['pointerdown', 'keydown']) document.addEventListener(gesture, () => audioContext.resume());
+    Promise.all([audio.play(), running]).then(() => send({ type: 'playing' }), (e) => console.warn(e));
   };
   pc.ondatachannel = (e) => {
     e.channel.binaryType = 'arraybuffer';
@@ -162,6 +179,8 @@ export function start({ canvas, audio, form, input, status, saying }) {
       send({ type: 'answer', sdp: answer.sdp });
     } else if (m.type === 'ice') {
       await pc.addIceCandidate({ candidate: m.candidate, sdpMLineIndex: m.sdpMLineIndex });
+    } else if (m.type === 'envelope') {
+      sent.add(m.runningTimeNs, m.rms);
     } else if (m.type === 'saying') {
       ++stats.texts;
       stats.sender = null;
@@ -182,7 +201,7 @@ export function start({ canvas, audio, form, input, status, saying }) {
   };
 
   function playThroughWebAudio(stream) {
-    audioContext = new AudioContext({ latencyHint: 'interactive' });
+    audioContext = new AudioContext({ latencyHint: 'interactive', sampleRate: 48000 });
     const source = audioContext.createMediaStreamSource(stream);
     source.connect(audioContext.destination);
     audioContext.audioWorklet.addModule(new URL('./tap.js', import.meta.url)).then(() => {
@@ -195,24 +214,70 @@ export function start({ canvas, audio, form, input, status, saying }) {
         for (let i = 0; i < data.length; i += 2) {
           stats.envelope.push({ t: performanceTime + (data[i] - contextTime) * 1000, rms: data[i + 1] });
         }
+        matchHeard();
       };
     });
     audioContext.resume();
   }
 
+  // The output's latency, which the synchronization source's timestamp is before the sound.
+  const latencyMs = () => (audioContext.baseLatency + (audioContext.outputLatency || 0)) * 1000;
+
+  // The value of `history` ([from, value], in order) at heard time t.
+  const valueAt = (history, t, otherwise) => {
+    for (let i = history.length - 1; i >= 0; --i) if (history[i][0] <= t) return history[i][1];
+    return history.length > 0 ? history[0][1] : otherwise;
+  };
+  const remember = (history, from, value) => {
+    if (history.length === 0 || history.at(-1)[1] !== value) history.push([from, value]);
+    if (history.length > 1000) history.splice(0, 500);
+  };
+
+  function mappingAt(t) {
+    if (!matched) return valueAt(readings, t, null);
+    return matched.m + (valueAt(stretches, t, 0) - matched.stretch) / (timing.audioClockRate / 1000);
+  }
+
+  // The last 150 ms of the audio played, found in the sender's level (clock.js).
+  function matchHeard() {
+    const env = stats.envelope;
+    if (env.length === 0 || readings.length === 0) return;
+    const newest = env.at(-1).t;
+    const heard = [];
+    for (let i = env.length - 1; i >= 0 && env[i].t >= newest - 150; --i) {
+      heard.push({ x: env[i].t + mappingAt(env[i].t), rms: env[i].rms });
+    }
+    const lag = matchLevels(heard.reverse(), (ms) => sent.at(ms));
+    if (lag !== null) matched = { m: mappingAt(newest) + lag, stretch: valueAt(stretches, newest, 0) };
+  }
+
   // The PFAP stream time of the audio heard at performance time `now`, or null before the
   // audio and the PFAP stream have both begun.
   function streamNs(now) {
-    if (!timing || firstPfapTimestamp === null || !audioReceiver) return null;
+    if (!timing || firstPfapTimestamp === null || !audioReceiver || !audioContext) return null;
     const source = audioReceiver.getSynchronizationSources()[0];
     if (!source) return null;
-    const playedMs = performance.timeOrigin + now - source.timestamp;
-    const latencyMs = audioContext ? (audioContext.baseLatency + (audioContext.outputLatency || 0)) * 1000 : 0;
-    const running = ((source.rtpTimestamp - timing.audioTimestampOffset) >>> 0) / timing.audioClockRate +
-      (playedMs - latencyMs) / 1000;
+    // The chunk it names is heard from its timestamp plus the latency on; until then the
+    // readings before hold (they differ when the jitter buffer stretches the audio).
+    const heardFrom = source.timestamp - performance.timeOrigin + latencyMs();
+    const rtpMs = ((source.rtpTimestamp - timing.audioTimestampOffset) >>> 0) / timing.audioClockRate * 1000;
+    remember(readings, heardFrom, rtpMs - heardFrom);
+    const running = (now + mappingAt(now)) / 1000;
     const first = ((firstPfapTimestamp - timing.pfapTimestampOffset) >>> 0) / timing.pfapClockRate;
     return Math.round((running - first) * 1e9);
   }
+
+  // The jitter buffer's stretching (getStats), from when it is heard: a poll sees a change
+  // some time in the 25 ms before it, which is heard the output's latency later.
+  setInterval(async () => {
+    if (!audioReceiver || !audioContext) return;
+    const polled = performance.now();
+    (await audioReceiver.getStats()).forEach((v) => {
+      if (v.type !== 'inbound-rtp') return;
+      const net = (v.removedSamplesForAcceleration ?? 0) - (v.insertedSamplesForDeceleration ?? 0);
+      remember(stretches, polled - 12.5 + latencyMs(), net);
+    });
+  }, 25);
 
   const frame = (now) => {
     const ns = streamNs(now);

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // An AudioWorklet that taps the audio the page plays: the RMS of each millisecond, with the
-// AudioContext time of its first sample, posted to the page in batches (live.js finds the
-// speech onsets in it for the lip-sync measurement).
+// AudioContext time of its first sample, posted to the page every 10 ms (live.js finds it in
+// the level the server sent, to know which running time it hears, and finds the speech onsets
+// in it for the lip-sync measurement).
 class Tap extends AudioWorkletProcessor {
   constructor() {
     super();
@@ -24,7 +25,7 @@ class Tap extends AudioWorkletProcessor {
           this.count = 0;
         }
       }
-      if (this.out.length >= 100) {
+      if (this.out.length >= 20) {
         this.port.postMessage(this.out);
         this.out = [];
       }

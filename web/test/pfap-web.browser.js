@@ -41,7 +41,24 @@ after(async () => {
   await browser?.close();
 });
 
-// Starts pfap-web on a free port; resolves to {url, stop}.
+// Stops pfap-web with SIGTERM (as Ctrl-C would); resolves to its exit status, or to the
+// signal that ended it (SIGKILL after 10 s if SIGTERM did not).
+function stop(server) {
+  return new Promise((resolve) => {
+    if (server.exitCode !== null || server.signalCode !== null) {
+      resolve(server.exitCode ?? server.signalCode);
+      return;
+    }
+    const kill = setTimeout(() => server.kill('SIGKILL'), 10000);
+    server.once('exit', (code, signal) => {
+      clearTimeout(kill);
+      resolve(code ?? signal);
+    });
+    server.kill('SIGTERM');
+  });
+}
+
+// Starts pfap-web on a free port; resolves to {url, stop, log}.
 function startServer(args) {
   const server = spawn(process.env.PFAP_WEB, ['--port=0', `--web-dir=${webDir}`, ...args], {
     stdio: ['ignore', 'pipe', 'pipe'],
@@ -53,7 +70,7 @@ function startServer(args) {
     server.stdout.on('data', (d) => {
       log += d;
       const m = /open (http:\S+)/.exec(log);
-      if (m) resolve({ url: m[1], stop: () => server.kill(), log: () => log });
+      if (m) resolve({ url: m[1], stop: () => stop(server), log: () => log });
     });
   });
 }
@@ -100,14 +117,18 @@ async function openPage(url, { screenshot, next } = {}) {
 // Starts a server with `args`, opens `pages` pages on it at once; their figures.
 async function sessions(args, { pages = 1, screenshot, next } = {}) {
   const server = await startServer(args);
+  let all;
   try {
-    return await Promise.all(Array.from({ length: pages }, (_, i) =>
+    all = await Promise.all(Array.from({ length: pages }, (_, i) =>
       openPage(server.url, { screenshot: i === 0 ? screenshot : undefined, next: i === 0 ? next : undefined })));
   } catch (e) {
+    await server.stop();
     throw new Error(`${e.message}\nserver: ${server.log()}`);
-  } finally {
-    server.stop();
   }
+  // A clean stop: sessions closed, pipelines stopped, exit status 0 (and, in the sanitizer
+  // build, nothing leaked).
+  assert.equal(await server.stop(), 0, `pfap-web stopped by SIGTERM:\n${server.log()}`);
+  return all;
 }
 
 test('every phoneme arrives, in lip sync with the sound', async () => {
@@ -122,10 +143,14 @@ test('every phoneme arrives, in lip sync with the sound', async () => {
   assert.ok(s.uncertain === 0 || s.late > 0, `uncertain ${s.uncertain}, late ${s.late}`);
   assert.equal(s.fapStateMatchesSender, true);
   // The lip-sync figures go to docs/web.md (PFAP_LIPSYNC_OUT collects them); here only
-  // sanity: most onsets found, none beyond the pairing window.
+  // sanity: most onsets found, none beyond the pairing window, and their median no further
+  // than a few frames from the sound (per run it was +3 to +11 ms, docs/web.md).
   if (process.env.PFAP_LIPSYNC_OUT) writeFileSync(process.env.PFAP_LIPSYNC_OUT, JSON.stringify(s));
-  assert.ok(s.lipSyncErrorsMs.length >= 5, `onsets paired (of 10): ${JSON.stringify(s.lipSyncErrorsMs)}`);
-  for (const e of s.lipSyncErrorsMs) assert.ok(Math.abs(e) <= 150, `lip sync error ${e} ms`);
+  const errors = s.lipSyncErrorsMs;
+  assert.ok(errors.length >= 5, `onsets paired (of 10): ${JSON.stringify(errors)}`);
+  for (const e of errors) assert.ok(Math.abs(e) <= 150, `lip sync error ${e} ms`);
+  const median = [...errors].sort((a, b) => a - b)[Math.floor(errors.length / 2)];
+  assert.ok(median >= -20 && median <= 40, `median lip sync error ${median} ms: ${JSON.stringify(errors)}`);
 });
 
 test('with a tenth of the PFAP messages dropped the FAP state is repaired', async () => {

@@ -62,13 +62,10 @@ class FapState {
   // Every FAP back to 0 with no transition running, as after construction.
   void reset();
   // Takes a complete state (C=1) at `time_ns`: every FAP not among `entries` is 0, so the
-  // state is reset, then each entry applied.
-  void apply_complete(std::span<const Fap> entries, int64_t time_ns);
+  // state is reset, then each entry applied. Returns whether any settled value changed.
+  bool apply_complete(std::span<const Fap> entries, int64_t time_ns);
 
  private:
-  // apply(), inlined into apply_complete's loop over every FAP of a complete state.
-  void start_transition(const Fap& fap, int64_t start_ns);
-
   struct Track {
     int32_t from = 0;  // amplitude when the transition started
     int32_t target = 0;
@@ -78,6 +75,14 @@ class FapState {
     int64_t duration_ns = 0;
     Curve curve = Curve::kLinear;
   };
+  // The track of `fap` started at `start_ns` from amplitude `from`, where the FAP held `held`.
+  static Track transition(const Fap& fap, int64_t start_ns, int32_t from, int32_t held);
+  // apply() without its check: apply_complete's entries come checked by their decoder.
+  void start_transition(const Fap& fap, int64_t start_ns);
+  // apply_complete() for entries out of index order or with a FAP twice (the draft forbids
+  // neither): reset, then each entry in turn.
+  bool apply_complete_any_order(std::span<const Fap> entries, int64_t time_ns);
+
   std::array<Track, kFapCount> tracks_{};
 };
 

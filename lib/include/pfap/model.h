@@ -55,13 +55,16 @@ struct Phoneme {
   unsigned f0_hz() const { return 2u * f0; }
 };
 
-// Inline: the codec checks every descriptor, and a call each costs more than the check.
+// Inline: the codec checks every descriptor, and a call each costs more than the check. Each
+// range is one unsigned comparison (a value below the range wraps round to a large one).
 inline bool is_valid(const Fap& fap) {
-  const int32_t magnitude = fap.amplitude < 0 ? -fap.amplitude : fap.amplitude;
-  return fap.index >= kMinFapIndex && fap.index <= kMaxFapIndex && magnitude <= kMaxAmplitude &&
-         fap.transition_ms <= kMaxTransitionMs &&
-         (fap.curve == Curve::kLinear || fap.curve == Curve::kTriangle ||
-          fap.curve == Curve::kSpline);
+  const uint32_t magnitude = fap.amplitude < 0 ? 0u - static_cast<uint32_t>(fap.amplitude)
+                                               : static_cast<uint32_t>(fap.amplitude);
+  constexpr auto kFirstCurve = static_cast<unsigned>(Curve::kLinear);
+  constexpr auto kLastCurve = static_cast<unsigned>(Curve::kSpline);
+  return static_cast<unsigned>(fap.index - kMinFapIndex) <= unsigned{kMaxFapIndex - kMinFapIndex} &&
+         magnitude <= uint32_t{kMaxAmplitude} && fap.transition_ms <= kMaxTransitionMs &&
+         static_cast<unsigned>(fap.curve) - kFirstCurve <= kLastCurve - kFirstCurve;
 }
 inline bool is_valid(const Phoneme& phoneme) {
   return phoneme.duration_ms <= kMaxPhonemeDurationMs;

@@ -1,0 +1,87 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Which running time of the server's pipeline the page is hearing (docs/web.md, Timing).
+//
+// The audio receiver's synchronization source says which RTP timestamp was last handed to
+// playout and when, but what lies after it is the browser's and differs per session: the
+// jitter buffer's leftover of decoded audio (its reading names the packet just decoded, not
+// the first sample handed out), which changes each time it stretches or squeezes the audio,
+// and the queue between WebRTC's 10 ms chunks and Web Audio's render quanta. The server sends
+// the level of the speech it sends (the RMS of each millisecond, by running time); the page
+// finds the level of what it plays in it, and so learns the remaining lag.
+
+/**
+ * The sender's level by running time, from the server's "envelope" messages.
+ */
+export class SentLevel {
+  constructor({ keepMs = 30000 } = {}) {
+    this.keepMs = keepMs;
+    this.segments = [];  // {startMs, levels}, in running time order
+    this.found = null;  // the index of the segment found last
+  }
+
+  /** A message: `levels[i]` is the RMS of the ms from runningTimeNs / 1e6 + i. */
+  add(runningTimeNs, levels) {
+    const startMs = runningTimeNs / 1e6;
+    this.segments.push({ startMs, levels: Float64Array.from(levels) });
+    this.segments.sort((a, b) => a.startMs - b.startMs);
+    const newest = this.segments.at(-1).startMs;
+    while (this.segments.length > 1 && this.segments[0].startMs < newest - this.keepMs) this.segments.shift();
+    this.found = null;
+  }
+
+  /** The level at running time `ms` (between two blocks' starts, interpolated), 0 where none was sent. */
+  at(ms) {
+    // Lookups come in runs of nearby times: the segment found last first.
+    const near = this.found ?? this.segments.length - 1;
+    const i = this.segments[near] && this.segments[near].startMs <= ms &&
+      (near + 1 >= this.segments.length || ms < this.segments[near + 1].startMs)
+      ? near : this.segments.findLastIndex((seg) => seg.startMs <= ms);
+    if (i < 0) return 0;
+    this.found = i;
+    const { startMs, levels } = this.segments[i];
+    const x = ms - startMs;
+    const k = Math.floor(x);
+    if (k >= levels.length) return 0;
+    const next = k + 1 < levels.length ? levels[k + 1] : 0;
+    return levels[k] + (next - levels[k]) * (x - k);
+  }
+}
+
+/**
+ * The lag by which the played audio's level best matches the sender's: each heard 1 ms block,
+ * put at running time `x` by the synchronization source, was sent at x + lag. Searched in
+ * 1 ms steps within ±searchMs (Pearson correlation of the two levels), refined between steps
+ * by a parabola. Null unless the window holds at least `minSpeechMs` of sound, the best
+ * correlation reaches `minCorrelation` and lies inside the search range.
+ * @param {{x: number, rms: number}[]} heard
+ * @param {(ms: number) => number} sentAt
+ * @returns {number|null} ms
+ */
+export function matchLevels(heard, sentAt, { searchMs = 50, minCorrelation = 0.9, minSpeechMs = 20 } = {}) {
+  const peak = heard.reduce((m, h) => Math.max(m, h.rms), 0);
+  if (peak === 0 || heard.filter((h) => h.rms > peak * 0.1).length < minSpeechMs) return null;
+  const n = heard.length;
+  const meanA = heard.reduce((s, h) => s + h.rms, 0) / n;
+  let varA = 0;
+  for (const h of heard) varA += (h.rms - meanA) ** 2;
+  const correlation = (lag) => {
+    const b = heard.map((h) => sentAt(h.x + lag));
+    const meanB = b.reduce((s, v) => s + v, 0) / n;
+    let cov = 0;
+    let varB = 0;
+    for (let i = 0; i < n; ++i) {
+      cov += (heard[i].rms - meanA) * (b[i] - meanB);
+      varB += (b[i] - meanB) ** 2;
+    }
+    return varB > 0 ? cov / Math.sqrt(varA * varB) : -1;
+  };
+  const scores = [];
+  for (let lag = -searchMs; lag <= searchMs; ++lag) scores.push(correlation(lag));
+  let best = 0;
+  for (let i = 1; i < scores.length; ++i) if (scores[i] > scores[best]) best = i;
+  if (scores[best] < minCorrelation || best === 0 || best === scores.length - 1) return null;
+  const [l, c, r] = [scores[best - 1], scores[best], scores[best + 1]];
+  const curvature = l - 2 * c + r;
+  const step = curvature < 0 ? Math.max(-0.5, Math.min(0.5, (l - r) / (2 * curvature))) : 0;
+  return best - searchMs + step;
+}

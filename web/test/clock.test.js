@@ -1,0 +1,69 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// The page's audio clock (web/live/clock.js): the played audio's level found in the level the
+// server sent, at a lag known to the test; nothing found where nothing tells.
+import assert from 'node:assert/strict';
+import { test } from 'node:test';
+
+import { SentLevel, matchLevels } from '../live/clock.js';
+
+// "pa. pa. pa.": a sharp onset every 337 ms, a vowel that decays, silence between (S16 RMS).
+function speech(ms) {
+  return Array.from({ length: ms }, (_, i) => {
+    const k = i % 337;
+    return k < 120 ? Math.round(8000 * Math.exp(-k / 60) * (1 + 0.3 * Math.sin(k / 3))) : 0;
+  });
+}
+
+// What the page heard of `levels` sent from running time `startMs`: the window [fromMs,
+// toMs) of running time, each block put by a clock that is `lagMs` behind (x + lag is the
+// running time it was sent at), its level scaled and slightly noisy, as Opus leaves it.
+function heardOf(levels, startMs, fromMs, toMs, lagMs) {
+  const sent = new SentLevel();
+  sent.add(startMs * 1e6, levels);
+  const heard = [];
+  for (let x = fromMs; x < toMs; ++x) {
+    heard.push({ x: x - lagMs, rms: (sent.at(x) / 32768) * (1 + 0.02 * Math.sin(x * 7.1)) });
+  }
+  return heard;
+}
+
+test('SentLevel: the level at a running time, interpolated, 0 where nothing was sent', () => {
+  const sent = new SentLevel();
+  sent.add(10e6, [100, 200, 300]);
+  sent.add(20e6, [50]);
+  assert.equal(sent.at(10), 100);
+  assert.equal(sent.at(11.5), 250);
+  assert.equal(sent.at(12.5), 150);  // toward the 0 after the last block
+  assert.equal(sent.at(9.9), 0);
+  assert.equal(sent.at(13), 0);
+  assert.equal(sent.at(20), 50);
+});
+
+test('SentLevel keeps the last 30 s', () => {
+  const sent = new SentLevel();
+  sent.add(0, [1]);
+  sent.add(31000e6, [2]);
+  assert.equal(sent.at(0), 0);
+  assert.equal(sent.at(31000), 2);
+});
+
+test('matchLevels finds the lag at an onset, to a fraction of a millisecond', () => {
+  const levels = speech(2000);
+  const sent = new SentLevel();
+  sent.add(1000e6, levels);
+  for (const lag of [-37.5, -12.3, 0, 4.6, 21]) {
+    // 150 ms ending 40 ms into the third onset (at 674 ms), as the page has it then.
+    const found = matchLevels(heardOf(levels, 1000, 1000 + 674 - 110, 1000 + 674 + 40, lag), (ms) => sent.at(ms));
+    assert.ok(found !== null && Math.abs(found - lag) < 0.5, `lag ${lag}: found ${found}`);
+  }
+});
+
+test('matchLevels says nothing in silence, nor beyond its search range', () => {
+  const levels = speech(2000);
+  const sent = new SentLevel();
+  sent.add(0, levels);
+  assert.equal(matchLevels(heardOf(levels, 0, 150, 300, 5), (ms) => sent.at(ms)), null);  // silence
+  assert.equal(matchLevels(heardOf(levels, 0, 564, 714, 80), (ms) => sent.at(ms)), null);
+  // Nothing sent there: no match.
+  assert.equal(matchLevels(heardOf(levels, 0, 564, 714, 5), () => 0), null);
+});
