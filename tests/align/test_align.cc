@@ -19,6 +19,7 @@
 #include "features.h"
 #include "recognizer.h"
 #include "speech_fixtures.h"
+#include "white_noise.h"
 
 namespace pfap::align {
 namespace {
@@ -299,16 +300,6 @@ TEST(Aligner, RateOutsideTheFeaturesIsOnePause) {
   expect_tiles(a, audio.size(), 8000);
 }
 
-// White noise, `n` samples at about -15 dBFS.
-std::vector<int16_t> white_noise(size_t n, uint32_t seed) {
-  std::vector<int16_t> noise(n);
-  for (int16_t& v : noise) {
-    seed = seed * 1664525 + 1013904223;
-    v = static_cast<int16_t>(static_cast<int>((seed >> 16) % 16000) - 8000);
-  }
-  return noise;
-}
-
 TEST(Aligner, NoiseAndAnotherTextMatchPoorly) {
   const tts::Speech s = say(kSentences[0], {"en", 150, 40, 100});
   // The right text matches; another text, or noise, does not, yet still tiles the audio.
@@ -319,7 +310,7 @@ TEST(Aligner, NoiseAndAnotherTextMatchPoorly) {
       aligned(std::string(kSentences[1]) + " " + kSentences[2] + " " + kSentences[3], s.samples,
               s.sample_rate);
   const Alignment noisy =
-      aligned(kSentences[0], white_noise(s.samples.size(), 12345), s.sample_rate);
+      aligned(kSentences[0], pfap::testing::white_noise(s.samples.size(), 8000, 12345), s.sample_rate);
   std::printf("relative cost: right %.2f, three other sentences %.2f, noise %.2f\n",
               right.relative_cost, longer.relative_cost, noisy.relative_cost);
   EXPECT_EQ(longer.problem, Problem::kPoorMatch);  // the speech ratio
@@ -339,7 +330,7 @@ TEST(Aligner, NoiseAndAnotherTextMatchPoorly) {
 // tell them apart: not checked).
 TEST(Aligner, OnlyTheWrongTextOfTheSameLengthMatchesPoorly) {
   const tts::Speech s = say(kSentences[1], {"en-us", 140, 70, 100});
-  std::vector<int16_t> noisy = white_noise(s.samples.size(), 7);
+  std::vector<int16_t> noisy = pfap::testing::white_noise(s.samples.size(), 8000, 7);
   for (size_t k = 0; k < noisy.size(); ++k) {
     noisy[k] = static_cast<int16_t>(std::clamp(s.samples[k] + noisy[k] / 8, -32768, 32767));
   }

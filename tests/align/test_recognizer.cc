@@ -16,6 +16,7 @@
 
 #include "recognizer.h"
 #include "speech_fixtures.h"
+#include "white_noise.h"
 #include "viseme_frames.h"
 
 namespace pfap::align {
@@ -127,12 +128,7 @@ TEST(Recognizer, SilenceNoiseAndBadRatesAreOnePause) {
   EXPECT_EQ(r.problem, RecognitionProblem::kNoSpeech);
   EXPECT_EQ(r.phonemes.size(), 1u);
 
-  std::vector<int16_t> noise(32000);
-  uint32_t x = 1;
-  for (int16_t& v : noise) {
-    x = x * 1664525 + 1013904223;
-    v = static_cast<int16_t>(static_cast<int>((x >> 16) % 16000) - 8000);
-  }
+  const std::vector<int16_t> noise = pfap::testing::white_noise(32000);
   r = recognized(noise, 16000);
   EXPECT_EQ(r.problem, RecognitionProblem::kNothingHeard);
   expect_one_pause(r, noise.size(), 16000);
@@ -224,12 +220,7 @@ TEST(Recognizer, LiveSilenceNoiseAndBadRatesArePausesInPieces) {
   EXPECT_EQ(run.problem, RecognitionProblem::kNoSpeech);
   expect_pauses(run, silence.size(), 16000);
 
-  std::vector<int16_t> noise(3 * 16000);
-  uint32_t x = 1;
-  for (int16_t& v : noise) {
-    x = x * 1664525 + 1013904223;
-    v = static_cast<int16_t>(static_cast<int>((x >> 16) % 16000) - 8000);
-  }
+  const std::vector<int16_t> noise = pfap::testing::white_noise(3 * 16000);
   // Loud white noise is not "nothing heard" live, as it is on the whole (docs/align.md): the
   // cepstral mean starts from the model's, for speech, and the noise sounds like an HH. Still
   // a stream within the bound.

@@ -13,6 +13,7 @@
 
 #include "boundaries.h"
 #include "speech_fixtures.h"
+#include "white_noise.h"
 #include "streaming.h"
 
 namespace pfap::align {
@@ -178,12 +179,7 @@ TEST(Streaming, SilenceIsAPauseUntilTheSpeech) {
   StreamingAligner a;
   std::string error;
   ASSERT_TRUE(a.start(utterance("Hello world."), {}, 16000, error));
-  std::vector<int16_t> silence(32000);
-  uint32_t x = 1;
-  for (int16_t& v : silence) {
-    x = x * 1664525 + 1013904223;
-    v = static_cast<int16_t>((x >> 16) % 64) - 32;
-  }
+  const std::vector<int16_t> silence = pfap::testing::white_noise(32000, 32);
   std::vector<tts::SpokenPhoneme> out;
   for (size_t i = 0; i < silence.size(); i += 320) {
     a.push(std::span(silence).subspan(i, 320), out);

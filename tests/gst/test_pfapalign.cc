@@ -23,6 +23,7 @@
 #include "recognizer.h"
 #include "speech.h"
 #include "temp_dir.h"
+#include "white_noise.h"
 
 namespace {
 
@@ -207,12 +208,7 @@ TEST(PfapAlign, NoiseAndAnotherTextWarnOfAPoorMatch) {
           "dog. Peter Piper picked a peck of pickled peppers.");
   EXPECT_TRUE(has_warning(wrong, "poorly"));
   expect_tiles(wrong, gst_util_uint64_scale(s.samples.size(), GST_SECOND, s.sample_rate));
-  std::vector<int16_t> noise(s.samples.size());
-  uint32_t x = 1;
-  for (int16_t& v : noise) {
-    x = x * 1664525 + 1013904223;
-    v = static_cast<int16_t>(static_cast<int>((x >> 16) % 16000) - 8000);
-  }
+  const std::vector<int16_t> noise = pfap::testing::white_noise(s.samples.size());
   const Result noisy = run(noise, s.sample_rate, kText);
   expect_tiles(noisy, gst_util_uint64_scale(noise.size(), GST_SECOND, s.sample_rate));
   if (!pfap::align::recognition_available()) return;  // the cost alone: test_align.cc
@@ -256,12 +252,7 @@ TEST(PfapAlign, WithoutTextPhonemesAreRecognizedOrOnePause) {
 TEST(PfapAlign, WithoutTextBadInputWarnsAndIsOnePause) {
   if (!pfap::align::recognition_available()) GTEST_SKIP() << "no recognizer in this build";
   const std::vector<int16_t> silence(16000, 0);
-  std::vector<int16_t> noise(16000);
-  uint32_t x = 1;
-  for (int16_t& v : noise) {
-    x = x * 1664525 + 1013904223;
-    v = static_cast<int16_t>(static_cast<int>((x >> 16) % 16000) - 8000);
-  }
+  const std::vector<int16_t> noise = pfap::testing::white_noise(16000);
   const std::vector<std::tuple<std::vector<int16_t>, unsigned, const char*>> cases{
       {silence, 16000, "silent"},
       {noise, 16000, "no speech was recognized"},
@@ -283,12 +274,7 @@ TEST(PfapAlign, WithoutTextBadInputWarnsAndIsOnePause) {
 TEST(PfapAlign, WithoutTextLiveBadInputWarnsAndIsPauses) {
   if (!pfap::align::recognition_available()) GTEST_SKIP() << "no recognizer in this build";
   const std::vector<int16_t> silence(32000, 0);
-  std::vector<int16_t> noise(32000);
-  uint32_t x = 1;
-  for (int16_t& v : noise) {
-    x = x * 1664525 + 1013904223;
-    v = static_cast<int16_t>(static_cast<int>((x >> 16) % 16000) - 8000);
-  }
+  const std::vector<int16_t> noise = pfap::testing::white_noise(32000);
   const std::vector<std::tuple<std::vector<int16_t>, unsigned, const char*>> cases{
       {silence, 16000, "silent"},
       {noise, 8000, "8000 Hz cannot be aligned"},

@@ -132,6 +132,24 @@ void push_in_real_time(GstElement* pipeline, GstElement* src, const std::vector<
   gst_object_unref(clock);
 }
 
+// A live appsrc at `rate` into pfapalign live=true (with `text`, or none if empty), both its
+// outputs to fakesinks that sync to the clock.
+std::string live_pipeline(unsigned rate, const std::string& text) {
+  return "appsrc name=src is-live=true format=time min-latency=20000000 caps=\"audio/x-raw,"
+         "format=S16LE,layout=interleaved,channels=1,rate=" +
+         std::to_string(rate) + "\" ! pfapalign name=a live=true" +
+         (text.empty() ? "" : " text=\"" + text + "\"") +
+         " a.src ! queue ! fakesink sync=true a.pfap ! queue ! fakesink sync=true";
+}
+
+// Sets `p` (a live_pipeline) playing with `probes` on pfapalign's audio in and phonemes out.
+void play_probed(pfap::testing::Pipeline& p, Probes& probes) {
+  probes.pipeline = p.get();
+  probe(p.by_name("a"), "sink", Probes::on_audio, &probes);
+  probe(p.by_name("a"), "pfap", Probes::on_pfap, &probes);
+  ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+}
+
 TEST(PfapAlignLive, DeclaresItsLatencyAndKeepsThePhonemesInSyncWithinIt) {
   // 400 ms of silence, the utterance, 300 ms of silence; its phoneme starts in the aligner's
   // phonetic convention (align/boundaries.h).
@@ -143,19 +161,13 @@ TEST(PfapAlignLive, DeclaresItsLatencyAndKeepsThePhonemesInSyncWithinIt) {
   audio.insert(audio.end(), truth.samples.begin(), truth.samples.end());
   audio.resize(audio.size() + rate * 3 / 10, 0);
 
-  pfap::testing::Pipeline p(
-      "appsrc name=src is-live=true format=time min-latency=20000000 caps=\"audio/x-raw,"
-      "format=S16LE,layout=interleaved,channels=1,rate=" +
-      std::to_string(rate) + "\" ! pfapalign name=a live=true text=\"" + kText +
-      "\" a.src ! queue ! fakesink sync=true a.pfap ! queue ! fakesink sync=true");
+  pfap::testing::Pipeline p(live_pipeline(rate, kText));
   ASSERT_TRUE(p.ok()) << p.error();
   GstElement* src = p.by_name("src");
   GstElement* align = p.by_name("a");
   Probes probes;
-  probes.pipeline = p.get();
-  probe(align, "sink", Probes::on_audio, &probes);
-  probe(align, "pfap", Probes::on_pfap, &probes);
-  ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+  play_probed(p, probes);
+  if (::testing::Test::HasFatalFailure()) return;
 
   push_in_real_time(p.get(), src, audio, rate);
   if (::testing::Test::HasFatalFailure()) return;
@@ -241,20 +253,13 @@ TEST(PfapAlignLive, WithoutTheTextRecognizesWithinTheSameLatency) {
   audio.insert(audio.end(), truth.samples.begin(), truth.samples.end());
   audio.resize(audio.size() + rate * 3 / 10, 0);
 
-  pfap::testing::Pipeline p(
-      "appsrc name=src is-live=true format=time min-latency=20000000 caps=\"audio/x-raw,"
-      "format=S16LE,layout=interleaved,channels=1,rate=" +
-      std::to_string(rate) +
-      "\" ! pfapalign name=a live=true a.src ! queue ! fakesink sync=true a.pfap ! queue ! "
-      "fakesink sync=true");
+  pfap::testing::Pipeline p(live_pipeline(rate, ""));
   ASSERT_TRUE(p.ok()) << p.error();
   GstElement* src = p.by_name("src");
   GstElement* align = p.by_name("a");
   Probes probes;
-  probes.pipeline = p.get();
-  probe(align, "sink", Probes::on_audio, &probes);
-  probe(align, "pfap", Probes::on_pfap, &probes);
-  ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+  play_probed(p, probes);
+  if (::testing::Test::HasFatalFailure()) return;
   push_in_real_time(p.get(), src, audio, rate);
   if (::testing::Test::HasFatalFailure()) return;
   GstPad* pfap_pad = gst_element_get_static_pad(align, "pfap");
