@@ -58,9 +58,17 @@ struct LiveDecoder;  // a pocketsphinx decoder of the live pool (recognizer.cc)
 // audio goes to pocketsphinx as it arrives, and after every kStepMs of it the best path so far
 // is traced back; a phone is settled, and given out, once it ends at least kLookaheadMs before
 // the newest audio, and a phone still going on kLookaheadMs + kHoldMs before it is given out
-// in pieces, as StreamingAligner does: the same bound, so the same declared latency
-// (kLiveLatencyMs). pocketsphinx's utterance restarts at a pause once it is kRestartMs long
-// (its history grows with it). docs/align.md, "Live without the text".
+// in pieces, as StreamingAligner does: the same bound. pocketsphinx's utterance restarts at a
+// pause once it is kRestartMs long (its history grows with it). docs/align.md, "Live without
+// the text".
+class StreamingRecognizer;
+
+// What pfapalign declares in the LATENCY query when it recognizes live: the bound, as with a
+// text (kLiveLatencyMs), and 300 ms more for the search's own work, which takes a quarter of
+// real time in bursts (a step's traceback, an utterance's restart): phonemes came up to 577 ms
+// after their start by the clock on a lightly loaded machine (docs/align.md).
+inline constexpr unsigned kLiveRecognitionLatencyMs = kLiveLatencyMs + 300;
+
 class StreamingRecognizer {
  public:
   StreamingRecognizer() = default;

@@ -416,6 +416,16 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
 // the audio before the first; without any text, the recognizer's (align/recognizer.h) over
 // the whole stream.
 
+// Whether live audio is recognized: no text, neither the property nor a linked text_sink, and
+// a build with the recognizer.
+static bool live_recognizes(GstPfapAlign* self) {
+  GST_OBJECT_LOCK(self);
+  const bool has_property = self->text != nullptr;
+  GST_OBJECT_UNLOCK(self);
+  return !has_property && !gst_pad_is_linked(self->textpad) &&
+         pfap::align::recognition_available();
+}
+
 static GstFlowReturn live_push(GstPfapAlign* self,
                                const std::vector<pfap::tts::SpokenPhoneme>& phonemes) {
   return push_phonemes(self, phonemes, self->stream->utterance_from);
@@ -531,7 +541,7 @@ static GstFlowReturn live_chain(GstPfapAlign* self, GstBuffer* buffer) {
     const std::string property = has_property ? self->text : "";
     GST_OBJECT_UNLOCK(self);
     const bool from_pad = gst_pad_is_linked(self->textpad);
-    if (!from_pad && !has_property && pfap::align::recognition_available()) {
+    if (live_recognizes(self)) {
       ret = live_start_recognition(self);
     } else {
       if (!from_pad && !has_property) warn_cannot_recognize(self);
@@ -564,13 +574,15 @@ static GstFlowReturn live_end(GstPfapAlign* self) {
   return ret;
 }
 
-// The latency upstream's plus kLiveLatencyMs: when the phonemes of the audio come at the latest.
+// The latency upstream's plus ours: when the phonemes of the audio come at the latest.
 static gboolean live_latency_query(GstPfapAlign* self, GstQuery* query) {
   if (!gst_pad_peer_query(self->sinkpad, query)) return FALSE;
   gboolean live = FALSE;
   GstClockTime min = 0, max = GST_CLOCK_TIME_NONE;
   gst_query_parse_latency(query, &live, &min, &max);
-  const GstClockTime ours = pfap::align::kLiveLatencyMs * GST_MSECOND;
+  const GstClockTime ours = (live_recognizes(self) ? pfap::align::kLiveRecognitionLatencyMs
+                                                   : pfap::align::kLiveLatencyMs) *
+                            GST_MSECOND;
   GST_DEBUG_OBJECT(self, "upstream latency %" GST_TIME_FORMAT ", ours %" GST_TIME_FORMAT,
                    GST_TIME_ARGS(min), GST_TIME_ARGS(ours));
   gst_query_set_latency(query, live, min + ours,
@@ -903,15 +915,16 @@ static void gst_pfap_align_class_init(GstPfapAlignClass* klass) {
    *
    * Aligns (or, without a text, recognizes) as the audio comes, for live sources: each
    * phoneme goes out by the time 350 ms (and one upstream buffer) more than its start has
-   * come, and the LATENCY query says 400 ms more than upstream's (docs/align.md, "Live" and
-   * "Live without the text"). Off: the phonemes come when the audio ends, aligned on it
+   * come, and the LATENCY query says 400 ms more than upstream's, 700 ms when it recognizes
+   * (docs/align.md, "Live" and "Live without the text"). Off: the phonemes come when the audio ends, aligned on it
    * whole. Read when the element goes to PAUSED.
    */
   g_object_class_install_property(
       gobject_class, PROP_LIVE,
       g_param_spec_boolean("live", "Live",
                            "Align (or recognize) as the audio comes, each phoneme out within "
-                           "400 ms (the latency it declares), instead of when the audio ends",
+                           "the latency it declares (400 ms; 700 ms when it recognizes), "
+                           "instead of when the audio ends",
                            FALSE, kReady));
 
   gst_element_class_add_static_pad_template(element_class, &sink_template);
