@@ -145,12 +145,24 @@ std::string live_pipeline(unsigned rate, const std::string& text) {
          " a.src ! queue ! fakesink sync=true a.pfap ! queue ! fakesink sync=true";
 }
 
-// Sets `p` (a live_pipeline) playing with `probes` on pfapalign's audio in and phonemes out.
-void play_probed(pfap::testing::Pipeline& p, Probes& probes) {
+// An utterance as the live tests give it: kLeadMs of silence, the speech, kTailMs of silence.
+constexpr unsigned kLeadMs = 400, kTailMs = 300;
+std::vector<int16_t> with_silence_around(const std::vector<int16_t>& speech, unsigned rate) {
+  std::vector<int16_t> audio(rate * kLeadMs / 1000, 0);
+  audio.insert(audio.end(), speech.begin(), speech.end());
+  audio.resize(audio.size() + rate * kTailMs / 1000, 0);
+  return audio;
+}
+
+// Sets `p` (a live_pipeline) playing with `probes` on pfapalign's audio in and phonemes out,
+// and pushes `audio` in real time.
+void play_live(pfap::testing::Pipeline& p, Probes& probes, const std::vector<int16_t>& audio,
+               unsigned rate) {
   probes.pipeline = p.get();
   probe(p.by_name("a"), "sink", Probes::on_audio, &probes);
   probe(p.by_name("a"), "pfap", Probes::on_pfap, &probes);
   ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+  push_in_real_time(p.get(), p.by_name("src"), audio, rate);
 }
 
 TEST(PfapAlignLive, DeclaresItsLatencyAndKeepsThePhonemesInSyncWithinIt) {
@@ -159,20 +171,15 @@ TEST(PfapAlignLive, DeclaresItsLatencyAndKeepsThePhonemesInSyncWithinIt) {
   pfap::tts::Speech truth = say(kText, 130, 25);
   pfap::align::to_phonetic_boundaries(truth);
   const unsigned rate = truth.sample_rate;
-  const size_t lead = rate * 2 / 5;
-  std::vector<int16_t> audio(lead, 0);
-  audio.insert(audio.end(), truth.samples.begin(), truth.samples.end());
-  audio.resize(audio.size() + rate * 3 / 10, 0);
+  const size_t lead = rate * kLeadMs / 1000;
+  const std::vector<int16_t> audio = with_silence_around(truth.samples, rate);
 
   pfap::testing::Pipeline p(live_pipeline(rate, kText));
   ASSERT_TRUE(p.ok()) << p.error();
   GstElement* src = p.by_name("src");
   GstElement* align = p.by_name("a");
   Probes probes;
-  play_probed(p, probes);
-  if (::testing::Test::HasFatalFailure()) return;
-
-  push_in_real_time(p.get(), src, audio, rate);
+  play_live(p, probes, audio, rate);
   if (::testing::Test::HasFatalFailure()) return;
 
   // The latency: appsrc's 20 ms and pfapalign's stated kLiveLatencyMs, on its pad and for the
@@ -253,18 +260,14 @@ TEST(PfapAlignLive, WithoutTheTextRecognizesWithinTheSameBoundAndDeclaresMore) {
   if (!pfap::align::recognition_available()) GTEST_SKIP() << "no recognizer in this build";
   const pfap::tts::Speech truth = say(kText, 130, 25);
   const unsigned rate = truth.sample_rate;
-  std::vector<int16_t> audio(rate * 2 / 5, 0);
-  audio.insert(audio.end(), truth.samples.begin(), truth.samples.end());
-  audio.resize(audio.size() + rate * 3 / 10, 0);
+  const std::vector<int16_t> audio = with_silence_around(truth.samples, rate);
 
   pfap::testing::Pipeline p(live_pipeline(rate, ""));
   ASSERT_TRUE(p.ok()) << p.error();
   GstElement* src = p.by_name("src");
   GstElement* align = p.by_name("a");
   Probes probes;
-  play_probed(p, probes);
-  if (::testing::Test::HasFatalFailure()) return;
-  push_in_real_time(p.get(), src, audio, rate);
+  play_live(p, probes, audio, rate);
   if (::testing::Test::HasFatalFailure()) return;
   GstPad* pfap_pad = gst_element_get_static_pad(align, "pfap");
   EXPECT_EQ(latency_of(nullptr, pfap_pad), 20 * GST_MSECOND + kDeclaredRecognizing);
