@@ -200,8 +200,6 @@ void give_back(LiveDecoder* d) {
 }  // namespace
 #endif
 
-namespace {}  // namespace
-
 uint8_t arpabet_symbol(std::string_view cmu_phone) {
   static const PhonemeAlphabet& arpabet = *find_alphabet(kArpabetAlphabet);
   // "pause" is x-pfap-arpabet's name for 0, never a CMU phone.
