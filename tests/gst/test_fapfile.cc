@@ -163,6 +163,19 @@ TEST(FapParse, BadFilesAreErrorsNamingFileLineAndField) {
   }
 }
 
+// Issue 27: a UTF-8 byte order mark before a FAP file was "unsupported version".
+TEST(FapParse, ByteOrderMarkAtTheStartIsSkipped) {
+  ASSERT_TRUE(plugin_available(kElements));
+  TempDir dir;
+  std::string mask = "0 0 1";
+  for (int i = 4; i <= 68; ++i) mask += " 0";
+  const std::string bom = "\xEF\xBB\xBF";
+  EXPECT_EQ(error_of(bom + "2.1 t 25 1\n" + mask + "\n0 5\n", dir), "");
+  // Only at the start: later, it is a bad field.
+  EXPECT_NE(error_of("2.1 t 25 1\n" + bom + mask + "\n0 5\n", dir).find("line 2, field 1"),
+            std::string::npos);
+}
+
 TEST(FapParse, VisemesAreReportedNotSilentlyLost) {
   ASSERT_TRUE(plugin_available(kElements));
   TempDir dir;
