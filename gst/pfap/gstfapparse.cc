@@ -27,14 +27,15 @@
  * spans a frame with changes is split there into pieces of the same symbol, and silence
  * phonemes carry only the frames where no one speaks. Both are timed from their segment's
  * start. The two inputs are kept until both have ended (at most 100000 speech events), then
- * the merged stream goes out; the caps take the speech's alphabet when it has one.
+ * the merged stream goes out, merged a window of at least 4096 file events at a time; the caps
+ * take the speech's alphabet when it has one.
  *
  * A bad file (an unsupported version, a mask without 68 flags, a value past the draft's
  * amplitude range, frame numbers out of order, an absurd frame count or rate, fewer frames
  * than the header says) is an error naming the file, its line, field and FAP: a FAP file's
  * frames depend on the lines before, so there is nothing to skip to. The limits against
  * hostile files are those of pfap/fap_file.h: lines of at most 64 KiB, 360000 frames, 1 to
- * 1000 frames a second.
+ * 1000 frames a second. A UTF-8 byte order mark at the start of the file is skipped.
  *
  * ## Example pipelines
  * |[

@@ -24,7 +24,9 @@
  * the viseme alphabets pfapmarksparse makes); a phoneme with no known viseme is written as a
  * half-open mouth, with a warning. Times are ms from the first event, as pfaptextenc's.
  * Marks come out per utterance (at each end of text), Rhubarb JSON as one document at EOS,
- * blendshape frames as time passes. A malformed buffer is dropped with a warning.
+ * blendshape frames as time passes. Once nothing moves, frames go on for 1 s of rest at most;
+ * the frames after a longer rest keep their times, with a warning (the 1st, 2nd, 4th, ...), so
+ * that a gap costs no more frames. A malformed buffer is dropped with a warning.
  *
  * ## Example pipelines
  * |[
