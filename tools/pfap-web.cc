@@ -47,6 +47,7 @@
 
 #include "launch_value.h"
 #include "pfap-web-signal.h"
+#include "pfap-web-stun.h"
 #include "pfap/model.h"
 #include "pfap/payload.h"
 #include "pfap/recovery.h"
@@ -582,6 +583,10 @@ struct Server {
   uint64_t foreign_origins = 0;
   uint64_t full = 0;
   uint64_t not_connected = 0;
+  // The STUN server the page is given (pfap-web-stun.h).
+  GSocket* stun = nullptr;
+  GSource* stun_source = nullptr;
+  guint16 stun_port = 0;
 };
 
 // Logs a refusal of a kind that a client can repeat at will, rate-limited: `count` counts
@@ -755,6 +760,7 @@ std::shared_ptr<Session> open_session(Server& server, SoupWebsocketConnection* w
   member(b, "pfapClockRate", kPfapClockRate);
   member(b, "pfapTimestampOffset", s->pfap_ts_offset);
   member(b, "drop", static_cast<int64_t>(server.options.drop * 1000));
+  member(b, "stunPort", server.stun_port);
   finish(*s, b);
 
   gst_element_set_state(s->pipeline, GST_STATE_PLAYING);
@@ -837,6 +843,64 @@ void on_websocket(SoupServer*, SoupServerMessage*, const char*, SoupWebsocketCon
       ws, "closed", G_CALLBACK(on_ws_closed), holder,
       [](gpointer d, GClosure*) { delete static_cast<std::shared_ptr<Session>*>(d); },
       GConnectFlags(0));
+}
+
+// -- STUN ---------------------------------------------------------------------------------
+
+// A datagram on the STUN socket: a binding request is answered, anything else dropped.
+gboolean on_stun(GSocket* socket, GIOCondition, gpointer) {
+  uint8_t buffer[548];  // RFC 8489's smallest MTU's worth; a longer request is cut, dropped
+  GSocketAddress* from = nullptr;
+  const gssize n = g_socket_receive_from(socket, &from, reinterpret_cast<gchar*>(buffer),
+                                         sizeof buffer, nullptr, nullptr);
+  if (n >= 0 && from != nullptr && G_IS_INET_SOCKET_ADDRESS(from)) {
+    auto* inet = G_INET_SOCKET_ADDRESS(from);
+    GInetAddress* address = g_inet_socket_address_get_address(inet);
+    if (g_inet_address_get_family(address) == G_SOCKET_FAMILY_IPV4) {
+      const guint8* a = g_inet_address_to_bytes(address);
+      const uint32_t ipv4 = static_cast<uint32_t>(a[0]) << 24 | static_cast<uint32_t>(a[1]) << 16 |
+                            static_cast<uint32_t>(a[2]) << 8 | a[3];
+      const auto response =
+          pfap_web::stun_binding_response(std::span<const uint8_t>(buffer, static_cast<size_t>(n)),
+                                          ipv4, g_inet_socket_address_get_port(inet));
+      if (response.has_value()) {
+        g_socket_send_to(socket, from, reinterpret_cast<const gchar*>(response->data()),
+                         response->size(), nullptr, nullptr);
+      }
+    }
+  }
+  if (from != nullptr) g_object_unref(from);
+  return G_SOURCE_CONTINUE;
+}
+
+// Listens for STUN on 127.0.0.1, UDP, on the HTTP port's number if it is free, else on any.
+// False when it cannot.
+bool start_stun(Server& server, guint16 http_port) {
+  GSocket* socket =
+      g_socket_new(G_SOCKET_FAMILY_IPV4, G_SOCKET_TYPE_DATAGRAM, G_SOCKET_PROTOCOL_UDP, nullptr);
+  if (socket == nullptr) return false;
+  GInetAddress* loopback = g_inet_address_new_loopback(G_SOCKET_FAMILY_IPV4);
+  bool bound = false;
+  for (const guint16 port : {http_port, guint16{0}}) {
+    GSocketAddress* address = g_inet_socket_address_new(loopback, port);
+    bound = g_socket_bind(socket, address, FALSE, nullptr);
+    g_object_unref(address);
+    if (bound) break;
+  }
+  g_object_unref(loopback);
+  GSocketAddress* local = bound ? g_socket_get_local_address(socket, nullptr) : nullptr;
+  if (local == nullptr) {
+    g_object_unref(socket);
+    return false;
+  }
+  server.stun_port = g_inet_socket_address_get_port(G_INET_SOCKET_ADDRESS(local));
+  g_object_unref(local);
+  g_socket_set_blocking(socket, FALSE);
+  server.stun = socket;
+  server.stun_source = g_socket_create_source(socket, G_IO_IN, nullptr);
+  g_source_set_callback(server.stun_source, G_SOURCE_FUNC(on_stun), nullptr, nullptr);
+  g_source_attach(server.stun_source, nullptr);
+  return true;
 }
 
 // -- HTTP ---------------------------------------------------------------------------------
@@ -1002,6 +1066,9 @@ void stop(Server& server, SoupServer* soup) {
     g_object_unref(ws);
   }
   server.open.clear();
+  g_source_destroy(server.stun_source);
+  g_source_unref(server.stun_source);
+  g_object_unref(server.stun);
   soup_server_disconnect(soup);
   g_object_unref(soup);
   // What the closing left to do (the close frames, finalizing the connections).
@@ -1050,6 +1117,12 @@ int main(int argc, char** argv) {
   const guint16 port =
       local != nullptr ? g_inet_socket_address_get_port(G_INET_SOCKET_ADDRESS(local)) : 0;
   if (local != nullptr) g_object_unref(local);
+  if (!start_stun(server, port)) {
+    std::fprintf(stderr, "pfap-web: cannot listen for STUN on 127.0.0.1 (UDP)\n");
+    soup_server_disconnect(soup);
+    g_object_unref(soup);
+    return 1;
+  }
   server.origins = {"http://127.0.0.1:" + std::to_string(port),
                     "http://localhost:" + std::to_string(port)};
   server.origins.insert(server.origins.end(), server.options.allowed_origins.begin(),

@@ -3,9 +3,12 @@
 // never crashes, and either refuses the message with a short reason of its own (never the
 // message's bytes, which go back to the page) or gives a message that fits the schema: the
 // strings within their limits and UTF-8, an SDP answer not empty. A message that is taken is
-// taken again the same when read a second time.
+// taken again the same when read a second time. The same bytes go to its STUN server
+// (tools/pfap-web-stun.h) as a datagram: it answers only a well-formed binding request, with
+// a success response of 32 bytes carrying the request's cookie and transaction ID.
 #include <glib.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -13,6 +16,7 @@
 
 #include "fuzz_check.h"
 #include "pfap-web-signal.h"
+#include "pfap-web-stun.h"
 
 namespace {
 
@@ -25,9 +29,18 @@ bool utf8(const std::string& s) {
   return g_utf8_validate(s.data(), static_cast<gssize>(s.size()), nullptr);
 }
 
+void check_stun(const uint8_t* data, size_t size) {
+  const auto response = pfap_web::stun_binding_response({data, size}, 0x7f000001, 40000);
+  if (!response.has_value()) return;
+  FUZZ_CHECK(size >= 20 && data[0] == 0 && data[1] == 1);
+  FUZZ_CHECK(response->size() == 32);
+  FUZZ_CHECK(std::equal(data + 4, data + 20, response->begin() + 4));
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  check_stun(data, size);
   const std::string_view message(reinterpret_cast<const char*>(data), size);
   pfap_web::Signal signal;
   std::string error;
