@@ -67,10 +67,11 @@ constexpr GstClockTime kSpeakLead = 300 * GST_MSECOND;
 // PFAP packets go this far ahead of their time: the page holds their events until the audio
 // reaches them, and what comes late is drawn late.
 constexpr GstClockTimeDiff kPfapLead = 400 * GST_MSECOND;
-// The file descriptors one session takes at most (measured: docs/security.md), and those kept
-// for the server itself (its listening socket, the page's HTTP connections, GLib's and
-// GStreamer's own) when the session cap is derived from the limit.
-constexpr int kFdsPerSession = 16;
+// The file descriptors one session takes at most (measured, docs/security.md: 16 waiting for
+// the answer, up to 24.1 connected and speaking), and those kept for the server itself (its
+// listening sockets, the page's HTTP connections, GLib's and GStreamer's own) when the
+// session cap is derived from the limit.
+constexpr int kFdsPerSession = 25;
 constexpr int kReservedFds = 64;
 
 struct Options {

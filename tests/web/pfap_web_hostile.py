@@ -275,7 +275,7 @@ class Hostile(unittest.TestCase):
     def test_the_cap_follows_the_open_file_limit(self):
         # Room for 3 sessions beside the reserve: the 4th and later are refused, and the
         # server, which aborted when the descriptors ran out, goes on.
-        per_session, reserve = 16, 64
+        per_session, reserve = 25, 64  # kFdsPerSession, kReservedFds
         server = Server(nofile=reserve + 3 * per_session + per_session // 2)
         try:
             self.assertIn(b'at most 3 sessions at once', server.out)
