@@ -169,10 +169,17 @@ async def main():
             peak[1] = max(peak[1], len(os.listdir(f'/proc/{server.pid}/task')))
             await asyncio.sleep(0.05)
 
+    def cpu_s():
+        fields = open(f'/proc/{server.pid}/stat').read().rsplit(')', 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
     sampler = asyncio.ensure_future(sample())
     start = time.monotonic()
+    cpu_start = cpu_s()
     results = await asyncio.gather(*(session(port, i + 1, 60) for i in range(sessions)))
     took = time.monotonic() - start
+    cpu = cpu_s() - cpu_start
+    rss_peak = open(f'/proc/{server.pid}/status').read().split('VmHWM:')[1].split('\n')[0].strip()
     sampler.cancel()
     server.terminate()
     out, err = server.communicate(timeout=30)
@@ -185,7 +192,8 @@ async def main():
     good = sum(whole(r) for r in results)
     print(f'pfap-web: {base[0]} file descriptors and {base[1]} threads alone, at most {peak[0]} '
           f'and {peak[1]} with the sessions ({(peak[0] - base[0]) / sessions:.1f} and '
-          f'{(peak[1] - base[1]) / sessions:.1f} per session)')
+          f'{(peak[1] - base[1]) / sessions:.1f} per session); CPU {cpu:.2f} s in {took:.1f} s '
+          f'({cpu / took / sessions * 100:.1f} % of a core per session); peak RSS {rss_peak}')
     print(f'{good} of {sessions} sessions whole in {took:.1f} s; pfap-web exited {server.returncode}')
     if good != sessions or server.returncode != 0:
         print(err[-2000:], file=sys.stderr)
