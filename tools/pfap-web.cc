@@ -18,7 +18,8 @@
 // What a page sends is checked against its schema before anything acts on it
 // (pfap-web-signal.h); a WebSocket is accepted only from the server's own origin and those
 // allowed; sessions are capped by the file descriptors they take, and one that does not connect
-// in time is closed (docs/security.md, "pfap-web").
+// in time is closed (docs/security.md, "pfap-web"). A STUN server beside the HTTP one gives
+// the page its own address when the browser hides it (pfap-web-stun.h, docs/web.md).
 #include <glib-unix.h>
 #include <gst/app/gstappsink.h>
 #include <gst/gst.h>
