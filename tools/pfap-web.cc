@@ -39,6 +39,7 @@
 #include <string>
 #include <vector>
 
+#include "command_line.h"
 #include "launch_value.h"
 #include "pfap/model.h"
 #include "pfap/payload.h"
@@ -66,18 +67,6 @@ struct Options {
   uint32_t seed = 1;
   std::string web_dir;
 };
-
-void usage(FILE* out) {
-  std::fprintf(out,
-               "usage: pfap-web [--port=N] [--text=TEXT] [--drop=P] [--seed=S] [--web-dir=DIR]\n"
-               "Serves the talking head on http://127.0.0.1:N/ (default 8080; 0 picks a free\n"
-               "port) and prints the URL. Each browser that opens it gets its own WebRTC\n"
-               "session: TEXT (or what the page asks for) spoken by pfaptts, the speech as\n"
-               "Opus audio, the PFAP stream as RTP packets on an unordered, unreliable data\n"
-               "channel, of which a share P (0 to 1) is dropped, seeded by S (each session\n"
-               "adds its number). DIR holds the page (live/) and pfap.js (src/): by default\n"
-               "$PFAP_WEB_DIR, else the installed one.\n");
-}
 
 // A WebRTC session with one browser. Lives on the main thread; GStreamer's threads post
 // what they have to say there (post()).
@@ -755,49 +744,51 @@ std::string default_web_dir() {
   return dir != nullptr && *dir != '\0' ? dir : PFAP_WEB_INSTALL_DIR;
 }
 
-// 0 when the arguments are good, -1 after --help, 2 on a usage error.
-int parse_options(int argc, char** argv, Options& o) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&](const char* name) -> const char* {
-      const size_t n = std::strlen(name);
-      return arg.compare(0, n, name) == 0 ? argv[i] + n : nullptr;
-    };
-    char* end = nullptr;
-    if (arg == "--help" || arg == "-h") {
-      usage(stdout);
-      return -1;
+// 0 when the arguments are good, else the exit status. GStreamer is initialized by the parse.
+int parse_options(int* argc, char*** argv, Options& o) {
+  gint port = o.port;
+  gint64 seed = o.seed;
+  gdouble drop = o.drop;
+  gchar *text = nullptr, *web_dir = nullptr;
+  const GOptionEntry entries[] = {
+      {"port", 0, 0, G_OPTION_ARG_INT, &port,
+       "The HTTP port on 127.0.0.1, 0..65535 (default 8080; 0 picks a free one)", "N"},
+      {"text", 0, 0, G_OPTION_ARG_STRING, &text, "The text to speak when the page asks for none",
+       "TEXT"},
+      {"drop", 0, 0, G_OPTION_ARG_DOUBLE, &drop,
+       "The share of PFAP packets dropped, in [0, 1) (default 0)", "P"},
+      {"seed", 0, 0, G_OPTION_ARG_INT64, &seed,
+       "The seed of the drops (default 1; each session adds its number)", "S"},
+      {"web-dir", 0, 0, G_OPTION_ARG_FILENAME, &web_dir,
+       "The page (live/) and pfap.js (src/) (default $PFAP_WEB_DIR, else the installed one)",
+       "DIR"},
+      {}};
+  int status = parse_command_line(
+      argc, argv, "",
+      "Serves the talking head on http://127.0.0.1:N/ and prints the URL. Each browser\n"
+      "that opens it gets its own WebRTC session: TEXT (or what the page asks for)\n"
+      "spoken by pfaptts, the speech as Opus audio, the PFAP stream as RTP packets on an\n"
+      "unordered, unreliable data channel, of which a share P is dropped.",
+      entries, gst_init_get_option_group());
+  if (status == 0) {
+    if (port < 0 || port > 65535) {
+      status = usage_error("--port wants 0..65535: %d", port);
+    } else if (!(drop >= 0.0 && drop < 1.0)) {
+      status = usage_error("--drop wants a probability in [0, 1): %g", drop);
+    } else if (seed < 0 || seed > G_MAXUINT32) {
+      status = usage_error("--seed wants 0..%u: %" G_GINT64_FORMAT, G_MAXUINT32, seed);
+    } else if (*argc > 1) {
+      status = usage_error("takes no operands: %s", (*argv)[1]);
     }
-    if (const char* v = value("--port=")) {
-      o.port = static_cast<int>(std::strtol(v, &end, 10));
-      if (end == v || *end != '\0' || o.port < 0 || o.port > 65535) {
-        std::fprintf(stderr, "pfap-web: --port wants 0..65535: %s\n", v);
-        return 2;
-      }
-    } else if (const char* v = value("--drop=")) {
-      o.drop = std::strtod(v, &end);
-      if (end == v || *end != '\0' || !(o.drop >= 0.0 && o.drop < 1.0)) {
-        std::fprintf(stderr, "pfap-web: --drop wants a probability in [0, 1): %s\n", v);
-        return 2;
-      }
-    } else if (const char* v = value("--seed=")) {
-      o.seed = static_cast<uint32_t>(std::strtoul(v, &end, 10));
-      if (end == v || *end != '\0') {
-        std::fprintf(stderr, "pfap-web: --seed wants a number: %s\n", v);
-        return 2;
-      }
-    } else if (const char* v = value("--text=")) {
-      o.text = v;
-    } else if (const char* v = value("--web-dir=")) {
-      o.web_dir = v;
-    } else {
-      std::fprintf(stderr, "pfap-web: unknown argument %s\n", arg.c_str());
-      usage(stderr);
-      return 2;
-    }
+    o.port = port;
+    o.drop = drop;
+    o.seed = static_cast<uint32_t>(seed);
+    if (text != nullptr) o.text = text;
+    o.web_dir = web_dir != nullptr && *web_dir != '\0' ? web_dir : default_web_dir();
   }
-  if (o.web_dir.empty()) o.web_dir = default_web_dir();
-  return 0;
+  g_free(text);
+  g_free(web_dir);
+  return status;
 }
 
 // Ctrl-C or SIGTERM: each session's pipeline stops, its browser is told, and what the
@@ -830,11 +821,8 @@ void stop(Server& server, SoupServer* soup) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  gst_init(&argc, &argv);
   Server server;
-  if (int status = parse_options(argc, argv, server.options); status != 0) {
-    return status < 0 ? 0 : status;
-  }
+  if (int status = parse_options(&argc, &argv, server.options); status != 0) return status;
   for (const char* element : {"webrtcbin", "pfaptts", "rtppfappay", "opusenc", "rtpopuspay"}) {
     GstElementFactory* factory = gst_element_factory_find(element);
     if (factory == nullptr) {
