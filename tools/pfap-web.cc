@@ -46,6 +46,7 @@
 #include <string>
 #include <vector>
 
+#include "command_line.h"
 #include "launch_value.h"
 #include "pfap-web-signal.h"
 #include "pfap-web-stun.h"
@@ -85,26 +86,6 @@ struct Options {
   double connect_timeout_s = 30.0;
   std::vector<std::string> allowed_origins;  // besides the server's own
 };
-
-void usage(FILE* out) {
-  std::fprintf(out,
-               "usage: pfap-web [--port=N] [--text=TEXT] [--drop=P] [--seed=S] [--web-dir=DIR]\n"
-               "                [--max-sessions=N] [--connect-timeout=S] [--allow-origin=ORIGIN]\n"
-               "Serves the talking head on http://127.0.0.1:N/ (default 8080; 0 picks a free\n"
-               "port) and prints the URL. Each browser that opens it gets its own WebRTC\n"
-               "session: TEXT (or what the page asks for) spoken by pfaptts, the speech as\n"
-               "Opus audio, the PFAP stream as RTP packets on an unordered, unreliable data\n"
-               "channel, of which a share P (0 to 1) is dropped, seeded by S (each session\n"
-               "adds its number). DIR holds the page (live/) and pfap.js (src/): by default\n"
-               "$PFAP_WEB_DIR, else the installed one.\n"
-               "At most N sessions at once (--max-sessions; by default as many as the open\n"
-               "file limit allows); a session whose page has not answered the offer and\n"
-               "opened the data channel in S seconds (--connect-timeout, default 30) is\n"
-               "closed. WebSockets are accepted from the page's own origin\n"
-               "(http://127.0.0.1:N, http://localhost:N), from clients that send no Origin,\n"
-               "and from each ORIGIN given (--allow-origin, repeatable, such as\n"
-               "http://example.org:8000).\n");
-}
 
 struct Server;
 
@@ -567,7 +548,8 @@ void on_channel_open(GstWebRTCDataChannel*, gpointer data) {
 // rtppfappay answers an upstream GstForceKeyUnit at once when idle.
 void request_complete(Session& s) {
   GstPad* src = gst_element_get_static_pad(s.pay, "src");
-  gst_pad_send_event(src, gst_video_event_new_upstream_force_key_unit(GST_CLOCK_TIME_NONE, TRUE, 0));
+  gst_pad_send_event(src,
+                     gst_video_event_new_upstream_force_key_unit(GST_CLOCK_TIME_NONE, TRUE, 0));
   gst_object_unref(src);
   send_state(s, "state");
 }
@@ -939,9 +921,9 @@ void on_http(SoupServer*, SoupServerMessage* msg, const char* path, GHashTable*,
   const Server& server = *static_cast<Server*>(data);
   std::string file = path;
   if (file == "/") file = "/live/index.html";
-  const bool allowed = (g_str_has_prefix(file.c_str(), "/live/") ||
-                        g_str_has_prefix(file.c_str(), "/src/")) &&
-                       file.find("..") == std::string::npos;
+  const bool allowed =
+      (g_str_has_prefix(file.c_str(), "/live/") || g_str_has_prefix(file.c_str(), "/src/")) &&
+      file.find("..") == std::string::npos;
   gchar* contents = nullptr;
   gsize length = 0;
   if (!allowed || soup_server_message_get_method(msg) != std::string("GET") ||
@@ -960,72 +942,83 @@ std::string default_web_dir() {
   return dir != nullptr && *dir != '\0' ? dir : PFAP_WEB_INSTALL_DIR;
 }
 
-// 0 when the arguments are good, -1 after --help, 2 on a usage error.
-int parse_options(int argc, char** argv, Options& o) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&](const char* name) -> const char* {
-      const size_t n = std::strlen(name);
-      return arg.compare(0, n, name) == 0 ? argv[i] + n : nullptr;
-    };
-    char* end = nullptr;
-    if (arg == "--help" || arg == "-h") {
-      usage(stdout);
-      return -1;
+// 0 when the arguments are good, else the exit status. GStreamer is initialized by the parse.
+int parse_options(int* argc, char*** argv, Options& o) {
+  gint port = o.port;
+  gint64 seed = o.seed;
+  gdouble drop = o.drop;
+  gint max_sessions = -1;  // not given
+  gdouble connect_timeout_s = o.connect_timeout_s;
+  gchar *text = nullptr, *web_dir = nullptr;
+  gchar** origins = nullptr;
+  const GOptionEntry entries[] = {
+      {"port", 0, 0, G_OPTION_ARG_INT, &port,
+       "The HTTP port on 127.0.0.1, 0..65535 (default 8080; 0 picks a free one)", "N"},
+      {"text", 0, 0, G_OPTION_ARG_STRING, &text, "The text to speak when the page asks for none",
+       "TEXT"},
+      {"drop", 0, 0, G_OPTION_ARG_DOUBLE, &drop,
+       "The share of PFAP packets dropped, in [0, 1) (default 0)", "P"},
+      {"seed", 0, 0, G_OPTION_ARG_INT64, &seed,
+       "The seed of the drops (default 1; each session adds its number)", "S"},
+      {"web-dir", 0, 0, G_OPTION_ARG_FILENAME, &web_dir,
+       "The page (live/) and pfap.js (src/) (default $PFAP_WEB_DIR, else the installed one)",
+       "DIR"},
+      {"max-sessions", 0, 0, G_OPTION_ARG_INT, &max_sessions,
+       "At most N sessions at once, 1..1000000 (default: as many as the open file limit allows)",
+       "N"},
+      {"connect-timeout", 0, 0, G_OPTION_ARG_DOUBLE, &connect_timeout_s,
+       "Close a session whose page has not answered the offer and opened the data channel in S "
+       "seconds, above 0 up to 86400 (default 30)",
+       "S"},
+      {"allow-origin", 0, 0, G_OPTION_ARG_STRING_ARRAY, &origins,
+       "Accept WebSockets from ORIGIN (scheme://host[:port], or null) besides the page's own "
+       "(http://127.0.0.1:N, http://localhost:N) and clients that send none; repeatable",
+       "ORIGIN"},
+      {}};
+  int status = parse_command_line(
+      argc, argv, "",
+      "Serves the talking head on http://127.0.0.1:N/ and prints the URL. Each browser\n"
+      "that opens it gets its own WebRTC session: TEXT (or what the page asks for)\n"
+      "spoken by pfaptts, the speech as Opus audio, the PFAP stream as RTP packets on an\n"
+      "unordered, unreliable data channel, of which a share P is dropped.",
+      entries, gst_init_get_option_group());
+  if (status == 0) {
+    if (port < 0 || port > 65535) {
+      status = usage_error("--port wants 0..65535: %d", port);
+    } else if (!(drop >= 0.0 && drop < 1.0)) {
+      status = usage_error("--drop wants a probability in [0, 1): %g", drop);
+    } else if (seed < 0 || seed > G_MAXUINT32) {
+      status = usage_error("--seed wants 0..%u: %" G_GINT64_FORMAT, G_MAXUINT32, seed);
+    } else if (max_sessions != -1 && (max_sessions < 1 || max_sessions > 1000000)) {
+      status = usage_error("--max-sessions wants 1..1000000: %d", max_sessions);
+    } else if (!(connect_timeout_s > 0 && connect_timeout_s <= 86400)) {
+      status = usage_error("--connect-timeout wants seconds, above 0 up to 86400: %g",
+                           connect_timeout_s);
+    } else if (*argc > 1) {
+      status = usage_error("takes no operands: %s", (*argv)[1]);
     }
-    if (const char* v = value("--port=")) {
-      o.port = static_cast<int>(std::strtol(v, &end, 10));
-      if (end == v || *end != '\0' || o.port < 0 || o.port > 65535) {
-        std::fprintf(stderr, "pfap-web: --port wants 0..65535: %s\n", v);
-        return 2;
-      }
-    } else if (const char* v = value("--drop=")) {
-      o.drop = std::strtod(v, &end);
-      if (end == v || *end != '\0' || !(o.drop >= 0.0 && o.drop < 1.0)) {
-        std::fprintf(stderr, "pfap-web: --drop wants a probability in [0, 1): %s\n", v);
-        return 2;
-      }
-    } else if (const char* v = value("--seed=")) {
-      o.seed = static_cast<uint32_t>(std::strtoul(v, &end, 10));
-      if (end == v || *end != '\0') {
-        std::fprintf(stderr, "pfap-web: --seed wants a number: %s\n", v);
-        return 2;
-      }
-    } else if (const char* v = value("--max-sessions=")) {
-      const long n = std::strtol(v, &end, 10);
-      if (end == v || *end != '\0' || n < 1 || n > 1000000) {
-        std::fprintf(stderr, "pfap-web: --max-sessions wants 1..1000000: %s\n", v);
-        return 2;
-      }
-      o.max_sessions = static_cast<int>(n);
-    } else if (const char* v = value("--connect-timeout=")) {
-      o.connect_timeout_s = std::strtod(v, &end);
-      if (end == v || *end != '\0' || !(o.connect_timeout_s > 0 && o.connect_timeout_s <= 86400)) {
-        std::fprintf(stderr, "pfap-web: --connect-timeout wants seconds, above 0 up to 86400: %s\n",
-                     v);
-        return 2;
-      }
-    } else if (const char* v = value("--allow-origin=")) {
+    for (gchar** v = origins; status == 0 && v != nullptr && *v != nullptr; ++v) {
       // scheme://host[:port] as browsers send it, or "null" (sandboxed and file: pages).
-      const char* host = std::strstr(v, "://");
-      if (std::strcmp(v, "null") != 0 && (host == nullptr || host == v || host[3] == '\0' ||
-                                          std::strchr(host + 3, '/') != nullptr)) {
-        std::fprintf(stderr, "pfap-web: --allow-origin wants scheme://host[:port]: %s\n", v);
-        return 2;
+      const char* host = std::strstr(*v, "://");
+      if (std::strcmp(*v, "null") != 0 && (host == nullptr || host == *v || host[3] == '\0' ||
+                                           std::strchr(host + 3, '/') != nullptr)) {
+        status = usage_error("--allow-origin wants scheme://host[:port]: %s", *v);
+      } else {
+        o.allowed_origins.emplace_back(*v);
       }
-      o.allowed_origins.emplace_back(v);
-    } else if (const char* v = value("--text=")) {
-      o.text = v;
-    } else if (const char* v = value("--web-dir=")) {
-      o.web_dir = v;
-    } else {
-      std::fprintf(stderr, "pfap-web: unknown argument %s\n", arg.c_str());
-      usage(stderr);
-      return 2;
     }
+    o.port = port;
+    o.max_sessions = max_sessions == -1 ? 0 : max_sessions;
+    o.connect_timeout_s = connect_timeout_s;
+    o.drop = drop;
+    o.seed = static_cast<uint32_t>(seed);
+    if (text != nullptr) o.text = text;
+    o.web_dir = web_dir != nullptr && *web_dir != '\0' ? web_dir : default_web_dir();
   }
-  if (o.web_dir.empty()) o.web_dir = default_web_dir();
-  return 0;
+  g_free(text);
+  g_free(web_dir);
+  g_strfreev(origins);
+  return status;
 }
 
 // The sessions the open file limit leaves room for, kReservedFds kept; `wanted` (if not 0)
@@ -1081,11 +1074,8 @@ void stop(Server& server, SoupServer* soup) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  gst_init(&argc, &argv);
   Server server;
-  if (int status = parse_options(argc, argv, server.options); status != 0) {
-    return status < 0 ? 0 : status;
-  }
+  if (int status = parse_options(&argc, &argv, server.options); status != 0) return status;
   for (const char* element : {"webrtcbin", "pfaptts", "rtppfappay", "opusenc", "rtpopuspay"}) {
     GstElementFactory* factory = gst_element_factory_find(element);
     if (factory == nullptr) {
@@ -1101,7 +1091,8 @@ int main(int argc, char** argv) {
   GError* error = nullptr;
   // Loopback only: the page and its sessions are for this machine.
   GInetAddress* loopback = g_inet_address_new_loopback(G_SOCKET_FAMILY_IPV4);
-  GSocketAddress* address = g_inet_socket_address_new(loopback, static_cast<guint16>(server.options.port));
+  GSocketAddress* address =
+      g_inet_socket_address_new(loopback, static_cast<guint16>(server.options.port));
   g_object_unref(loopback);
   const bool listening = soup_server_listen(soup, address, SoupServerListenOptions(0), &error);
   g_object_unref(address);
