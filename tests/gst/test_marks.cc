@@ -90,28 +90,28 @@ TEST_F(MarksEnc, WritesPollyMarksPerUtterance) {
   make("pfapmarksenc format=polly");
   gst_harness_set_src_caps_str(h_, PFAP_MARKUP_CAPS ",alphabet=x-pfap-arpabet");
   // "HH AH" + "M" (end of text), then a second sentence starting 1 s in: "P" with no end.
-  const GstClockTime base = 5000 * kMs;  // times are counted from the first event
+  const GstClockTime base = 5000 * kMs;  // stream time: marks from 5 s
   gst_harness_push(h_, pfap::testing::phoneme_buffer(phoneme(16, 60, true), {}, base, true));
   gst_harness_push(h_, pfap::testing::phoneme_buffer(phoneme(3, 90), {}, base + 60 * kMs, false));
   EXPECT_EQ(pull_text(h_), "");  // the utterance is not over
   gst_harness_push(
       h_, pfap::testing::phoneme_buffer(phoneme(22, 80, true, true), {}, base + 150 * kMs, false));
   EXPECT_EQ(pull_text(h_),
-            "{\"time\":0,\"type\":\"sentence\",\"value\":\"HH-AH M\"}\n"
-            "{\"time\":0,\"type\":\"word\",\"value\":\"HH-AH\"}\n"
-            "{\"time\":0,\"type\":\"viseme\",\"value\":\"k\"}\n"
-            "{\"time\":60,\"type\":\"viseme\",\"value\":\"@\"}\n"
-            "{\"time\":150,\"type\":\"word\",\"value\":\"M\"}\n"
-            "{\"time\":150,\"type\":\"viseme\",\"value\":\"p\"}\n"
-            "{\"time\":230,\"type\":\"viseme\",\"value\":\"sil\"}\n");
+            "{\"time\":5000,\"type\":\"sentence\",\"value\":\"HH-AH M\"}\n"
+            "{\"time\":5000,\"type\":\"word\",\"value\":\"HH-AH\"}\n"
+            "{\"time\":5000,\"type\":\"viseme\",\"value\":\"k\"}\n"
+            "{\"time\":5060,\"type\":\"viseme\",\"value\":\"@\"}\n"
+            "{\"time\":5150,\"type\":\"word\",\"value\":\"M\"}\n"
+            "{\"time\":5150,\"type\":\"viseme\",\"value\":\"p\"}\n"
+            "{\"time\":5230,\"type\":\"viseme\",\"value\":\"sil\"}\n");
   gst_harness_push(h_, pfap::testing::phoneme_buffer(phoneme(27, 70, true), {}, base + kMs * 1000,
                                                      true));
   gst_harness_push_event(h_, gst_event_new_eos());
   EXPECT_EQ(pull_text(h_),
-            "{\"time\":1000,\"type\":\"sentence\",\"value\":\"P\"}\n"
-            "{\"time\":1000,\"type\":\"word\",\"value\":\"P\"}\n"
-            "{\"time\":1000,\"type\":\"viseme\",\"value\":\"p\"}\n"
-            "{\"time\":1070,\"type\":\"viseme\",\"value\":\"sil\"}\n");
+            "{\"time\":6000,\"type\":\"sentence\",\"value\":\"P\"}\n"
+            "{\"time\":6000,\"type\":\"word\",\"value\":\"P\"}\n"
+            "{\"time\":6000,\"type\":\"viseme\",\"value\":\"p\"}\n"
+            "{\"time\":6070,\"type\":\"viseme\",\"value\":\"sil\"}\n");
   EXPECT_TRUE(messages(bus_, GST_MESSAGE_WARNING).empty());
 }
 
