@@ -13,6 +13,7 @@
 #include "pfap/markup.h"
 #include "pfap/markup_event.h"
 #include "documented_commands.h"
+#include "element_harness.h"
 #include "pfap_buffers.h"
 #include "pipeline.h"
 #include "temp_dir.h"
@@ -22,6 +23,7 @@ namespace {
 using namespace std::chrono_literals;
 using pfap::Phoneme;
 using pfap::testing::Pipeline;
+using pfap::testing::pull_text;
 using pfap::testing::read_file;
 using pfap::testing::replace_all;
 using pfap::testing::source_path;
@@ -30,19 +32,6 @@ using pfap::testing::TempDir;
 constexpr GstClockTime kMs = GST_MSECOND;
 constexpr std::array<const char*, 5> kElements{"pfapmarksenc", "pfapmarksparse", "pfapparse",
                                                "rtppfappay", "pfapface"};
-
-// The text of every buffer the harness holds, in order.
-std::string pull_text(GstHarness* h) {
-  std::string text;
-  while (GstBuffer* b = gst_harness_try_pull(h)) {
-    GstMapInfo map;
-    gst_buffer_map(b, &map, GST_MAP_READ);
-    text.append(reinterpret_cast<const char*>(map.data), map.size);
-    gst_buffer_unmap(b, &map);
-    gst_buffer_unref(b);
-  }
-  return text;
-}
 
 // The messages of the bus's warnings (or errors), taken off it.
 std::vector<std::string> messages(GstBus* bus, GstMessageType type) {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "documented_commands.h"
+#include "element_harness.h"
 #include "pfap/markup.h"
 #include "pfap/markup_event.h"
 #include "pfap_buffers.h"
@@ -183,14 +184,7 @@ TEST_P(ZeroLengthMarks, NoMarkOfNoLengthFromSubMillisecondGaps) {
     gst_harness_push(h, pfap::testing::phoneme_buffer(p, {}, phonemes[i].second, i == 0));
   }
   gst_harness_push_event(h, gst_event_new_eos());
-  std::string text;
-  while (GstBuffer* b = gst_harness_try_pull(h)) {
-    GstMapInfo map;
-    gst_buffer_map(b, &map, GST_MAP_READ);
-    text.append(reinterpret_cast<const char*>(map.data), map.size);
-    gst_buffer_unmap(b, &map);
-    gst_buffer_unref(b);
-  }
+  const std::string text = pfap::testing::pull_text(h);
   gst_harness_teardown(h);
   SCOPED_TRACE(text);
 
