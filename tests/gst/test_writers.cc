@@ -47,14 +47,17 @@ constexpr std::array<const char*, 9> kWriters{
 
 // The README's "Into files" line with each writer where pfaptextenc is. A writer that holds
 // its output (a FAP file, a Rhubarb JSON document, an utterance's marks) left the markup's
-// filesink without preroll: the audio queue filled, pfaptts blocked, and nothing ended.
+// filesink without preroll: the audio queue filled, pfaptts blocked, and nothing ended. The
+// first sentence lasts longer than the queue holds (1 s), so that the writers that hold an
+// utterance's marks hold them past that too.
 TEST(WritersIntoFiles, EveryWriterLetsTheAudioBranchRunAndBothFilesAreWritten) {
   ASSERT_TRUE(pfap::testing::plugin_available(kElements));
   for (const char* writer : kWriters) {
     SCOPED_TRACE(writer);
     TempDir dir;
-    Pipeline p(std::string("pfaptts name=t text=\"Hello <FAP 2 1 40 0 0 500 1> world. How are "
-                           "you?\" t.audio ! queue ! audioconvert ! wavenc ! filesink "
+    Pipeline p(std::string("pfaptts name=t text=\"Hello <FAP 2 1 40 0 0 500 1> world, this first "
+                           "sentence goes on for well over a second of speech before it ends. "
+                           "How are you?\" t.audio ! queue ! audioconvert ! wavenc ! filesink "
                            "location=") +
                dir.file("speech.wav") + " t.pfap ! queue ! " + writer +
                " ! filesink location=" + dir.file("speech.out"));
