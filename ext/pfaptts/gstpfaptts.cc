@@ -22,7 +22,7 @@
  *
  * A bad bookmark is an error naming its character (counted from 1 in the utterance); with
  * #GstPfapTts:skip-bad-bookmarks it is a warning (at the 1st, 2nd, 4th, ... only, counted in
- * #GstPfapTts:bad-bookmarks), and the bookmark is left out.
+ * #GstPfapTts:stats), and the bookmark is left out.
  *
  * An utterance is spoken a piece (about a sentence) at a time: a long text starts speaking
  * after its first sentence, the speech held is one piece's whatever the text's length, and a
@@ -77,6 +77,7 @@ enum {
   PROP_VOLUME,
   PROP_SKIP_BAD_BOOKMARKS,
   PROP_BAD_BOOKMARKS,
+  PROP_STATS,
 };
 
 // The output timeline: a position is `base` plus `samples` at `rate`, so that a change of rate
@@ -335,7 +336,7 @@ static bool handle_bad_bookmark(GstPfapTts* self, const pfap::tts::BadBookmark& 
                          pfap::to_string(b.status)),
                         ("%" G_GUINT64_FORMAT
                          " bad bookmarks left out so far (warned at the 1st, 2nd, 4th, 8th, ...; "
-                         "the bad-bookmarks property counts them)",
+                         "the stats property's bad-bookmarks counts them)",
                          count));
   }
   return true;
@@ -563,6 +564,10 @@ static void gst_pfap_tts_get_property(GObject* object, guint prop_id, GValue* va
     case PROP_BAD_BOOKMARKS:
       g_value_set_uint64(value, self->bad_bookmarks);
       break;
+    case PROP_STATS:
+      g_value_take_boxed(value, gst_structure_new("application/x-pfap-tts-stats", "bad-bookmarks",
+                                                  G_TYPE_UINT64, self->bad_bookmarks, nullptr));
+      break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
       break;
@@ -643,13 +648,33 @@ static void gst_pfap_tts_class_init(GstPfapTtsClass* klass) {
    * GstPfapTts:bad-bookmarks:
    *
    * The bad bookmarks left out (#GstPfapTts:skip-bad-bookmarks) since the element last went
-   * from READY to PAUSED. Their warnings come at the 1st, 2nd, 4th, 8th, ... only.
+   * from READY to PAUSED: the bad-bookmarks field of #GstPfapTts:stats.
+   *
+   * Deprecated: read bad-bookmarks in the stats property.
    */
   g_object_class_install_property(
       gobject_class, PROP_BAD_BOOKMARKS,
       g_param_spec_uint64("bad-bookmarks", "Bad bookmarks",
-                          "Bad bookmarks left out since READY to PAUSED", 0, G_MAXUINT64, 0,
-                          static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
+                          "Bad bookmarks left out since READY to PAUSED (deprecated: the stats "
+                          "property's bad-bookmarks)",
+                          0, G_MAXUINT64, 0,
+                          static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS |
+                                                   G_PARAM_DEPRECATED)));
+  /**
+   * GstPfapTts:stats:
+   *
+   * Counters since the element last went from READY to PAUSED, guint64, as every element of
+   * the plugins has them (docs/elements.md, "Counters"):
+   *
+   * - bad-bookmarks: bad bookmarks left out (#GstPfapTts:skip-bad-bookmarks); their warnings
+   *   come at the 1st, 2nd, 4th, 8th, ... only
+   */
+  g_object_class_install_property(
+      gobject_class, PROP_STATS,
+      g_param_spec_boxed("stats", "Statistics",
+                         "Counters since READY to PAUSED (guint64): bad-bookmarks (left out)",
+                         GST_TYPE_STRUCTURE,
+                         static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
 
   gst_element_class_add_static_pad_template(element_class, &sink_template);
   gst_element_class_add_static_pad_template(element_class, &audio_template);

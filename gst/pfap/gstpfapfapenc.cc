@@ -10,10 +10,10 @@
  * version 2.1, the format Xface, Greta and other MPEG-4 face players read;
  * docs/fap-files.md): the receiver's FAP state, built from the application/x-pfap events as
  * pfapface builds it (phoneme FAPs at their start, recovered entries at their time, a
- * complete state replacing everything), sampled at #GstPfapFapEnc:frame-rate. Frame 0 is the
- * start of the first segment (running time), so that fapparse's frames come back as the same
- * frames even when the first events are lost; a stream whose first event comes later starts
- * with neutral frames, the receiver's state until then. Frame k is k / frame rate seconds
+ * complete state replacing everything), sampled at #GstPfapFapEnc:frame-rate. Frame 0 is
+ * stream time 0, as every writer's times count (docs/elements.md), so that fapparse's frames
+ * come back as the same frames even when the first events are lost; a stream whose first
+ * event comes later starts with neutral frames, the receiver's state until then. Frame k is k / frame rate seconds
  * after frame 0, rounded to the ms; the file ends with the last frame before the end of the
  * last phoneme received, or later, once the last transition is over. Each amplitude is rounded
  * to the nearest whole unit.
@@ -25,7 +25,9 @@
  *
  * The header line holds the number of frames, so the file is written at EOS, in buffers of
  * about 64 KiB; until then up to #GstPfapFapEnc:max-frames frames are kept, 300 bytes each (a
- * warning says when later events are not written). A malformed buffer is dropped with a warning and the stream goes on. An event
+ * warning says when later events are not written), and a GAP event for each event held lets
+ * the sinks downstream preroll. A malformed buffer is dropped with a warning and the stream
+ * goes on. An event
  * without a PTS starts where the previous one ended; one earlier than the one before it is
  * taken at that one's time, with a warning at the 1st, 2nd, 4th, 8th, ... such event. A
  * flush, or going from READY to PAUSED, starts a new file.
@@ -66,7 +68,6 @@ constexpr size_t kPieceBytes = 64 * 1024;
 // lives behind a pointer made in init and deleted in finalize.
 struct Stream {
   std::optional<pfap::FapRecorder> recorder;  // made at the first event, with the properties
-  std::optional<int64_t> origin_ns;           // the first segment's start: frame 0
   int64_t end_ns = 0;                         // where the last phoneme ends, from frame 0
   uint64_t over_limit = 0;                    // events after max-frames
 };
@@ -95,8 +96,9 @@ static void gst_pfap_fap_enc_reset(GstPfapBaseEnc* enc) {
   *GST_PFAP_FAP_ENC(enc)->stream = Stream{};
 }
 
-static GstFlowReturn gst_pfap_fap_enc_handle_event(GstPfapBaseEnc* enc, GstBuffer* buffer,
-                                                   const pfap::MarkupEvent& event) {
+static GstFlowReturn gst_pfap_fap_enc_handle_event(GstPfapBaseEnc* enc, GstBuffer*,
+                                                   const pfap::MarkupEvent& event,
+                                                   int64_t time_ns) {
   GstPfapFapEnc* self = GST_PFAP_FAP_ENC(enc);
   Stream& s = *self->stream;
   if (!s.recorder) {
@@ -104,12 +106,6 @@ static GstFlowReturn gst_pfap_fap_enc_handle_event(GstPfapBaseEnc* enc, GstBuffe
     s.recorder.emplace(self->frame_rate, self->max_frames);
     GST_OBJECT_UNLOCK(self);
   }
-  // Placed as every writer places events: the recorder's times never go back.
-  const int64_t running = gst_pfap_base_enc_place(enc, GST_BUFFER_PTS(buffer), event);
-  if (!s.origin_ns) s.origin_ns = running;  // no segment came: the first event's time
-  // An event before frame 0 acts at frame 0.
-  const int64_t time_ns = std::max<int64_t>(running - *s.origin_ns, 0);
-
   // The recorder adds the frames of transitions still running at the end.
   const int64_t end =
       time_ns + (event.kind == PFAP_EVENT_PHONEME ? event.phoneme.duration_ms : 0) * pfap::kNsPerMs;
@@ -164,7 +160,7 @@ static void gst_pfap_fap_enc_finish(GstPfapBaseEnc* enc) {
     pfap::format_fap_frame(recorder.frame(k, mask, not_written), text);
     if (text.size() >= kPieceBytes || k + 1 == recorder.frames()) {
       bytes += text.size();
-      ret = gst_pad_push(srcpad, gst_buffer_new_memdup(text.data(), text.size()));
+      ret = gst_pfap_base_enc_push(enc, gst_buffer_new_memdup(text.data(), text.size()));
       text.clear();
     }
   }
@@ -179,28 +175,12 @@ static void gst_pfap_fap_enc_finish(GstPfapBaseEnc* enc) {
   }
 }
 
-// The file is bytes from its start; frame 0 is the first segment's start.
-static GstEvent* gst_pfap_fap_enc_output_segment(GstPfapBaseEnc* enc, GstEvent* event) {
-  Stream& s = *GST_PFAP_FAP_ENC(enc)->stream;
-  const GstSegment* segment = nullptr;
-  gst_event_parse_segment(event, &segment);
-  if (!s.origin_ns) {
-    s.origin_ns =
-        static_cast<int64_t>(gst_segment_to_running_time(segment, GST_FORMAT_TIME, segment->start));
-  }
+// The file is bytes from its start.
+static GstEvent* gst_pfap_fap_enc_output_segment(GstPfapBaseEnc*, GstEvent* event) {
   gst_event_unref(event);
   GstSegment bytes;
   gst_segment_init(&bytes, GST_FORMAT_BYTES);
   return gst_event_new_segment(&bytes);
-}
-
-// Gaps are times, which the file's bytes have not.
-static gboolean gst_pfap_fap_enc_sink_event(GstPfapBaseEnc* enc, GstEvent* event) {
-  if (GST_EVENT_TYPE(event) == GST_EVENT_GAP) {
-    gst_event_unref(event);
-    return TRUE;
-  }
-  return GST_PFAP_BASE_ENC_CLASS(gst_pfap_fap_enc_parent_class)->sink_event(enc, event);
 }
 
 static void gst_pfap_fap_enc_set_property(GObject* object, guint prop_id, const GValue* value,
@@ -313,7 +293,6 @@ static void gst_pfap_fap_enc_class_init(GstPfapFapEncClass* klass) {
   enc_class->output_segment = gst_pfap_fap_enc_output_segment;
   enc_class->finish = gst_pfap_fap_enc_finish;
   enc_class->reset = gst_pfap_fap_enc_reset;
-  enc_class->sink_event = gst_pfap_fap_enc_sink_event;
 }
 
 static void gst_pfap_fap_enc_init(GstPfapFapEnc* self) {

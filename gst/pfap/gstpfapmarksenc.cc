@@ -22,7 +22,7 @@
  *
  * The `alphabet` field of the input caps names the phoneme table (x-pfap-arpabet, or one of
  * the viseme alphabets pfapmarksparse makes); a phoneme with no known viseme is written as a
- * half-open mouth, with a warning. Times are ms from the first event, as pfaptextenc's.
+ * half-open mouth, with a warning. Times are the events' stream times, as pfaptextenc's.
  * Marks come out per utterance (at each end of text), Rhubarb JSON as one document at EOS,
  * blendshape frames as time passes. Once nothing moves, frames go on for 1 s of rest at most;
  * the frames after a longer rest keep their times, with a warning (the 1st, 2nd, 4th, ...), so
@@ -40,7 +40,6 @@
 #include "gstpfapmarksenc.h"
 
 #include <cstdint>
-#include <optional>
 #include <string>
 
 #include "pfap/model.h"
@@ -63,7 +62,6 @@ struct Stream {
   Stream(pfap::MarksFormat format, int frame_rate) : writer(format, frame_rate) {}
 
   pfap::MarksWriter writer;
-  std::optional<int64_t> origin_ns;  // the first event's running time: time 0
   uint64_t unknown_warned = 0;       // unknown phonemes already counted in a warning
   uint64_t unknown_warnings = 0;
   uint64_t cut_rests = 0;  // the writer's count when last looked at
@@ -136,20 +134,18 @@ static pfap::MarksWriter::Sink make_sink(GstPfapMarksEnc* self) {
   return [self](std::string_view text) {
     if (text.empty()) return true;
     GstBuffer* out = gst_buffer_new_memdup(text.data(), text.size());
-    self->stream->flow = gst_pad_push(gst_pfap_base_enc_srcpad(GST_PFAP_BASE_ENC(self)), out);
+    self->stream->flow = gst_pfap_base_enc_push(GST_PFAP_BASE_ENC(self), out);
     return self->stream->flow == GST_FLOW_OK;
   };
 }
 
-static GstFlowReturn gst_pfap_marks_enc_handle_event(GstPfapBaseEnc* enc, GstBuffer* buffer,
-                                                     const pfap::MarkupEvent& event) {
+static GstFlowReturn gst_pfap_marks_enc_handle_event(GstPfapBaseEnc* enc, GstBuffer*,
+                                                     const pfap::MarkupEvent& event,
+                                                     int64_t time_ns) {
   GstPfapMarksEnc* self = GST_PFAP_MARKS_ENC(enc);
   Stream& s = *self->stream;
-  // Times from the stream's first event.
-  const int64_t running = gst_pfap_base_enc_place(enc, GST_BUFFER_PTS(buffer), event);
-  if (!s.origin_ns) s.origin_ns = running;
   s.flow = GST_FLOW_OK;
-  if (!s.writer.add(event, running - *s.origin_ns, make_sink(self))) {
+  if (!s.writer.add(event, time_ns, make_sink(self))) {
     if (s.writer.overflow()) {
       GST_ELEMENT_ERROR(self, STREAM, FAILED,
                         ("More than %zu phonemes for one Rhubarb JSON document.",

@@ -68,7 +68,6 @@ struct Stream {
   bool started = false;   // the first non-blank byte has been seen
   bool document = false;  // Rhubarb JSON: the input is kept whole until EOS
   bool oversized = false;  // the document grew past its limit: one bad item, the rest dropped
-  uint64_t bad_lines = 0;
   std::vector<pfap::TextEvent> events;
 };
 
@@ -148,11 +147,12 @@ static GstFlowReturn bad_input(GstPfapMarksParse* self, size_t column, const std
                                  : "Rhubarb JSON document";
   const uint64_t line = s.document ? 1 : s.line;
   if (skip) {
-    if (pfap_warn_at(++s.bad_lines)) {
+    const guint64 bad_lines = gst_pfap_base_parse_count_bad_line(GST_PFAP_BASE_PARSE(self));
+    if (pfap_warn_at(bad_lines)) {
       GST_ELEMENT_WARNING(self, STREAM, DECODE,
                           ("Skipped %s %" G_GUINT64_FORMAT ", column %zu: %s (%" G_GUINT64_FORMAT
                            " bad so far)",
-                           kind, line, column + 1, what.c_str(), s.bad_lines),
+                           kind, line, column + 1, what.c_str(), bad_lines),
                           (nullptr));
     }
     return GST_FLOW_OK;

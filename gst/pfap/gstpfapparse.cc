@@ -23,7 +23,7 @@
  * more than 65536 bytes, or a time past about 292 years) is an
  * error naming its line, its column (in bytes, from 1) and what is wrong; with
  * #GstPfapParse:skip-bad-lines it is a warning instead (at the 1st, 2nd, 4th, ... bad line,
- * all counted in #GstPfapParse:bad-lines), and the lines after it are read as usual. Input
+ * all counted in the stats property's bad-lines), and the lines after it are read as usual. Input
  * that arrives from sources without caps (filesrc, fdsrc) is taken as .pfap text; caps, when
  * given, must be text/x-pfap (the typefinder's, for decodebin) or text/x-raw,format=utf8.
  *
@@ -77,7 +77,6 @@ struct Stream {
 struct _GstPfapParse {
   GstPfapBaseParse parent;
   gboolean skip_bad_lines;  // under the object lock
-  guint64 bad_lines;        // under the object lock: skipped since READY to PAUSED
   gchar* alphabet;          // under the object lock; NULL when unset
   Stream* stream;
 };
@@ -140,11 +139,11 @@ static std::string source_name(GstPfapParse* self) {
 static GstFlowReturn bad_line(GstPfapParse* self, size_t column, const std::string& what) {
   GST_OBJECT_LOCK(self);
   const bool skip = self->skip_bad_lines;
-  const guint64 count = skip ? ++self->bad_lines : self->bad_lines;
   GST_OBJECT_UNLOCK(self);
   const uint64_t line = self->stream->line;
   const std::string source = source_name(self);
   if (skip) {
+    const guint64 count = gst_pfap_base_parse_count_bad_line(GST_PFAP_BASE_PARSE(self));
     GST_DEBUG_OBJECT(self, "skipped line %" G_GUINT64_FORMAT ", column %zu%s: %s", line,
                      column + 1, source.c_str(), what.c_str());
     // Random bytes are a bad line every few hundred bytes: warn at the 1st, 2nd, 4th, ...
@@ -154,7 +153,7 @@ static GstFlowReturn bad_line(GstPfapParse* self, size_t column, const std::stri
                            column + 1, source.c_str(), what.c_str()),
                           ("%" G_GUINT64_FORMAT
                            " bad lines skipped so far (warned at the 1st, 2nd, 4th, 8th, ...; "
-                           "the bad-lines property counts them)",
+                           "the stats property's bad-lines counts them)",
                            count));
     }
     return GST_FLOW_OK;
@@ -230,17 +229,6 @@ static GstFlowReturn gst_pfap_parse_finish(GstPfapBaseParse* parse) {
   return ret;
 }
 
-static GstStateChangeReturn gst_pfap_parse_change_state(GstElement* element,
-                                                        GstStateChange transition) {
-  GstPfapParse* self = GST_PFAP_PARSE(element);
-  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) {
-    GST_OBJECT_LOCK(self);
-    self->bad_lines = 0;
-    GST_OBJECT_UNLOCK(self);
-  }
-  return GST_ELEMENT_CLASS(gst_pfap_parse_parent_class)->change_state(element, transition);
-}
-
 static void gst_pfap_parse_set_property(GObject* object, guint prop_id, const GValue* value,
                                         GParamSpec* pspec) {
   GstPfapParse* self = GST_PFAP_PARSE(object);
@@ -277,9 +265,7 @@ static void gst_pfap_parse_get_property(GObject* object, guint prop_id, GValue* 
       GST_OBJECT_UNLOCK(self);
       break;
     case PROP_BAD_LINES:
-      GST_OBJECT_LOCK(self);
-      g_value_set_uint64(value, self->bad_lines);
-      GST_OBJECT_UNLOCK(self);
+      g_value_set_uint64(value, gst_pfap_base_parse_bad_lines(GST_PFAP_BASE_PARSE(self)));
       break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
@@ -338,13 +324,18 @@ static void gst_pfap_parse_class_init(GstPfapParseClass* klass) {
    * GstPfapParse:bad-lines:
    *
    * The bad lines skipped (#GstPfapParse:skip-bad-lines) since the element last went from
-   * READY to PAUSED.
+   * READY to PAUSED: the bad-lines field of the stats property, which every parser has.
+   *
+   * Deprecated: read bad-lines in the stats property.
    */
   g_object_class_install_property(
       gobject_class, PROP_BAD_LINES,
-      g_param_spec_uint64("bad-lines", "Bad lines", "Bad lines skipped since READY to PAUSED", 0,
-                          G_MAXUINT64, 0,
-                          static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
+      g_param_spec_uint64("bad-lines", "Bad lines",
+                          "Bad lines skipped since READY to PAUSED (deprecated: the stats "
+                          "property's bad-lines)",
+                          0, G_MAXUINT64, 0,
+                          static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS |
+                                                   G_PARAM_DEPRECATED)));
 
   gst_element_class_add_static_pad_template(element_class, &sink_template);
   gst_element_class_add_static_pad_template(element_class, &src_template);
@@ -354,7 +345,6 @@ static void gst_pfap_parse_class_init(GstPfapParseClass* klass) {
       "application/x-pfap events",
       "gst-pfap developers");
 
-  element_class->change_state = gst_pfap_parse_change_state;
   parse_class->read_chunk = gst_pfap_parse_read_chunk;
   parse_class->finish = gst_pfap_parse_finish;
   parse_class->reset = gst_pfap_parse_reset;
@@ -363,7 +353,6 @@ static void gst_pfap_parse_class_init(GstPfapParseClass* klass) {
 
 static void gst_pfap_parse_init(GstPfapParse* self) {
   self->skip_bad_lines = FALSE;
-  self->bad_lines = 0;
   self->alphabet = nullptr;
   self->stream = new Stream{};
 }

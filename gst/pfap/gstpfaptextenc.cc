@@ -11,15 +11,15 @@
  * holding its canonical line and a newline, with the input's PTS and duration. Written to a
  * file, the lines read back with pfapparse as the same phonemes, FAPs and state events.
  *
- * A line's time is the event's running time less the first event's, in ms rounded to the
- * nearest: a received stream starts at 0, and a new segment does not move the origin. A
- * flush, or going from READY to PAUSED, starts again: the next event is at 0.
+ * A line's time is the event's stream time, in ms rounded to the nearest: a file read by
+ * pfapparse and written again keeps its times, and a received stream's times count from the
+ * receiver's segment start (docs/elements.md, "Times in the files written").
  *
  * An event without a PTS starts where the previous one ended (a phoneme lasts its duration,
  * a state event none), the first one where the segment begins. An event earlier than the
  * one before it is written at that one's time, with a warning: the format wants times that
  * never go back. A malformed buffer is dropped with a warning and the stream goes on. Both
- * faults are counted in #GstPfapTextEnc:stats and warned about at their 1st, 2nd, 4th, 8th,
+ * faults are counted in the stats property and warned about at their 1st, 2nd, 4th, 8th,
  * ... occurrence, so that a stream of them does not flood the bus.
  *
  * The format has no flag for an event the receiver is unsure of (its FAP state may be
@@ -37,7 +37,6 @@
 #include "gstpfaptextenc.h"
 
 #include <cstdint>
-#include <optional>
 #include <string>
 
 #include "pfap/model.h"
@@ -51,7 +50,6 @@ namespace {
 // What the streaming thread keeps between buffers. GObject runs no C++ constructors, so it
 // lives behind a pointer made in init and deleted in finalize.
 struct Stream {
-  std::optional<int64_t> origin_ns;  // the first event's running time: line time 0
   // Reused for every buffer so that steady streaming does not allocate.
   pfap::TextEvent text;
   std::string line;
@@ -59,12 +57,9 @@ struct Stream {
 
 }  // namespace
 
-enum { PROP_0, PROP_STATS };
-
 struct _GstPfapTextEnc {
   GstPfapBaseEnc parent;
   Stream* stream;
-  guint64 events;  // under the object lock: lines written since READY to PAUSED
 };
 
 static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
@@ -76,26 +71,17 @@ static GstStaticPadTemplate src_template = GST_STATIC_PAD_TEMPLATE(
 G_DEFINE_TYPE(GstPfapTextEnc, gst_pfap_text_enc, GST_TYPE_PFAP_BASE_ENC)
 GST_ELEMENT_REGISTER_DEFINE(pfaptextenc, "pfaptextenc", GST_RANK_NONE, GST_TYPE_PFAP_TEXT_ENC)
 
-// Forgets the time origin (FLUSH_STOP, READY to PAUSED).
-static void gst_pfap_text_enc_reset(GstPfapBaseEnc* enc) {
-  GST_PFAP_TEXT_ENC(enc)->stream->origin_ns.reset();
-}
-
 static GstFlowReturn gst_pfap_text_enc_handle_event(GstPfapBaseEnc* enc, GstBuffer* buffer,
-                                                    const pfap::MarkupEvent& event) {
+                                                    const pfap::MarkupEvent& event,
+                                                    int64_t time_ns) {
   GstPfapTextEnc* self = GST_PFAP_TEXT_ENC(enc);
   Stream& s = *self->stream;
   s.text.event = event;
-  const int64_t time = gst_pfap_base_enc_place(enc, GST_BUFFER_PTS(buffer), event);
-  if (!s.origin_ns) s.origin_ns = time;
-  s.text.time_ms = (time - *s.origin_ns + pfap::kNsPerMs / 2) / pfap::kNsPerMs;
+  s.text.time_ms = (time_ns + pfap::kNsPerMs / 2) / pfap::kNsPerMs;
   s.line.clear();
   pfap::format_text_line(s.text, s.line);
   // The format has no flag for it; a comment tells the reader and pfapparse skips it.
   if (s.text.event.uncertain) s.line += " # uncertain";
-  GST_OBJECT_LOCK(self);
-  self->events++;
-  GST_OBJECT_UNLOCK(self);
   GST_LOG_OBJECT(self, "%s", s.line.c_str());
   s.line += '\n';
 
@@ -103,40 +89,7 @@ static GstFlowReturn gst_pfap_text_enc_handle_event(GstPfapBaseEnc* enc, GstBuff
   GST_BUFFER_PTS(out) = GST_BUFFER_PTS(buffer);
   GST_BUFFER_DURATION(out) = GST_BUFFER_DURATION(buffer);
   if (GST_BUFFER_IS_DISCONT(buffer)) GST_BUFFER_FLAG_SET(out, GST_BUFFER_FLAG_DISCONT);
-  return gst_pad_push(gst_pfap_base_enc_srcpad(enc), out);
-}
-
-static void gst_pfap_text_enc_get_property(GObject* object, guint prop_id, GValue* value,
-                                           GParamSpec* pspec) {
-  GstPfapTextEnc* self = GST_PFAP_TEXT_ENC(object);
-  switch (prop_id) {
-    case PROP_STATS: {
-      GstPfapBaseEnc* enc = GST_PFAP_BASE_ENC(self);
-      GST_OBJECT_LOCK(self);
-      const guint64 events = self->events;
-      GST_OBJECT_UNLOCK(self);
-      g_value_take_boxed(
-          value, gst_structure_new("application/x-pfap-text-enc-stats", "events", G_TYPE_UINT64,
-                                   events, "malformed", G_TYPE_UINT64,
-                                   gst_pfap_base_enc_malformed(enc), "earlier", G_TYPE_UINT64,
-                                   gst_pfap_base_enc_earlier(enc), nullptr));
-      break;
-    }
-    default:
-      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
-      break;
-  }
-}
-
-static GstStateChangeReturn gst_pfap_text_enc_change_state(GstElement* element,
-                                                           GstStateChange transition) {
-  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) {
-    GstPfapTextEnc* self = GST_PFAP_TEXT_ENC(element);
-    GST_OBJECT_LOCK(self);
-    self->events = 0;
-    GST_OBJECT_UNLOCK(self);
-  }
-  return GST_ELEMENT_CLASS(gst_pfap_text_enc_parent_class)->change_state(element, transition);
+  return gst_pfap_base_enc_push(enc, out);
 }
 
 static void gst_pfap_text_enc_finalize(GObject* object) {
@@ -152,26 +105,6 @@ static void gst_pfap_text_enc_class_init(GstPfapTextEncClass* klass) {
   GST_DEBUG_CATEGORY_INIT(pfaptextenc_debug, "pfaptextenc", 0, "PFAP text writer");
 
   gobject_class->finalize = gst_pfap_text_enc_finalize;
-  gobject_class->get_property = gst_pfap_text_enc_get_property;
-
-  /**
-   * GstPfapTextEnc:stats:
-   *
-   * Counters since the element last went from READY to PAUSED (a flush keeps them), all
-   * guint64, in an application/x-pfap-text-enc-stats structure:
-   *
-   * - events: lines written
-   * - malformed: input buffers dropped because they are not valid x-pfap events
-   * - earlier: events earlier than the one before them, written at that one's time
-   */
-  g_object_class_install_property(
-      gobject_class, PROP_STATS,
-      g_param_spec_boxed("stats", "Statistics",
-                         "Counters since READY to PAUSED (guint64): events (lines written), "
-                         "malformed (input buffers dropped), earlier (events earlier than the "
-                         "one before, written at its time)",
-                         GST_TYPE_STRUCTURE,
-                         static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
 
   gst_element_class_add_static_pad_template(element_class, &sink_template);
   gst_element_class_add_static_pad_template(element_class, &src_template);
@@ -181,12 +114,7 @@ static void gst_pfap_text_enc_class_init(GstPfapTextEncClass* klass) {
       "per event",
       "gst-pfap developers");
 
-  element_class->change_state = gst_pfap_text_enc_change_state;
   enc_class->handle_event = gst_pfap_text_enc_handle_event;
-  enc_class->reset = gst_pfap_text_enc_reset;
 }
 
-static void gst_pfap_text_enc_init(GstPfapTextEnc* self) {
-  self->stream = new Stream{};
-  self->events = 0;
-}
+static void gst_pfap_text_enc_init(GstPfapTextEnc* self) { self->stream = new Stream{}; }

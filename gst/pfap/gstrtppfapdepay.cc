@@ -66,11 +66,12 @@
 #include <optional>
 #include <span>
 
+#include "markupbuffer.h"
 #include "pfap/payload.h"
 #include "pfap/recovery.h"
-#include "markupbuffer.h"
 #include "ratelimit.h"
 #include "sparse.h"
+#include "stats.h"
 
 GST_DEBUG_CATEGORY_STATIC(rtp_pfap_depay_debug);
 #define GST_CAT_DEFAULT rtp_pfap_depay_debug
@@ -441,10 +442,11 @@ static GstStructure* stats_structure(GstRtpPfapDepay* self) {
   GST_OBJECT_LOCK(self);
   const Stats s = self->stats;
   GST_OBJECT_UNLOCK(self);
-  GstStructure* out =
-      gst_structure_new("application/x-rtp-pfap-depay-stats", "packets", G_TYPE_UINT64, s.packets,
-                        "phonemes", G_TYPE_UINT64, s.phonemes, "faps", G_TYPE_UINT64, s.faps,
-                        "malformed", G_TYPE_UINT64, s.malformed, nullptr);
+  // GstRTPBaseDepayload's (seqnum, timestamp, npt-start, running-time-pts, ...) and ours.
+  GstStructure* out = pfap_owner_stats(G_OBJECT(self), GST_TYPE_RTP_BASE_DEPAYLOAD);
+  gst_structure_set(out, "packets", G_TYPE_UINT64, s.packets, "phonemes", G_TYPE_UINT64, s.phonemes,
+                    "faps", G_TYPE_UINT64, s.faps, "malformed", G_TYPE_UINT64, s.malformed,
+                    nullptr);
   for (const MalformedField& field : kMalformedFields) {
     gst_structure_set(out, field.name, G_TYPE_UINT64,
                       s.malformed_by_status[static_cast<size_t>(field.status)], nullptr);
@@ -522,8 +524,9 @@ static void gst_rtp_pfap_depay_class_init(GstRtpPfapDepayClass* klass) {
   /**
    * GstRtpPfapDepay:stats:
    *
-   * Counters since the element last went from READY to PAUSED (a flush keeps them), all
-   * guint64, in an application/x-rtp-pfap-depay-stats structure:
+   * GstRTPBaseDepayload's statistics (seqnum, timestamp, npt-start, npt-stop, play-speed,
+   * play-scale, running-time-dts, running-time-pts), with the depayloader's counters added,
+   * each guint64, since the element last went from READY to PAUSED (a flush keeps them):
    *
    * - packets: RTP packets received, good or malformed
    * - phonemes: phoneme buffers made
@@ -551,20 +554,7 @@ static void gst_rtp_pfap_depay_class_init(GstRtpPfapDepayClass* klass) {
    * - requests: requests for a complete state sent upstream (GstForceKeyUnit events)
    * - packet-lost-events: rtpjitterbuffer's packet-lost events received
    */
-  g_object_class_install_property(
-      gobject_class, PROP_STATS,
-      g_param_spec_boxed(
-          "stats", "Statistics",
-          "Counters since READY to PAUSED (guint64): packets received; phonemes and faps "
-          "output; malformed packets dropped, in total and per class (malformed-truncated, "
-          "-reserved-recovery-type, -reserved-info-bits, -missing-coverage, "
-          "-fap-index-out-of-range, -amplitude-out-of-range, -curve-zero, "
-          "-missing-final-phoneme, -trailing-bytes, -data-in-complete-recovery, "
-          "-unterminated-recovery, -empty-packet); lost packets (sequence-number gaps, "
-          "malformed packets included); gaps, recovered (gaps covered by dynamic recovery), "
-          "faps-recovered; complete-states received, complete-changes (those that changed "
-          "the state); requests for a complete state sent; packet-lost-events received",
-          GST_TYPE_STRUCTURE, static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
+  g_object_class_override_property(gobject_class, PROP_STATS, "stats");
 
   /**
    * GstRtpPfapDepay:request-recovery:

@@ -82,6 +82,7 @@
 #include "pfap/payload.h"
 #include "pfap/sender.h"
 #include "pfap/timeline.h"
+#include "stats.h"
 #include "warning.h"
 
 GST_DEBUG_CATEGORY_STATIC(rtppfappay_debug);
@@ -451,13 +452,15 @@ static GstStructure* stats_structure(GstRtpPfapPay* self) {
   GST_OBJECT_LOCK(self);
   const Stats s = self->stats;
   GST_OBJECT_UNLOCK(self);
-  return gst_structure_new("application/x-rtp-pfap-pay-stats", "packets", G_TYPE_UINT64, s.packets,
-                           "recovery-entries", G_TYPE_UINT64, s.recovery_entries,
-                           "complete-recoveries", G_TYPE_UINT64, s.complete_recoveries, "requests",
-                           G_TYPE_UINT64, s.requests, "requests-served", G_TYPE_UINT64,
-                           s.requests_served, "complete-too-large", G_TYPE_UINT64,
-                           s.complete_too_large, "oversized", G_TYPE_UINT64, s.oversized,
-                           "malformed", G_TYPE_UINT64, s.malformed, nullptr);
+  // GstRTPBasePayload's (clock-rate, running-time, seqnum, timestamp, ssrc, pt, ...) and ours.
+  GstStructure* stats = pfap_owner_stats(G_OBJECT(self), GST_TYPE_RTP_BASE_PAYLOAD);
+  gst_structure_set(stats, "packets", G_TYPE_UINT64, s.packets, "recovery-entries",
+                    G_TYPE_UINT64, s.recovery_entries, "complete-recoveries", G_TYPE_UINT64,
+                    s.complete_recoveries, "requests", G_TYPE_UINT64, s.requests,
+                    "requests-served", G_TYPE_UINT64, s.requests_served, "complete-too-large",
+                    G_TYPE_UINT64, s.complete_too_large, "oversized", G_TYPE_UINT64, s.oversized,
+                    "malformed", G_TYPE_UINT64, s.malformed, nullptr);
+  return stats;
 }
 
 static GstStateChangeReturn gst_rtp_pfap_pay_change_state(GstElement* element,
@@ -632,8 +635,9 @@ static void gst_rtp_pfap_pay_class_init(GstRtpPfapPayClass* klass) {
   /**
    * GstRtpPfapPay:stats:
    *
-   * Counters since the element last went from READY to PAUSED (a flush keeps them), all
-   * guint64, in an application/x-rtp-pfap-pay-stats structure:
+   * GstRTPBasePayload's statistics (clock-rate, running-time, seqnum, timestamp, ssrc, pt,
+   * seqnum-offset, timestamp-offset), with the payloader's counters added, each guint64,
+   * since the element last went from READY to PAUSED (a flush keeps them):
    *
    * - packets: data packets sent
    * - recovery-entries: dynamic recovery entries in them
@@ -648,17 +652,7 @@ static void gst_rtp_pfap_pay_class_init(GstRtpPfapPayClass* klass) {
    * The faults counted in the last three are each warned about at their 1st, 2nd, 4th, 8th,
    * ... occurrence only, so that a lasting fault does not flood the bus.
    */
-  g_object_class_install_property(
-      gobject_class, PROP_STATS,
-      g_param_spec_boxed("stats", "Statistics",
-                         "Counters since READY to PAUSED (guint64): packets (data), "
-                         "recovery-entries (dynamic, in them), complete-recoveries, requests "
-                         "(GstForceKeyUnit received), requests-served (complete packets that "
-                         "answered requests), complete-too-large (complete states not sent: "
-                         "over the MTU), oversized (data packets over the MTU), malformed "
-                         "(input buffers dropped)",
-                         GST_TYPE_STRUCTURE,
-                         static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
+  g_object_class_override_property(gobject_class, PROP_STATS, "stats");
 
   gst_type_mark_as_plugin_api(GST_TYPE_RTP_PFAP_RECOVERY_DEPTH, static_cast<GstPluginAPIFlags>(0));
   gst_element_class_add_static_pad_template(element_class, &sink_template);

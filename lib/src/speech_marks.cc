@@ -57,12 +57,20 @@ constexpr VisemeSet kSilence{Viseme::kNone, OculusViseme::kSil, 0, 0, 0};
 bool is_silence(const Spoken& p) { return p.visemes.mpeg4 == Viseme::kNone; }
 
 // The phonemes with every gap between one's end and the next's start filled with silence,
-// and for formats whose marks have no duration a last silence where speech ends.
+// and for formats whose marks have no duration a last silence where speech ends. Every format
+// writes whole ms, and no service writes a mark of no length or two marks at one time: a gap
+// shorter than a ms (phoneme times from audio samples leave such gaps) is no silence, the
+// phoneme before it lasting to the next one's start, and a phoneme of no length is no mark.
 std::vector<Spoken> contiguous(const std::vector<Spoken>& phonemes, bool closing_silence) {
   std::vector<Spoken> items;
   for (const Spoken& p : phonemes) {
+    if (p.end_ns <= p.start_ns) continue;
     if (!items.empty() && p.start_ns > items.back().end_ns) {
-      items.push_back({items.back().end_ns, p.start_ns, kSilence, "", false, false});
+      if (p.start_ns - items.back().end_ns < kNsPerMs) {
+        items.back().end_ns = p.start_ns;
+      } else {
+        items.push_back({items.back().end_ns, p.start_ns, kSilence, "", false, false});
+      }
     }
     items.push_back(p);
   }

@@ -14,6 +14,19 @@
 
 namespace pfap::testing {
 
+// The bytes of every buffer the harness holds now, in order: a writer's text.
+inline std::string pull_text(GstHarness* h) {
+  std::string text;
+  while (GstBuffer* b = gst_harness_try_pull(h)) {
+    GstMapInfo map;
+    gst_buffer_map(b, &map, GST_MAP_READ);
+    text.append(reinterpret_cast<const char*>(map.data), map.size);
+    gst_buffer_unmap(b, &map);
+    gst_buffer_unref(b);
+  }
+  return text;
+}
+
 class ElementHarness {
  public:
   // `factory` in a harness of its own.

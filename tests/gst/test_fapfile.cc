@@ -25,6 +25,7 @@
 #include "pfap/fap_file.h"
 #include "pfap/fap_state.h"
 #include "documented_commands.h"
+#include "element_harness.h"
 #include "pfap_buffers.h"
 #include "pipeline.h"
 #include "temp_dir.h"
@@ -396,14 +397,7 @@ RoundTrip round_trip(const std::string& bytes, double loss, uint32_t seed) {
   gst_pad_add_probe(depay_sink, GST_PAD_PROBE_TYPE_BUFFER, drop_some, &drops, nullptr);
   gst_pad_add_probe(enc_sink, GST_PAD_PROBE_TYPE_BUFFER, keep_event, &out.received, nullptr);
   push_file(h, bytes);
-  std::string text;
-  while (GstBuffer* b = gst_harness_try_pull(h)) {
-    GstMapInfo map;
-    gst_buffer_map(b, &map, GST_MAP_READ);
-    text.append(reinterpret_cast<const char*>(map.data), map.size);
-    gst_buffer_unmap(b, &map);
-    gst_buffer_unref(b);
-  }
+  const std::string text = pfap::testing::pull_text(h);
   gst_object_unref(depay_sink);
   gst_object_unref(enc_sink);
   gst_object_unref(depay);
@@ -492,13 +486,7 @@ Encoded encode(const std::string& properties, const std::vector<GstBuffer*>& buf
   for (GstBuffer* b : buffers) EXPECT_EQ(gst_harness_push(h, b), GST_FLOW_OK);
   EXPECT_TRUE(gst_harness_push_event(h, gst_event_new_eos()));
   Encoded out;
-  while (GstBuffer* b = gst_harness_try_pull(h)) {
-    GstMapInfo map;
-    gst_buffer_map(b, &map, GST_MAP_READ);
-    out.text.append(reinterpret_cast<const char*>(map.data), map.size);
-    gst_buffer_unmap(b, &map);
-    gst_buffer_unref(b);
-  }
+  out.text = pfap::testing::pull_text(h);
   while (GstMessage* m = gst_bus_pop_filtered(bus, GST_MESSAGE_WARNING)) {
     GError* error = nullptr;
     gst_message_parse_warning(m, &error, nullptr);

@@ -14,6 +14,7 @@
 #include "pfap/markup.h"
 #include "pfap/markup_event.h"
 #include "documented_commands.h"
+#include "element_harness.h"
 #include "pfap_buffers.h"
 #include "pipeline.h"
 #include "temp_dir.h"
@@ -23,6 +24,7 @@ namespace {
 using namespace std::chrono_literals;
 using pfap::Phoneme;
 using pfap::testing::Pipeline;
+using pfap::testing::pull_text;
 using pfap::testing::read_file;
 using pfap::testing::replace_all;
 using pfap::testing::source_path;
@@ -31,19 +33,6 @@ using pfap::testing::TempDir;
 constexpr GstClockTime kMs = GST_MSECOND;
 constexpr std::array<const char*, 5> kElements{"pfapmarksenc", "pfapmarksparse", "pfapparse",
                                                "rtppfappay", "pfapface"};
-
-// The text of every buffer the harness holds, in order.
-std::string pull_text(GstHarness* h) {
-  std::string text;
-  while (GstBuffer* b = gst_harness_try_pull(h)) {
-    GstMapInfo map;
-    gst_buffer_map(b, &map, GST_MAP_READ);
-    text.append(reinterpret_cast<const char*>(map.data), map.size);
-    gst_buffer_unmap(b, &map);
-    gst_buffer_unref(b);
-  }
-  return text;
-}
 
 // The messages of the bus's warnings (or errors), taken off it.
 std::vector<std::string> messages(GstBus* bus, GstMessageType type) {
@@ -91,28 +80,28 @@ TEST_F(MarksEnc, WritesPollyMarksPerUtterance) {
   make("pfapmarksenc format=polly");
   gst_harness_set_src_caps_str(h_, PFAP_MARKUP_CAPS ",alphabet=x-pfap-arpabet");
   // "HH AH" + "M" (end of text), then a second sentence starting 1 s in: "P" with no end.
-  const GstClockTime base = 5000 * kMs;  // times are counted from the first event
+  const GstClockTime base = 5000 * kMs;  // stream time: marks from 5 s
   gst_harness_push(h_, pfap::testing::phoneme_buffer(phoneme(16, 60, true), {}, base, true));
   gst_harness_push(h_, pfap::testing::phoneme_buffer(phoneme(3, 90), {}, base + 60 * kMs, false));
   EXPECT_EQ(pull_text(h_), "");  // the utterance is not over
   gst_harness_push(
       h_, pfap::testing::phoneme_buffer(phoneme(22, 80, true, true), {}, base + 150 * kMs, false));
   EXPECT_EQ(pull_text(h_),
-            "{\"time\":0,\"type\":\"sentence\",\"value\":\"HH-AH M\"}\n"
-            "{\"time\":0,\"type\":\"word\",\"value\":\"HH-AH\"}\n"
-            "{\"time\":0,\"type\":\"viseme\",\"value\":\"k\"}\n"
-            "{\"time\":60,\"type\":\"viseme\",\"value\":\"@\"}\n"
-            "{\"time\":150,\"type\":\"word\",\"value\":\"M\"}\n"
-            "{\"time\":150,\"type\":\"viseme\",\"value\":\"p\"}\n"
-            "{\"time\":230,\"type\":\"viseme\",\"value\":\"sil\"}\n");
+            "{\"time\":5000,\"type\":\"sentence\",\"value\":\"HH-AH M\"}\n"
+            "{\"time\":5000,\"type\":\"word\",\"value\":\"HH-AH\"}\n"
+            "{\"time\":5000,\"type\":\"viseme\",\"value\":\"k\"}\n"
+            "{\"time\":5060,\"type\":\"viseme\",\"value\":\"@\"}\n"
+            "{\"time\":5150,\"type\":\"word\",\"value\":\"M\"}\n"
+            "{\"time\":5150,\"type\":\"viseme\",\"value\":\"p\"}\n"
+            "{\"time\":5230,\"type\":\"viseme\",\"value\":\"sil\"}\n");
   gst_harness_push(h_, pfap::testing::phoneme_buffer(phoneme(27, 70, true), {}, base + kMs * 1000,
                                                      true));
   gst_harness_push_event(h_, gst_event_new_eos());
   EXPECT_EQ(pull_text(h_),
-            "{\"time\":1000,\"type\":\"sentence\",\"value\":\"P\"}\n"
-            "{\"time\":1000,\"type\":\"word\",\"value\":\"P\"}\n"
-            "{\"time\":1000,\"type\":\"viseme\",\"value\":\"p\"}\n"
-            "{\"time\":1070,\"type\":\"viseme\",\"value\":\"sil\"}\n");
+            "{\"time\":6000,\"type\":\"sentence\",\"value\":\"P\"}\n"
+            "{\"time\":6000,\"type\":\"word\",\"value\":\"P\"}\n"
+            "{\"time\":6000,\"type\":\"viseme\",\"value\":\"p\"}\n"
+            "{\"time\":6070,\"type\":\"viseme\",\"value\":\"sil\"}\n");
   EXPECT_TRUE(messages(bus_, GST_MESSAGE_WARNING).empty());
 }
 

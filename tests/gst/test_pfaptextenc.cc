@@ -193,33 +193,34 @@ TEST_F(PfapTextEncTest, StateEventsNameTheirKindWithOrWithoutFaps) {
   EXPECT_EQ(read[3].event, state_event(PFAP_EVENT_COMPLETE, {}));
 }
 
-TEST_F(PfapTextEncTest, TimesAreRelativeToTheFirstEventSoANonZeroFirstPtsIsZero) {
+// A file's times come back as they were: the first event at 5 s is written at 5000.
+TEST_F(PfapTextEncTest, TimesAreStreamTimesSoAFirstEventAt5SIsWrittenAt5000) {
   push(phoneme(1, 100), 5 * GST_SECOND);
   push(phoneme(2, 100), 5 * GST_SECOND + 100 * kMs);
   push(markup_buffer(state_event(PFAP_EVENT_COMPLETE, {}), 7 * GST_SECOND));
-  EXPECT_EQ(pull_lines(), (std::vector<std::string>{"0 1 100 120 -\n", "100 2 100 120 -\n",
-                                                    "2000 state complete\n"}));
+  EXPECT_EQ(pull_lines(), (std::vector<std::string>{"5000 1 100 120 -\n", "5100 2 100 120 -\n",
+                                                    "7000 state complete\n"}));
 }
 
-TEST_F(PfapTextEncTest, TimesAreRunningTimesAndANewSegmentKeepsTheOrigin) {
+TEST_F(PfapTextEncTest, TimesAreTheFirstSegmentsStreamTimesAndANewSegmentGoesOnInRunningTime) {
   push_segment(10 * GST_SECOND, 2 * GST_SECOND, 3 * GST_SECOND);
-  push(phoneme(1, 500), 12500 * kMs);      // running time 3.5 s
-  push(phoneme(2, 100), 13 * GST_SECOND);  // 4 s
+  push(phoneme(1, 500), 12500 * kMs);      // stream time 2.5 s, running time 3.5 s
+  push(phoneme(2, 100), 13 * GST_SECOND);  // 3 s, 4 s
   push_segment(0, 0, 5 * GST_SECOND);
-  push(phoneme(3, 100), 250 * kMs);  // 5.25 s
-  EXPECT_EQ(pull_lines(), (std::vector<std::string>{"0 1 500 120 -\n", "500 2 100 120 -\n",
-                                                    "1750 3 100 120 -\n"}));
+  push(phoneme(3, 100), 250 * kMs);  // running time 5.25 s: 1.25 s after the first
+  EXPECT_EQ(pull_lines(), (std::vector<std::string>{"2500 1 500 120 -\n", "3000 2 100 120 -\n",
+                                                    "4250 3 100 120 -\n"}));
 }
 
-TEST_F(PfapTextEncTest, TimesRoundToTheNearestMsAfterTheOriginIsTakenOff) {
-  const GstClockTime origin = 700'000;  // 0.7 ms
-  for (GstClockTime offset : {GstClockTime{0}, GstClockTime{499'999}, GstClockTime{500'000},
-                              GstClockTime{1'499'999}, GstClockTime{2'500'000}}) {
-    push(phoneme(1, 0), origin + offset);
+TEST_F(PfapTextEncTest, TimesRoundToTheNearestMs) {
+  const GstClockTime start = 700'000;  // 0.7 ms
+  for (GstClockTime offset : {GstClockTime{0}, GstClockTime{299'999}, GstClockTime{800'000},
+                              GstClockTime{1'799'999}, GstClockTime{2'300'000}}) {
+    push(phoneme(1, 0), start + offset);
   }
   EXPECT_EQ(pull_lines(),
-            (std::vector<std::string>{"0 1 0 120 -\n", "0 1 0 120 -\n", "1 1 0 120 -\n",
-                                      "1 1 0 120 -\n", "3 1 0 120 -\n"}));
+            (std::vector<std::string>{"1 1 0 120 -\n", "1 1 0 120 -\n", "2 1 0 120 -\n",
+                                      "2 1 0 120 -\n", "3 1 0 120 -\n"}));
 }
 
 TEST_F(PfapTextEncTest, EventWithoutPtsStartsWhereThePreviousEnded) {
@@ -228,9 +229,9 @@ TEST_F(PfapTextEncTest, EventWithoutPtsStartsWhereThePreviousEnded) {
   push(markup_buffer(state_event(PFAP_EVENT_RECOVERED, {}), kNone));
   push(phoneme(3, 40), kNone);
   push(phoneme(4, 10), GST_SECOND + 500 * kMs);
-  EXPECT_EQ(pull_lines(), (std::vector<std::string>{"0 1 100 120 -\n", "100 2 80 120 -\n",
-                                                    "180 state recovered\n", "180 3 40 120 -\n",
-                                                    "500 4 10 120 -\n"}));
+  EXPECT_EQ(pull_lines(), (std::vector<std::string>{"1000 1 100 120 -\n", "1100 2 80 120 -\n",
+                                                    "1180 state recovered\n", "1180 3 40 120 -\n",
+                                                    "1500 4 10 120 -\n"}));
 }
 
 TEST_F(PfapTextEncTest, FirstEventWithoutPtsIsWhereTheSegmentBegins) {
@@ -270,9 +271,9 @@ TEST_F(PfapTextEncTest, EarlierEventIsWrittenAtThePreviousTimeWithAWarning) {
   EXPECT_EQ(pop_warning(), "");
 
   const std::vector<std::string> lines = pull_lines();
-  EXPECT_EQ(lines,
-            (std::vector<std::string>{"0 1 100 120 -\n", "200 2 100 120 -\n", "200 3 100 120 -\n",
-                                      "200 4 100 120 -\n", "300 5 100 120 -\n"}));
+  EXPECT_EQ(lines, (std::vector<std::string>{"1000 1 100 120 -\n", "1200 2 100 120 -\n",
+                                             "1200 3 100 120 -\n", "1200 4 100 120 -\n",
+                                             "1300 5 100 120 -\n"}));
   EXPECT_EQ(read_back(lines).size(), 5u);
 }
 
@@ -308,8 +309,8 @@ TEST_F(PfapTextEncTest, MalformedBufferIsDroppedWithAWarningAndTheNextWritten) {
   EXPECT_EQ(pull_lines(), std::vector<std::string>{});
   EXPECT_NE(pop_warning().find("malformed"), std::string::npos);
 
-  push(phoneme(1, 100), 2 * GST_SECOND);  // the first good event is the origin
-  EXPECT_EQ(pull_lines(), std::vector<std::string>{"0 1 100 120 -\n"});
+  push(phoneme(1, 100), 2 * GST_SECOND);
+  EXPECT_EQ(pull_lines(), std::vector<std::string>{"2000 1 100 120 -\n"});
   EXPECT_EQ(pop_warning(), "");
 }
 
@@ -339,24 +340,28 @@ TEST_F(PfapTextEncTest, UncertainEventEndsWithACommentReadersSkip) {
   EXPECT_EQ(read_back(lines).at(0).event, event);
 }
 
-TEST_F(PfapTextEncTest, FlushStartsTheTimesAgainAtZero) {
+// After a flush the next segment is the first again: a seek to 5 s writes from 5000, and an
+// earlier time than before the flush is no fault.
+TEST_F(PfapTextEncTest, FlushTakesTheTimesFromTheNextSegment) {
   push(phoneme(1, 100), GST_SECOND);
-  push(phoneme(2, 100), 2 * GST_SECOND);
+  push(phoneme(2, 100), 8 * GST_SECOND);
   flush();
   push(phoneme(3, 100), 5 * GST_SECOND);
   push(phoneme(4, 100), 5 * GST_SECOND + 100 * kMs);
-  EXPECT_EQ(pull_lines(), (std::vector<std::string>{"0 1 100 120 -\n", "1000 2 100 120 -\n",
-                                                    "0 3 100 120 -\n", "100 4 100 120 -\n"}));
+  EXPECT_EQ(pull_lines(), (std::vector<std::string>{"1000 1 100 120 -\n", "8000 2 100 120 -\n",
+                                                    "5000 3 100 120 -\n", "5100 4 100 120 -\n"}));
+  EXPECT_EQ(pop_warning(), "");
 }
 
-TEST_F(PfapTextEncTest, ReadyToPausedStartsTheTimesAgainAtZero) {
+TEST_F(PfapTextEncTest, ReadyToPausedTakesTheTimesFromTheNextSegment) {
   push(phoneme(1, 100), GST_SECOND);
-  push(phoneme(2, 100), 2 * GST_SECOND);
+  push(phoneme(2, 100), 8 * GST_SECOND);
   ASSERT_EQ(gst_element_set_state(h_->element, GST_STATE_READY), GST_STATE_CHANGE_SUCCESS);
   ASSERT_EQ(gst_element_set_state(h_->element, GST_STATE_PLAYING), GST_STATE_CHANGE_SUCCESS);
   push(phoneme(3, 100), 5 * GST_SECOND);
-  EXPECT_EQ(pull_lines(),
-            (std::vector<std::string>{"0 1 100 120 -\n", "1000 2 100 120 -\n", "0 3 100 120 -\n"}));
+  EXPECT_EQ(pull_lines(), (std::vector<std::string>{"1000 1 100 120 -\n", "8000 2 100 120 -\n",
+                                                    "5000 3 100 120 -\n"}));
+  EXPECT_EQ(pop_warning(), "");
 }
 
 TEST_F(PfapTextEncTest, LinesReadBackAsTheSameEventsWithSentencesFromEndOfText) {
@@ -371,10 +376,10 @@ TEST_F(PfapTextEncTest, LinesReadBackAsTheSameEventsWithSentencesFromEndOfText) 
 
   const std::vector<pfap::TextEvent> read = read_back(pull_lines());
   ASSERT_EQ(read.size(), 4u);
-  EXPECT_EQ(read[0], (pfap::TextEvent{0, {PFAP_EVENT_PHONEME, a, true, false, faps}}));
-  EXPECT_EQ(read[1], (pfap::TextEvent{100, {PFAP_EVENT_PHONEME, b, false, false, {}}}));
-  EXPECT_EQ(read[2], (pfap::TextEvent{180, state_event(PFAP_EVENT_RECOVERED, faps)}));
-  EXPECT_EQ(read[3], (pfap::TextEvent{260, {PFAP_EVENT_PHONEME, c, true, false, {}}}));
+  EXPECT_EQ(read[0], (pfap::TextEvent{40, {PFAP_EVENT_PHONEME, a, true, false, faps}}));
+  EXPECT_EQ(read[1], (pfap::TextEvent{140, {PFAP_EVENT_PHONEME, b, false, false, {}}}));
+  EXPECT_EQ(read[2], (pfap::TextEvent{220, state_event(PFAP_EVENT_RECOVERED, faps)}));
+  EXPECT_EQ(read[3], (pfap::TextEvent{300, {PFAP_EVENT_PHONEME, c, true, false, {}}}));
 }
 
 }  // namespace

@@ -505,7 +505,7 @@ TEST(PfapTts, PropertiesAreDocumented) {
   g_free(specs);
   std::sort(own.begin(), own.end());
   EXPECT_EQ(own, (std::vector<std::string>{"bad-bookmarks", "pitch", "rate", "skip-bad-bookmarks",
-                                           "text", "voice", "volume"}));
+                                           "stats", "text", "voice", "volume"}));
   gchar* voice = nullptr;
   gint rate = 0, pitch = 0, volume = 0;
   g_object_get(tts, "voice", &voice, "rate", &rate, "pitch", &pitch, "volume", &volume, nullptr);

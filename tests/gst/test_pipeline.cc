@@ -467,7 +467,7 @@ TEST(GstInspect, Payloader) {
 
 TEST(GstInspect, Depayloader) {
   ASSERT_TRUE(plugin_available(kElements));
-  check_element_inspect(kDepay, "stats");
+  check_element_inspect(kDepay, "request-recovery");
 }
 
 // Each plugin needs only what its elements use (docs/elements.md): the RTP and text elements

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 #include "baseenc.h"
 
+#include <algorithm>
 #include <new>
+#include <optional>
 
 #include "basepads.h"
 #include "markupbuffer.h"
@@ -22,18 +24,24 @@ struct GstPfapBaseEncPrivate {
   GstPad* sinkpad = nullptr;
   GstPad* srcpad = nullptr;
   GstSegment segment;
-  pfap::EventTimeline timeline;  // the events' running times
-  pfap::MarkupEvent event;       // reused for every buffer
-  guint64 malformed = 0;         // under the object lock
-  guint64 earlier = 0;           // under the object lock
+  pfap::EventTimeline timeline;   // the events' running times
+  pfap::MarkupEvent event;        // reused for every buffer
+  bool pushed = false;            // the subclass pushed output for the event in hand
+  std::optional<int64_t> origin;  // file time less running time, from the first event's segment
+  // Under the object lock, since READY to PAUSED (a flush keeps them): the stats.
+  guint64 events = 0;
+  guint64 malformed = 0;
+  guint64 earlier = 0;
 };
+
+enum { PROP_0, PROP_STATS };
 
 }  // namespace
 
 G_DEFINE_ABSTRACT_TYPE_WITH_CODE(GstPfapBaseEnc, gst_pfap_base_enc, GST_TYPE_ELEMENT,
-                                 G_ADD_PRIVATE(GstPfapBaseEnc) GST_DEBUG_CATEGORY_INIT(
-                                     pfapbaseenc_debug, "pfapbaseenc", 0,
-                                     "PFAP writer base class"))
+                                 G_ADD_PRIVATE(GstPfapBaseEnc)
+                                     GST_DEBUG_CATEGORY_INIT(pfapbaseenc_debug, "pfapbaseenc", 0,
+                                                             "PFAP writer base class"))
 
 static GstPfapBaseEncPrivate* priv(GstPfapBaseEnc* enc) {
   return static_cast<GstPfapBaseEncPrivate*>(gst_pfap_base_enc_get_instance_private(enc));
@@ -42,22 +50,40 @@ static GstPfapBaseEncPrivate* priv(GstPfapBaseEnc* enc) {
 GstPad* gst_pfap_base_enc_sinkpad(GstPfapBaseEnc* enc) { return priv(enc)->sinkpad; }
 GstPad* gst_pfap_base_enc_srcpad(GstPfapBaseEnc* enc) { return priv(enc)->srcpad; }
 
-guint64 gst_pfap_base_enc_malformed(GstPfapBaseEnc* enc) {
-  GST_OBJECT_LOCK(enc);
-  const guint64 count = priv(enc)->malformed;
-  GST_OBJECT_UNLOCK(enc);
-  return count;
+GstFlowReturn gst_pfap_base_enc_push(GstPfapBaseEnc* enc, GstBuffer* buffer) {
+  priv(enc)->pushed = true;
+  return gst_pad_push(priv(enc)->srcpad, buffer);
 }
 
-guint64 gst_pfap_base_enc_earlier(GstPfapBaseEnc* enc) {
-  GST_OBJECT_LOCK(enc);
-  const guint64 count = priv(enc)->earlier;
-  GST_OBJECT_UNLOCK(enc);
-  return count;
+// How long `event` lasts: a phoneme its duration, a state event nothing.
+static int64_t event_duration_ns(const pfap::MarkupEvent& event) {
+  return event.kind == PFAP_EVENT_PHONEME ? event.phoneme.duration_ms * pfap::kNsPerMs : 0;
 }
 
-int64_t gst_pfap_base_enc_place(GstPfapBaseEnc* enc, GstClockTime pts,
-                                const pfap::MarkupEvent& event) {
+// Stream time less running time at the start of `segment` (rate 1, as x-pfap streams are).
+static int64_t stream_less_running(const GstSegment& segment) {
+  const guint64 start = segment.start + segment.offset;
+  guint64 running = 0;
+  guint64 stream = 0;
+  if (gst_segment_to_running_time_full(&segment, GST_FORMAT_TIME, start, &running) != 1 ||
+      gst_segment_to_stream_time_full(&segment, GST_FORMAT_TIME, start, &stream) != 1) {
+    return -static_cast<int64_t>(segment.base);
+  }
+  return static_cast<int64_t>(stream) - static_cast<int64_t>(running);
+}
+
+// The time in the file (ns) of an event at running time `running`: its stream time in the
+// segment of the stream's first event, where a reader put the file's times; later segments
+// go on from there in running time, so that the file's times never go back. Before 0, 0.
+static int64_t file_time(GstPfapBaseEncPrivate& p, int64_t running) {
+  if (!p.origin) p.origin = stream_less_running(p.segment);
+  return std::max<int64_t>(running + *p.origin, 0);
+}
+
+// The running time (ns) of `event`, read from a buffer with `pts`: an event without a PTS
+// starts where the one before it ended (the first where the segment begins); one earlier
+// than the one before it is placed at that one's time, with a rate-limited warning.
+static int64_t place(GstPfapBaseEnc* enc, GstClockTime pts, const pfap::MarkupEvent& event) {
   GstPfapBaseEncPrivate& p = *priv(enc);
   // A first event without a PTS is where the segment begins, whose running time is base.
   int64_t time =
@@ -70,9 +96,21 @@ int64_t gst_pfap_base_enc_place(GstPfapBaseEnc* enc, GstClockTime pts,
     PFAP_WARN_EARLIER_EVENT(enc, "written", time, p.timeline.previous_ns(), count);
     time = p.timeline.previous_ns();
   }
-  p.timeline.add(time,
-                 event.kind == PFAP_EVENT_PHONEME ? event.phoneme.duration_ms * pfap::kNsPerMs : 0);
+  p.timeline.add(time, event_duration_ns(event));
   return time;
+}
+
+// A held event's time span, as a GAP, so that the sinks downstream preroll and their running
+// time goes on while the writer holds its output (a FAP file, a Rhubarb JSON document, an
+// utterance's marks).
+static void push_gap(GstPfapBaseEnc* enc, int64_t running, const pfap::MarkupEvent& event) {
+  GstPfapBaseEncPrivate& p = *priv(enc);
+  guint64 position = 0;
+  if (running < 0 || gst_segment_position_from_running_time_full(&p.segment, GST_FORMAT_TIME,
+                                                                 running, &position) != 1) {
+    return;
+  }
+  gst_pad_push_event(p.srcpad, gst_event_new_gap(position, event_duration_ns(event)));
 }
 
 // Forgets the segment and the events' times (FLUSH_STOP, READY to PAUSED).
@@ -80,6 +118,7 @@ static void reset(GstPfapBaseEnc* enc) {
   GstPfapBaseEncPrivate& p = *priv(enc);
   gst_segment_init(&p.segment, GST_FORMAT_TIME);
   p.timeline.reset();
+  p.origin.reset();
   GstPfapBaseEncClass* klass = GST_PFAP_BASE_ENC_GET_CLASS(enc);
   if (klass->reset != nullptr) klass->reset(enc);
 }
@@ -95,8 +134,15 @@ static GstFlowReturn gst_pfap_base_enc_chain(GstPad*, GstObject* parent, GstBuff
     gst_buffer_unref(buffer);
     return GST_FLOW_OK;
   }
-  const GstFlowReturn ret = GST_PFAP_BASE_ENC_GET_CLASS(enc)->handle_event(enc, buffer, p.event);
+  GST_OBJECT_LOCK(enc);
+  p.events++;
+  GST_OBJECT_UNLOCK(enc);
+  const int64_t running = place(enc, GST_BUFFER_PTS(buffer), p.event);
+  p.pushed = false;
+  const GstFlowReturn ret =
+      GST_PFAP_BASE_ENC_GET_CLASS(enc)->handle_event(enc, buffer, p.event, file_time(p, running));
   gst_buffer_unref(buffer);
+  if (ret == GST_FLOW_OK && !p.pushed) push_gap(enc, running, p.event);
   return ret;
 }
 
@@ -156,6 +202,7 @@ static GstStateChangeReturn gst_pfap_base_enc_change_state(GstElement* element,
     // The counters start again; earlier_count is the timeline's.
     p.timeline = pfap::EventTimeline{};
     GST_OBJECT_LOCK(enc);
+    p.events = 0;
     p.malformed = 0;
     p.earlier = 0;
     GST_OBJECT_UNLOCK(enc);
@@ -176,13 +223,40 @@ static void gst_pfap_base_enc_finalize(GObject* object) {
   G_OBJECT_CLASS(gst_pfap_base_enc_parent_class)->finalize(object);
 }
 
+static void gst_pfap_base_enc_get_property(GObject* object, guint prop_id, GValue* value,
+                                           GParamSpec* pspec) {
+  GstPfapBaseEncPrivate& p = *priv(GST_PFAP_BASE_ENC(object));
+  switch (prop_id) {
+    case PROP_STATS:
+      GST_OBJECT_LOCK(object);
+      g_value_take_boxed(
+          value, gst_structure_new("application/x-pfap-enc-stats", "events", G_TYPE_UINT64,
+                                   p.events, "malformed", G_TYPE_UINT64, p.malformed, "earlier",
+                                   G_TYPE_UINT64, p.earlier, nullptr));
+      GST_OBJECT_UNLOCK(object);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
+}
+
 static void gst_pfap_base_enc_class_init(GstPfapBaseEncClass* klass) {
-  G_OBJECT_CLASS(klass)->constructed = gst_pfap_base_enc_constructed;
-  G_OBJECT_CLASS(klass)->finalize = gst_pfap_base_enc_finalize;
+  GObjectClass* gobject_class = G_OBJECT_CLASS(klass);
+  gobject_class->constructed = gst_pfap_base_enc_constructed;
+  gobject_class->finalize = gst_pfap_base_enc_finalize;
+  gobject_class->get_property = gst_pfap_base_enc_get_property;
+  // The same counters, by the same names, as every element of the plugins (docs/elements.md).
+  g_object_class_install_property(
+      gobject_class, PROP_STATS,
+      g_param_spec_boxed("stats", "Statistics",
+                         "Counters since READY to PAUSED (guint64): events (read), malformed "
+                         "(input buffers dropped), earlier (events earlier than the one before, "
+                         "written at its time)",
+                         GST_TYPE_STRUCTURE,
+                         static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
   GST_ELEMENT_CLASS(klass)->change_state = gst_pfap_base_enc_change_state;
   klass->sink_event = gst_pfap_base_enc_default_sink_event;
 }
 
-static void gst_pfap_base_enc_init(GstPfapBaseEnc* enc) {
-  new (priv(enc)) GstPfapBaseEncPrivate();
-}
+static void gst_pfap_base_enc_init(GstPfapBaseEnc* enc) { new (priv(enc)) GstPfapBaseEncPrivate(); }

@@ -5,8 +5,11 @@
 // event and handed to handle_event, a malformed one dropped with a rate-limited warning
 // (warning.h) and counted; the input caps set the src template's caps; a segment must be
 // TIME and is kept; at EOS finish writes what is held, then EOS goes on; a flush or READY
-// to PAUSED calls reset. gst_pfap_base_enc_place gives each event its running time by the
-// writers' one rule (pfap::EventTimeline). A subclass adds pad templates "sink" and "src"
+// to PAUSED calls reset. Each event gets its time in the file by the writers' one rule: its
+// running time placed by pfap::EventTimeline, as stream time of the stream's first segment
+// (a file read by the readers keeps its times; docs/elements.md). A writer that holds an event
+// (writes it later) lets downstream preroll and sync all the same: the base sends a GAP event for
+// it. The `stats` property counts for every writer. A subclass adds pad templates "sink" and "src"
 // and keeps only its writer and properties.
 #pragma once
 
@@ -24,9 +27,11 @@ G_DECLARE_DERIVABLE_TYPE(GstPfapBaseEnc, gst_pfap_base_enc, GST, PFAP_BASE_ENC, 
 struct _GstPfapBaseEncClass {
   GstElementClass parent_class;
 
-  // Writes `event`, read from `buffer` (the base unrefs it after). Required.
+  // Writes `event`, read from `buffer` (the base unrefs it after), at `time_ns` in the file
+  // (never negative, never earlier than the event before). Output goes through
+  // gst_pfap_base_enc_push. Required.
   GstFlowReturn (*handle_event)(GstPfapBaseEnc* enc, GstBuffer* buffer,
-                                const pfap::MarkupEvent& event);
+                                const pfap::MarkupEvent& event, int64_t time_ns);
   // Takes what the subclass needs from the input caps. Optional.
   void (*set_caps)(GstPfapBaseEnc* enc, GstCaps* caps);
   // Given the TIME segment event just kept, returns the event to send downstream instead
@@ -46,13 +51,6 @@ G_END_DECLS
 GstPad* gst_pfap_base_enc_sinkpad(GstPfapBaseEnc* enc);
 GstPad* gst_pfap_base_enc_srcpad(GstPfapBaseEnc* enc);
 
-// The running time (ns) of `event`, read from a buffer with `pts`: an event without a PTS
-// starts where the one before it ended (the first where the segment begins); one earlier
-// than the one before it is placed at that one's time, with a rate-limited warning.
-int64_t gst_pfap_base_enc_place(GstPfapBaseEnc* enc, GstClockTime pts,
-                                const pfap::MarkupEvent& event);
-
-// Since READY to PAUSED (a flush keeps them): input buffers dropped as malformed, and events
-// placed later than their time because they were earlier than the one before.
-guint64 gst_pfap_base_enc_malformed(GstPfapBaseEnc* enc);
-guint64 gst_pfap_base_enc_earlier(GstPfapBaseEnc* enc);
+// Pushes output on the src pad: what the subclass writes goes through here, so that the base
+// knows which events it held.
+GstFlowReturn gst_pfap_base_enc_push(GstPfapBaseEnc* enc, GstBuffer* buffer);

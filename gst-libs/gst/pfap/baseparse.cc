@@ -18,7 +18,12 @@ struct GstPfapBaseParsePrivate {
   gboolean discont;
   gboolean at_start;  // the bytes read so far may be the start of a byte order mark
   gsize mark_bytes;   // how many of them there are
+  // Under the object lock, since READY to PAUSED (a flush keeps them): the stats.
+  guint64 events;
+  guint64 bad_lines;
 };
+
+enum { PROP_0, PROP_STATS };
 
 // A UTF-8 byte order mark (U+FEFF), which editors on Windows put at the start of a text file,
 // is no part of any format read here: it is dropped before the subclass reads.
@@ -27,9 +32,9 @@ constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";
 }  // namespace
 
 G_DEFINE_ABSTRACT_TYPE_WITH_CODE(GstPfapBaseParse, gst_pfap_base_parse, GST_TYPE_ELEMENT,
-                                 G_ADD_PRIVATE(GstPfapBaseParse) GST_DEBUG_CATEGORY_INIT(
-                                     pfapbaseparse_debug, "pfapbaseparse", 0,
-                                     "PFAP text parser base class"))
+                                 G_ADD_PRIVATE(GstPfapBaseParse)
+                                     GST_DEBUG_CATEGORY_INIT(pfapbaseparse_debug, "pfapbaseparse",
+                                                             0, "PFAP text parser base class"))
 
 static GstPfapBaseParsePrivate* priv(GstPfapBaseParse* parse) {
   return static_cast<GstPfapBaseParsePrivate*>(gst_pfap_base_parse_get_instance_private(parse));
@@ -37,6 +42,20 @@ static GstPfapBaseParsePrivate* priv(GstPfapBaseParse* parse) {
 
 GstPad* gst_pfap_base_parse_sinkpad(GstPfapBaseParse* parse) { return priv(parse)->sinkpad; }
 GstPad* gst_pfap_base_parse_srcpad(GstPfapBaseParse* parse) { return priv(parse)->srcpad; }
+
+guint64 gst_pfap_base_parse_count_bad_line(GstPfapBaseParse* parse) {
+  GST_OBJECT_LOCK(parse);
+  const guint64 count = ++priv(parse)->bad_lines;
+  GST_OBJECT_UNLOCK(parse);
+  return count;
+}
+
+guint64 gst_pfap_base_parse_bad_lines(GstPfapBaseParse* parse) {
+  GST_OBJECT_LOCK(parse);
+  const guint64 count = priv(parse)->bad_lines;
+  GST_OBJECT_UNLOCK(parse);
+  return count;
+}
 
 static void reset(GstPfapBaseParse* parse) {
   priv(parse)->need_events = TRUE;
@@ -89,6 +108,9 @@ GstFlowReturn gst_pfap_base_parse_push(GstPfapBaseParse* parse, const pfap::Text
   if (p.discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
   p.discont = FALSE;
   gst_pfap_base_parse_start_output(parse);
+  GST_OBJECT_LOCK(parse);
+  p.events++;
+  GST_OBJECT_UNLOCK(parse);
   GST_LOG_OBJECT(parse, "event kind %d at %" GST_TIME_FORMAT, event.event.kind,
                  GST_TIME_ARGS(GST_BUFFER_PTS(buffer)));
   return gst_pad_push(p.srcpad, buffer);
@@ -175,21 +197,55 @@ static gboolean gst_pfap_base_parse_sink_event(GstPad* pad, GstObject* parent, G
 
 static GstStateChangeReturn gst_pfap_base_parse_change_state(GstElement* element,
                                                              GstStateChange transition) {
-  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) reset(GST_PFAP_BASE_PARSE(element));
+  if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) {
+    GstPfapBaseParse* parse = GST_PFAP_BASE_PARSE(element);
+    GST_OBJECT_LOCK(parse);
+    priv(parse)->events = 0;
+    priv(parse)->bad_lines = 0;
+    GST_OBJECT_UNLOCK(parse);
+    reset(parse);
+  }
   return GST_ELEMENT_CLASS(gst_pfap_base_parse_parent_class)->change_state(element, transition);
 }
 
 static void gst_pfap_base_parse_constructed(GObject* object) {
   G_OBJECT_CLASS(gst_pfap_base_parse_parent_class)->constructed(object);
   GstPfapBaseParsePrivate& p = *priv(GST_PFAP_BASE_PARSE(object));
-  pfap_base_add_pads(GST_ELEMENT(object), gst_pfap_base_parse_chain,
-                     gst_pfap_base_parse_sink_event, &p.sinkpad, &p.srcpad);
+  pfap_base_add_pads(GST_ELEMENT(object), gst_pfap_base_parse_chain, gst_pfap_base_parse_sink_event,
+                     &p.sinkpad, &p.srcpad);
   pfap_noseek_set_src_functions(p.srcpad);
 }
 
+static void gst_pfap_base_parse_get_property(GObject* object, guint prop_id, GValue* value,
+                                             GParamSpec* pspec) {
+  GstPfapBaseParsePrivate& p = *priv(GST_PFAP_BASE_PARSE(object));
+  switch (prop_id) {
+    case PROP_STATS:
+      GST_OBJECT_LOCK(object);
+      g_value_take_boxed(
+          value, gst_structure_new("application/x-pfap-parse-stats", "events", G_TYPE_UINT64,
+                                   p.events, "bad-lines", G_TYPE_UINT64, p.bad_lines, nullptr));
+      GST_OBJECT_UNLOCK(object);
+      break;
+    default:
+      G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
+      break;
+  }
+}
+
 static void gst_pfap_base_parse_class_init(GstPfapBaseParseClass* klass) {
-  G_OBJECT_CLASS(klass)->constructed = gst_pfap_base_parse_constructed;
+  GObjectClass* gobject_class = G_OBJECT_CLASS(klass);
+  gobject_class->constructed = gst_pfap_base_parse_constructed;
+  gobject_class->get_property = gst_pfap_base_parse_get_property;
   GST_ELEMENT_CLASS(klass)->change_state = gst_pfap_base_parse_change_state;
+  // The same counters, by the same names, as every element of the plugins (docs/elements.md).
+  g_object_class_install_property(
+      gobject_class, PROP_STATS,
+      g_param_spec_boxed("stats", "Statistics",
+                         "Counters since READY to PAUSED (guint64): events (output), bad-lines "
+                         "(skipped, with skip-bad-lines)",
+                         GST_TYPE_STRUCTURE,
+                         static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
 }
 
 static void gst_pfap_base_parse_init(GstPfapBaseParse* parse) {

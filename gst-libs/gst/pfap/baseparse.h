@@ -6,7 +6,8 @@
 // read_chunk, a UTF-8 byte order mark at the start of the text left out; the upstream
 // stream-start goes on sparse (sparse.h); upstream caps, segments and gaps are dropped; at EOS
 // finish reads what is left, then the output's first events go if no buffer sent them, then
-// EOS; a flush or READY to PAUSED calls reset. The output cannot seek (noseek.h). A subclass
+// EOS; a flush or READY to PAUSED calls reset. The output cannot seek (noseek.h). The `stats`
+// property counts the events output and the bad lines skipped for every parser. A subclass
 // adds pad templates "sink" and "src" and keeps only its reader and properties.
 #pragma once
 
@@ -48,6 +49,11 @@ GstPad* gst_pfap_base_parse_srcpad(GstPfapBaseParse* parse);
 // Sends the output's stream-start (if upstream sent none), caps and TIME segment from 0, once
 // per stream; pushing a buffer does it too.
 void gst_pfap_base_parse_start_output(GstPfapBaseParse* parse);
+
+// Counts a bad line skipped (stats: bad-lines); returns the count since READY to PAUSED.
+guint64 gst_pfap_base_parse_count_bad_line(GstPfapBaseParse* parse);
+// The bad lines skipped since READY to PAUSED.
+guint64 gst_pfap_base_parse_bad_lines(GstPfapBaseParse* parse);
 
 // Pushes `event` as an x-pfap buffer at its time from the start of the text (a phoneme
 // lasting its duration), the first after a start or flush DISCONT.
