@@ -59,6 +59,11 @@ MarkupEvent pause_event(const tts::Utterance& utterance) {
   return e;
 }
 
+size_t max_text_characters(double seconds) {
+  return kTextSlackCharacters +
+         static_cast<size_t>(std::max(seconds, 0.0) * kMaxCharactersPerSecond);
+}
+
 const char* problem_text(Problem p) {
   switch (p) {
     case Problem::kNone:
@@ -69,6 +74,8 @@ const char* problem_text(Problem p) {
       return "the audio is silent: it is one pause";
     case Problem::kBadRate:
       return "the sample rate is outside 16000..48000 Hz: the audio is one pause";
+    case Problem::kTextTooLong:
+      return "the text is far longer than the audio can hold: the audio is one pause";
     case Problem::kPoorMatch:
       return "the audio matches the text poorly: the times may be wrong";
   }
@@ -100,6 +107,11 @@ double heard_agreement(const std::vector<tts::SpokenPhoneme>& phonemes,
 bool align(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
            std::span<const int16_t> audio, unsigned rate, Alignment& out, std::string& error) {
   out = Alignment{};
+  if (utterance.text.size() > max_text_characters(static_cast<double>(audio.size()) / rate)) {
+    out.problem = Problem::kTextTooLong;
+    pause_over(utterance, audio.size(), rate, out);
+    return true;
+  }
   tts::Speech syn;
   if (!tts::speak(utterance, voice, syn, error)) return false;
   out.inexact = syn.inexact;

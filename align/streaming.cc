@@ -107,8 +107,12 @@ bool StreamingAligner::start(const tts::Utterance& utterance, const tts::VoiceSe
                              unsigned rate, std::string& error) {
   *this = StreamingAligner{};
   rate_ = rate;
-  if (!tts::speak(utterance, voice, syn_, error)) return false;
-  if (rate < kMinRate || rate > kMaxRate) {
+  // The audio to come is unknown: the text is bounded as for the most align() takes.
+  if (utterance.text.size() > max_text_characters(kMaxAudioSeconds)) {
+    problem_ = Problem::kTextTooLong;
+  } else if (!tts::speak(utterance, voice, syn_, error)) {
+    return false;
+  } else if (rate < kMinRate || rate > kMaxRate) {
     problem_ = Problem::kBadRate;
   } else if (std::none_of(syn_.phonemes.begin(), syn_.phonemes.end(),
                           [](const auto& p) { return p.event.phoneme.symbol != 0; })) {
