@@ -376,5 +376,41 @@ TEST(Aligner, TextFarLongerThanTheAudioIsOnePauseUnspoken) {
   EXPECT_EQ(aligned(fits, s.samples, s.sample_rate).problem, Problem::kPoorMatch);
 }
 
+// Issue 31: the silence before a sentence, however long, is a pause, and the first sound
+// starts where the speaker's does.
+TEST(Aligner, LeadingSilenceIsAPause) {
+  const tts::Speech truth =
+      phonetic_truth("Always remember the open ocean.", {"en-us", 140, 60, 100});
+  for (const double lead_seconds : {0.0, 2.0}) {
+    SCOPED_TRACE(lead_seconds);
+    const auto lead = static_cast<size_t>(lead_seconds * truth.sample_rate);
+    std::vector<int16_t> audio(lead, 0);
+    audio.insert(audio.end(), truth.samples.begin(), truth.samples.end());
+    audio.resize(audio.size() + truth.sample_rate, 0);  // and a second after
+    const Alignment a = aligned("Always remember the open ocean.", audio, truth.sample_rate);
+    expect_tiles(a, audio.size(), truth.sample_rate);
+    size_t first = 0;  // the first sound
+    while (first < a.phonemes.size() && a.phonemes[first].event.phoneme.symbol == 0) ++first;
+    ASSERT_LT(first, a.phonemes.size());
+    if (lead > 0) {
+      EXPECT_EQ(first, 1u);  // one pause, then the sound
+    }
+    size_t want = lead;
+    for (const tts::SpokenPhoneme& p : truth.phonemes) {
+      if (p.event.phoneme.symbol != 0) {
+        want += p.start;
+        break;
+      }
+    }
+    const double error_ms =
+        std::abs(static_cast<double>(a.phonemes[first].start) - static_cast<double>(want)) * 1000 /
+        truth.sample_rate;
+    std::printf("lead-in %.1f s: first sound %.1f ms off\n", lead_seconds, error_ms);
+    EXPECT_LT(error_ms, 50);
+    EXPECT_EQ(a.phonemes.back().event.phoneme.symbol, 0);  // the second after: a pause
+    EXPECT_TRUE(a.phonemes.back().event.phoneme.end_of_text);
+  }
+}
+
 }  // namespace
 }  // namespace pfap::align

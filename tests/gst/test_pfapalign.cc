@@ -353,6 +353,30 @@ TEST(PfapAlign, TextFarLongerThanTheAudioWarnsAndIsOnePause) {
   EXPECT_EQ(r.audio, s.samples);
 }
 
+// Issue 31: 2 s of silence before a sentence is a pause, offline and live, and the first sound
+// starts within 50 ms of the speaker's (espeak-ng starts this text with no pause of its own).
+TEST(PfapAlign, LeadingSilenceIsAPauseOfflineAndLive) {
+  constexpr const char* kVowelFirst = "Always remember the open ocean.";
+  const pfap::tts::Speech s = say(kVowelFirst);
+  ASSERT_NE(s.phonemes[0].event.phoneme.symbol, 0);
+  std::vector<int16_t> audio(2 * s.sample_rate, 0);
+  audio.insert(audio.end(), s.samples.begin(), s.samples.end());
+  for (const bool live : {false, true}) {
+    SCOPED_TRACE(live ? "live" : "offline");
+    const Result r = run(audio, s.sample_rate, kVowelFirst, {}, "en", live);
+    ASSERT_GE(r.events.size(), 2u);
+    EXPECT_EQ(r.events[0].event.phoneme.symbol, 0);
+    size_t first = 0;  // the first sound (live, the pause comes in pieces)
+    while (first < r.events.size() && r.events[first].event.phoneme.symbol == 0) ++first;
+    ASSERT_LT(first, r.events.size());
+    const double error_ms =
+        std::abs(static_cast<double>(r.events[first].pts) - 2.0 * GST_SECOND) / GST_MSECOND;
+    std::printf("%s, lead-in 2 s: first sound %.1f ms off\n", live ? "live" : "offline", error_ms);
+    EXPECT_LT(error_ms, 50);
+    expect_tiles(r, gst_util_uint64_scale(audio.size(), GST_SECOND, s.sample_rate));
+  }
+}
+
 TEST(PfapAlign, WaitForTheTextsEosEndsWithTheStream) {
   // text_sink linked, its EOS never comes: the audio's EOS waits for it, and stopping the
   // element ends the wait instead of hanging.
