@@ -59,6 +59,11 @@ MarkupEvent pause_event(const tts::Utterance& utterance) {
   return e;
 }
 
+size_t max_text_characters(double seconds) {
+  return kTextSlackCharacters +
+         static_cast<size_t>(std::max(seconds, 0.0) * kMaxCharactersPerSecond);
+}
+
 const char* problem_text(Problem p) {
   switch (p) {
     case Problem::kNone:
@@ -69,6 +74,8 @@ const char* problem_text(Problem p) {
       return "the audio is silent: it is one pause";
     case Problem::kBadRate:
       return "the sample rate is outside 16000..48000 Hz: the audio is one pause";
+    case Problem::kTextTooLong:
+      return "the text is far longer than the audio can hold: the audio is one pause";
     case Problem::kPoorMatch:
       return "the audio matches the text poorly: the times may be wrong";
   }
@@ -95,11 +102,33 @@ double heard_agreement(const std::vector<tts::SpokenPhoneme>& phonemes,
   return viseme_agreement(frames(phonemes), frames(heard.phonemes));
 }
 
+// A pause pad_with_pauses() put at an end that is shorter than kMinSilenceMs is no silence
+// (snap_to_silence's rule): its samples go to the phoneme next to it, and end of text back
+// onto the last. `bounds` holds each event's start and the end.
+void drop_short_end_pauses(EndPauses put, std::vector<MarkupEvent>& events,
+                           std::vector<size_t>& bounds, unsigned rate) {
+  const size_t shortest = size_t{kMinSilenceMs} * rate / 1000;
+  if (put.last && events.size() > 1 && bounds.end()[-1] - bounds.end()[-2] < shortest) {
+    events.end()[-2].phoneme.end_of_text = events.back().phoneme.end_of_text;
+    events.pop_back();
+    bounds.erase(bounds.end() - 2);
+  }
+  if (put.first && events.size() > 1 && bounds[1] - bounds[0] < shortest) {
+    events.erase(events.begin());
+    bounds.erase(bounds.begin() + 1);
+  }
+}
+
 }  // namespace
 
 bool align(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
            std::span<const int16_t> audio, unsigned rate, Alignment& out, std::string& error) {
   out = Alignment{};
+  if (utterance.text.size() > max_text_characters(static_cast<double>(audio.size()) / rate)) {
+    out.problem = Problem::kTextTooLong;
+    pause_over(utterance, audio.size(), rate, out);
+    return true;
+  }
   tts::Speech syn;
   if (!tts::speak(utterance, voice, syn, error)) return false;
   out.inexact = syn.inexact;
@@ -123,15 +152,12 @@ bool align(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
     pause_over(utterance, audio.size(), rate, out);
     return true;
   }
-  // The synthetic speech has almost no silence about it, a recording often has much: padded
-  // with silence, its ends have pause frames to match the recording's.
-  const size_t pad = syn.sample_rate / 10;
-  std::vector<int16_t> padded(pad, 0);
-  padded.insert(padded.end(), syn.samples.begin(), syn.samples.end());
-  padded.resize(padded.size() + pad, 0);
-  const Features synf = mfcc(padded, syn.sample_rate);
-  // A pause the speaker makes between words and espeak-ng does not is held at the word's end.
-  const std::vector<bool> rest = pause_frames(syn.phonemes, pad, synf);
+  // The synthetic speech has almost no silence about it, a recording often has much: a pause
+  // at each end holds the recording's, and a pause the speaker makes between words and
+  // espeak-ng does not is held at the word's end.
+  const EndPauses put = pad_with_pauses(syn, syn.sample_rate / 10);
+  const Features synf = mfcc(syn.samples, syn.sample_rate);
+  const std::vector<bool> rest = pause_frames(syn.phonemes, 0, synf);
   const Warp w = warp(synf, rec, kMaxWarpCells, &rest);
   out.relative_cost = w.relative_cost;
   const double ratio = speech_seconds(rec) / std::max(speech_seconds(synf), 0.01);
@@ -141,7 +167,7 @@ bool align(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
 
   std::vector<double> starts;
   for (size_t k = 1; k < syn.phonemes.size(); ++k) {
-    starts.push_back(map_boundary(syn.phonemes[k].start + pad, synf, rec, w));
+    starts.push_back(map_boundary(syn.phonemes[k].start, synf, rec, w));
   }
   snap_to_silence(syn.phonemes, audio, rate, starts);
 
@@ -155,10 +181,13 @@ bool align(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
     bounds.push_back(std::max(s, bounds.back()));
   }
   bounds.push_back(audio.size());
+  std::vector<MarkupEvent> events;
+  for (const tts::SpokenPhoneme& p : syn.phonemes) events.push_back(p.event);
+  drop_short_end_pauses(put, events, bounds, rate);
 
   const std::vector<double> f0 = tts::segment_f0(audio, rate, bounds);
-  for (size_t k = 0; k < syn.phonemes.size(); ++k) {
-    MarkupEvent e = syn.phonemes[k].event;
+  for (size_t k = 0; k < events.size(); ++k) {
+    MarkupEvent e = events[k];
     e.phoneme.f0 = f0_code(static_cast<unsigned>(std::lround(f0[k])));
     tts::add_phoneme(e, bounds[k], bounds[k + 1], rate, out.phonemes);
   }

@@ -23,12 +23,14 @@ namespace pfap::align {
 // Why an alignment is only a pause or may be wrong; each a warning for the user.
 enum class Problem {
   kNone,
-  kEmptyText,  // no phonemes to align: one pause over the audio
-  kNoSpeech,   // the audio is all below kSpeechLevelDb: one pause, bookmarks on it
-  kBadRate,    // the rate is outside kMinRate..kMaxRate: one pause, bookmarks on it
-  kPoorMatch,  // aligned, but the audio matches the text poorly: the recognizer hears other
-               // visemes than the aligned ones, relative_cost very high, or the speech much
-               // longer or shorter than the text's spoken by espeak-ng
+  kEmptyText,    // no phonemes to align: one pause over the audio
+  kNoSpeech,     // the audio is all below kSpeechLevelDb: one pause, bookmarks on it
+  kBadRate,      // the rate is outside kMinRate..kMaxRate: one pause, bookmarks on it
+  kTextTooLong,  // more text than max_text_characters(): one pause, bookmarks on it, the text
+                 // not spoken
+  kPoorMatch,    // aligned, but the audio matches the text poorly: the recognizer hears other
+                 // visemes than the aligned ones, relative_cost very high, or the speech much
+                 // longer or shorter than the text's spoken by espeak-ng
 };
 
 const char* problem_text(Problem p);
@@ -43,6 +45,18 @@ inline constexpr double kSureMatchCost = 0.72;
 inline constexpr double kPoorHeardAgreement = 0.44;
 inline constexpr double kPoorMatchCost = 0.97;
 inline constexpr double kMaxSpeechRatio = 2.5;  // recording's speech over espeak-ng's, or back
+
+// The most audio one alignment takes, in seconds: pfapalign keeps no more of a stream, and a
+// live utterance's text is bounded as for this much audio.
+inline constexpr unsigned kMaxAudioSeconds = 600;
+// The most text (code points, bookmarks left out) that `seconds` of audio can hold:
+// kMaxCharactersPerSecond, about three times fast speech (the Festival corpus speaks 14 a
+// second), and kTextSlackCharacters for short audio. espeak-ng's work and memory grow with the
+// text, whatever the audio (a 1 MB text took 7.7 GB for 1.9 s of audio): a longer text is
+// refused before it is spoken (docs/security.md).
+inline constexpr double kMaxCharactersPerSecond = 40;
+inline constexpr size_t kTextSlackCharacters = 200;
+size_t max_text_characters(double seconds);
 
 struct Alignment {
   // Phonemes on the recording: contiguous from sample 0 to the audio's end; starts in

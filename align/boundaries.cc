@@ -33,9 +33,42 @@ void to_phonetic_boundaries(tts::Speech& syn) {
   }
 }
 
+EndPauses pad_with_pauses(tts::Speech& syn, size_t pad) {
+  EndPauses put;
+  std::vector<tts::SpokenPhoneme>& ph = syn.phonemes;
+  const size_t end = syn.samples.size() + pad;
+  syn.samples.insert(syn.samples.begin(), pad, 0);
+  syn.samples.resize(syn.samples.size() + pad, 0);
+  for (size_t k = 1; k < ph.size(); ++k) ph[k].start += pad;
+  MarkupEvent pause;
+  pause.kind = PFAP_EVENT_PHONEME;
+  if (ph.empty() || !is_pause(ph.front())) {
+    if (!ph.empty()) ph.front().start = pad;
+    ph.insert(ph.begin(), tts::SpokenPhoneme{pause, 0, 0});
+    put.first = true;
+  }
+  if (!is_pause(ph.back())) {
+    std::swap(pause.phoneme.end_of_text, ph.back().event.phoneme.end_of_text);
+    ph.push_back(tts::SpokenPhoneme{pause, end, 0});
+    put.last = true;
+  }
+  return put;
+}
+
 std::vector<bool> pause_frames(const std::vector<tts::SpokenPhoneme>& phonemes, size_t offset,
                                const Features& features) {
   std::vector<bool> rest(features.n_frames, false);
+  if (phonemes.empty()) return rest;
+  // The pauses at the ends: every frame up to the first sound's start, from the last pause's.
+  if (is_pause(phonemes.front()) && phonemes.size() > 1) {
+    const size_t to = std::min(features.frame_at(phonemes[1].start + offset), rest.size());
+    std::fill(rest.begin(), rest.begin() + static_cast<std::ptrdiff_t>(to), true);
+  }
+  if (is_pause(phonemes.back()) && phonemes.size() > 1) {
+    const size_t from =
+        std::min(features.frame_at(phonemes.back().start + offset) + 1, rest.size());
+    std::fill(rest.begin() + static_cast<std::ptrdiff_t>(from), rest.end(), true);
+  }
   for (size_t k = 1; k < phonemes.size(); ++k) {
     if (!phonemes[k].event.phoneme.word_begin || is_pause(phonemes[k]) ||
         is_pause(phonemes[k - 1])) {

@@ -28,11 +28,23 @@ inline constexpr double kPhoneticLeadSeconds = 0.010;
 //    start before it.
 void to_phonetic_boundaries(tts::Speech& syn);
 
+// Pads `syn` with `pad` samples of silence at both ends, each end a pause: the first phoneme
+// when it is one (espeak-ng starts some texts with a short pause), else a pause put before it;
+// the same at the end, end of text moved onto it. A recording's silence before and after its
+// speech, however long, then has a pause to be (pause_frames() lets the warp hold it there).
+// Which ends got a pause of their own:
+struct EndPauses {
+  bool first = false, last = false;
+};
+EndPauses pad_with_pauses(tts::Speech& syn, size_t pad);
+
 // Per frame of `features` (the synthetic speech of `phonemes`, whose starts are `offset`
 // samples earlier), whether a pause the speaker makes and the synthesis lacks may be matched
 // there: the last frame before each word that follows speech, so that the word's start maps
-// to the pause's end and the word before holds over it. Speakers pause between words; at
-// every phoneme boundary it did worse (docs/align.md, "Live").
+// to the pause's end and the word before holds over it; and every frame of a pause at the
+// start or the end, which holds the recording's silence before and after its speech (issue
+// 31). Speakers pause between words; at every phoneme boundary it did worse (docs/align.md,
+// "Live").
 std::vector<bool> pause_frames(const std::vector<tts::SpokenPhoneme>& phonemes, size_t offset,
                                const Features& features);
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <utility>
 
 namespace pfap::align {
 namespace {
@@ -31,17 +32,38 @@ namespace {
 
 enum Step : uint8_t { kDiagonal, kUp, kLeft };  // from (i-1, j-1), (i-1, j), (i, j-1)
 
+// The first and last frame of `f` within kLoudRangeDb of its loudest (the level dimension):
+// where its speech begins and ends. The whole when none is.
+constexpr float kLoudRangeDb = 30;
+std::pair<size_t, size_t> loud_span(const Features& f) {
+  constexpr float kLoud = -kLoudRangeDb / kLevelRangeDb * kLevelWeight;
+  auto loud = [&](size_t k) { return f.data[k * Features::kDims + Features::kMfccs] >= kLoud; };
+  size_t first = 0, last = f.n_frames - 1;
+  while (first < last && !loud(first)) ++first;
+  while (last > first && !loud(last)) --last;
+  return first < last ? std::pair{first, last} : std::pair{size_t{0}, f.n_frames - 1};
+}
+
 }  // namespace
 
 Warp warp(const Features& a, const Features& b, size_t max_cells, const std::vector<bool>* rest) {
   const size_t n = a.n_frames, m = b.n_frames;
-  // Row i covers columns [lo[i], hi[i]) about the diagonal's column i * m / n.
+  // Row i covers columns [lo[i], hi[i]) about the line through the loud spans' ends (the
+  // diagonal when both are loud throughout): silence before or after the speech, seconds of it
+  // in a recording and none in the synthesis, does not take the speech out of the band.
+  const auto [a0, a1] = loud_span(a);
+  const auto [b0, b1] = loud_span(b);
+  const double slope = a1 > a0 ? static_cast<double>(b1 - b0) / static_cast<double>(a1 - a0)
+                               : static_cast<double>(m) / static_cast<double>(n);
   size_t radius = std::max(n, m) / 2 + 1;
   if (n * (2 * radius + 1) > max_cells) radius = std::max<size_t>(max_cells / n / 2, 1);
-  radius = std::max(radius, (m + n - 1) / n);  // neighbouring rows' bands must touch
+  // Neighbouring rows' bands must touch.
+  radius = std::max({radius, (m + n - 1) / n, static_cast<size_t>(std::ceil(slope))});
   std::vector<size_t> lo(n), hi(n);
   for (size_t i = 0; i < n; ++i) {
-    const size_t c = n > 1 ? i * (m - 1) / (n - 1) : 0;
+    const double line =
+        static_cast<double>(b0) + (static_cast<double>(i) - static_cast<double>(a0)) * slope;
+    const auto c = static_cast<size_t>(std::clamp(line, 0.0, static_cast<double>(m - 1)));
     lo[i] = c > radius ? c - radius : 0;
     hi[i] = std::min(m, c + radius + 1);
   }

@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <utility>
 
 #include "aligner.h"  // kSpeechLevelDb
 #include "f0.h"
@@ -221,6 +222,21 @@ const char* problem_text(RecognitionProblem p) {
   return "?";
 }
 
+std::vector<size_t> recognition_windows(const Features& level, size_t n_samples) {
+  std::vector<size_t> starts = {0};
+  const auto samples = [&](double seconds) { return static_cast<size_t>(seconds * level.rate); };
+  while (n_samples - starts.back() > samples(kMaxWindowSeconds)) {
+    const size_t from = starts.back() + samples(kMinWindowSeconds);
+    const size_t to = starts.back() + samples(kMaxWindowSeconds);
+    size_t quietest = level.frame_at(from);
+    for (size_t k = quietest; k < level.n_frames && level.centre(k) < to; ++k) {
+      if (level.level_db[k] < level.level_db[quietest]) quietest = k;
+    }
+    starts.push_back(std::clamp(level.centre(quietest), from, to));
+  }
+  return starts;
+}
+
 #if PFAP_HAVE_POCKETSPHINX
 bool recognition_available() { return true; }
 
@@ -244,12 +260,27 @@ bool recognize(std::span<const int16_t> audio, unsigned rate, Recognition& out,
     pause_over(audio.size(), rate, out);
     return false;
   }
-  std::vector<Phone> phones;
-  {
-    std::lock_guard<std::mutex> turn(decoder->lock);
-    phones = decode(decoder->ps, audio);
+  // Each window's phones, as (symbol, first sample), consecutive pauses merged.
+  std::vector<std::pair<uint8_t, size_t>> phones;
+  const std::vector<size_t> windows = recognition_windows(level, audio.size());
+  for (size_t w = 0; w < windows.size(); ++w) {
+    const size_t from = windows[w];
+    const size_t to = w + 1 < windows.size() ? windows[w + 1] : audio.size();
+    std::vector<Phone> heard;
+    {
+      std::lock_guard<std::mutex> turn(decoder->lock);
+      heard = decode(decoder->ps, audio.subspan(from, to - from));
+    }
+    for (size_t k = 0; k < heard.size(); ++k) {
+      if (!phones.empty() && heard[k].symbol == 0 && phones.back().first == 0) continue;
+      const size_t start =
+          k == 0 ? from
+                 : from + std::min(static_cast<size_t>(frame_start(heard[k].first_frame, rate)),
+                                   to - from);
+      phones.emplace_back(heard[k].symbol, start);
+    }
   }
-  if (std::none_of(phones.begin(), phones.end(), [](const Phone& p) { return p.symbol != 0; })) {
+  if (std::none_of(phones.begin(), phones.end(), [](const auto& p) { return p.first != 0; })) {
     out.problem = RecognitionProblem::kNothingHeard;
     pause_over(audio.size(), rate, out);
     return true;
@@ -257,20 +288,17 @@ bool recognize(std::span<const int16_t> audio, unsigned rate, Recognition& out,
 
   std::vector<size_t> bounds;
   bounds.push_back(0);
-  for (size_t k = 1; k < phones.size(); ++k) {
-    const size_t s =
-        std::min(static_cast<size_t>(frame_start(phones[k].first_frame, rate)), audio.size());
-    bounds.push_back(std::max(s, bounds.back()));
-  }
+  for (size_t k = 1; k < phones.size(); ++k)
+    bounds.push_back(std::max(phones[k].second, bounds.back()));
   bounds.push_back(audio.size());
 
   const std::vector<double> f0 = tts::segment_f0(audio, rate, bounds);
   for (size_t k = 0; k < phones.size(); ++k) {
     MarkupEvent e;
     e.kind = PFAP_EVENT_PHONEME;
-    e.phoneme.symbol = phones[k].symbol;
+    e.phoneme.symbol = phones[k].first;
     e.phoneme.f0 = f0_code(static_cast<unsigned>(std::lround(f0[k])));
-    e.phoneme.word_begin = phones[k].symbol != 0 && (k == 0 || phones[k - 1].symbol == 0);
+    e.phoneme.word_begin = phones[k].first != 0 && (k == 0 || phones[k - 1].first == 0);
     e.sentence_start = k == 0;
     e.phoneme.end_of_text = k + 1 == phones.size();
     tts::add_phoneme(e, bounds[k], bounds[k + 1], rate, out.phonemes);

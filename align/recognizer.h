@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "mfcc.h"
 #include "speech.h"
 #include "streaming.h"  // kLookaheadMs, kHoldMs, kStepMs: the live bound, one for both modes
 
@@ -42,6 +43,18 @@ struct Recognition {
 
 // Whether this build has the recognizer (pocketsphinx found at build time).
 bool recognition_available();
+
+// pocketsphinx keeps every frame of an utterance (its features, for the mean over the
+// utterance, and the search's history): 4.7 MB per second of audio, 2.9 GB for 600 s of noise.
+// recognize() therefore decodes audio longer than kMaxWindowSeconds in windows, each cut at the
+// quietest 5 ms frame between kMinWindowSeconds and kMaxWindowSeconds after its start (a pause
+// where there is one); its memory is that of one window (docs/security.md).
+inline constexpr double kMinWindowSeconds = 10;
+inline constexpr double kMaxWindowSeconds = 20;
+
+// Where recognize() cuts audio whose frames' levels are `level` (mfcc()'s, over the audio):
+// each window's first sample, the first 0.
+std::vector<size_t> recognition_windows(const Features& level, size_t n_samples);
 
 // Recognizes `audio` (mono, `rate` Hz, kMinRate..kMaxRate: the acoustic front end takes the
 // rate as it is, over the model's 130..6800 Hz band). False with `error`, and `out` one pause,

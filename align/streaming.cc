@@ -107,8 +107,12 @@ bool StreamingAligner::start(const tts::Utterance& utterance, const tts::VoiceSe
                              unsigned rate, std::string& error) {
   *this = StreamingAligner{};
   rate_ = rate;
-  if (!tts::speak(utterance, voice, syn_, error)) return false;
-  if (rate < kMinRate || rate > kMaxRate) {
+  // The audio to come is unknown: the text is bounded as for the most align() takes.
+  if (utterance.text.size() > max_text_characters(kMaxAudioSeconds)) {
+    problem_ = Problem::kTextTooLong;
+  } else if (!tts::speak(utterance, voice, syn_, error)) {
+    return false;
+  } else if (rate < kMinRate || rate > kMaxRate) {
     problem_ = Problem::kBadRate;
   } else if (std::none_of(syn_.phonemes.begin(), syn_.phonemes.end(),
                           [](const auto& p) { return p.event.phoneme.symbol != 0; })) {
@@ -119,12 +123,8 @@ bool StreamingAligner::start(const tts::Utterance& utterance, const tts::VoiceSe
     return true;
   }
   to_phonetic_boundaries(syn_);
-  // As align() does: silence before the synthetic speech matches the recording's lead-in;
-  // the first phoneme (espeak-ng's short pause) takes it.
-  const size_t pad = syn_.sample_rate / 10;
-  syn_.samples.insert(syn_.samples.begin(), pad, 0);
-  syn_.samples.resize(syn_.samples.size() + pad, 0);
-  for (size_t k = 1; k < syn_.phonemes.size(); ++k) syn_.phonemes[k].start += pad;
+  // As align() does: a pause at each end holds the recording's silence before and after.
+  pad_with_pauses(syn_, syn_.sample_rate / 10);
   synf_ = mfcc(syn_.samples, syn_.sample_rate);
   silence_quiet_frames(synf_);
   rest_ = pause_frames(syn_.phonemes, 0, synf_);
@@ -236,6 +236,13 @@ void StreamingAligner::emit(size_t to, bool whole, std::vector<tts::SpokenPhonem
     e.phoneme.word_begin = false;
   }
   if (!whole) e.phoneme.end_of_text = false;
+  // The pause put before the first sound (pad_with_pauses) when the speech starts at once:
+  // no length, nothing it marks, left out.
+  if (whole && to == rec_settled_ && e.phoneme.symbol == 0 && e.faps.empty() && !e.sentence_start &&
+      !e.phoneme.end_of_text) {
+    ++next_;
+    return;
+  }
   // f0 on the piece, YIN's windows centred in it.
   const size_t half_window = 512;
   const size_t a = rec_settled_ - std::min(rec_settled_, half_window);

@@ -71,7 +71,7 @@ class StreamingAligner {
 
   unsigned rate_ = 0;
   Problem problem_ = Problem::kNone;
-  tts::Speech syn_;  // padded with silence at its start, as align() does
+  tts::Speech syn_;  // padded with pauses at its ends, as align() does
   Features synf_;
   std::vector<bool> rest_;    // per frame of synf_: a pause may be matched here (open_warp)
   std::vector<int16_t> rec_;  // the utterance's audio from sample rec_first_ (what is needed)

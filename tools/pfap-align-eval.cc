@@ -16,7 +16,9 @@
 // PFAP_ALIGN_EVAL_VOICE picks the espeak-ng voice (default "en"); with PFAP_ALIGN_EVAL_LIVE
 // set it aligns as pfapalign live=true does (align/streaming.h, the audio in 20 ms blocks) and
 // recognizes live too (StreamingRecognizer), beside the offline recognition; with
-// PFAP_ALIGN_EVAL_TEXT_ONLY set it leaves out the text-free modes (minutes of recognition).
+// PFAP_ALIGN_EVAL_TEXT_ONLY set it leaves out the text-free modes (minutes of recognition);
+// PFAP_ALIGN_EVAL_LEAD_IN=S puts S seconds of silence before each recording (its truth moved
+// with it), for the first sound's start error (issue 31), printed beside the median and p90.
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -175,6 +177,26 @@ struct Agreement {
   }
 };
 
+// PFAP_ALIGN_EVAL_LEAD_IN seconds of digital silence (as `sox in.wav out.wav pad S 0`) put
+// before `samples`, and the truth's starts after its first moved by as much.
+void add_lead_in(std::vector<int16_t>& samples, unsigned rate, std::vector<Phone>& truth) {
+  const char* lead_in = std::getenv("PFAP_ALIGN_EVAL_LEAD_IN");
+  const double seconds = lead_in != nullptr ? std::max(0.0, std::atof(lead_in)) : 0;
+  samples.insert(samples.begin(), static_cast<size_t>(seconds * rate), 0);
+  for (size_t k = 1; k < truth.size(); ++k) truth[k].start += seconds;
+}
+
+// The error of the first sound's start (the first phoneme that is not a pause) in seconds.
+double first_sound_error(const std::vector<Phone>& got, const std::vector<Phone>& truth) {
+  auto first = [](const std::vector<Phone>& ps) {
+    for (const Phone& p : ps) {
+      if (p.name != "pau" && p.name != "h#" && p.name != "brth") return p.start;
+    }
+    return 0.0;
+  };
+  return std::abs(first(got) - first(truth));
+}
+
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
@@ -247,7 +269,7 @@ int main(int argc, char** argv) {
   pfap::tts::VoiceSettings voice;
   if (const char* v = std::getenv("PFAP_ALIGN_EVAL_VOICE")) voice.voice = v;
   const pfap::PhonemeAlphabet& arpabet = *pfap::find_alphabet(pfap::kArpabetAlphabet);
-  std::vector<double> aligned_errors, equal_errors, scaled_errors, costs;
+  std::vector<double> aligned_errors, first_errors, equal_errors, scaled_errors, costs;
   size_t matched_total = 0, truth_total = 0, poor = 0;
   double audio_seconds = 0, align_seconds = 0, recognize_seconds = 0, recognize_cpu_seconds = 0;
   const bool recognize =
@@ -272,7 +294,8 @@ int main(int argc, char** argv) {
     std::ifstream text_in(dir + "/" + argv[2 + (a - 2 + shift) % (argc - 2)] + ".txt");
     std::stringstream text;
     text << text_in.rdbuf();
-    const std::vector<Phone> truth = read_segs(base + ".segs");
+    std::vector<Phone> truth = read_segs(base + ".segs");
+    add_lead_in(samples, rate, truth);
 
     std::vector<pfap::tts::BadBookmark> bad;
     const pfap::tts::Utterance utterance = pfap::tts::parse_utterance(text.str(), bad);
@@ -315,6 +338,7 @@ int main(int argc, char** argv) {
     size_t matched = 0, unused = 0;
     const std::vector<double> e = matched_errors(got, truth, matched);
     aligned_errors.insert(aligned_errors.end(), e.begin(), e.end());
+    first_errors.push_back(first_sound_error(got, truth));
     const std::vector<double> b1 = matched_errors(equal, truth, unused);
     equal_errors.insert(equal_errors.end(), b1.begin(), b1.end());
     const std::vector<double> b2 = matched_errors(scaled, truth, unused);
@@ -395,6 +419,9 @@ int main(int argc, char** argv) {
               argc - 2, audio_seconds, aligned_errors.size(), matched_total, truth_total);
   std::printf("%-36s median %6.1f ms   p90 %6.1f ms\n", "aligned (pfapalign)",
               percentile(aligned_errors, 0.5) * 1000, percentile(aligned_errors, 0.9) * 1000);
+  std::printf("%-36s median %6.1f ms   p90 %6.1f ms   max %6.1f ms\n", "first sound's start",
+              percentile(first_errors, 0.5) * 1000, percentile(first_errors, 0.9) * 1000,
+              percentile(first_errors, 1) * 1000);
   std::printf("%-36s median %6.1f ms   p90 %6.1f ms\n", "baseline: equal-length phonemes",
               percentile(equal_errors, 0.5) * 1000, percentile(equal_errors, 0.9) * 1000);
   std::printf("%-36s median %6.1f ms   p90 %6.1f ms\n", "baseline: espeak-ng times stretched",

@@ -14,10 +14,10 @@
  * to the time of the recording it matches; word starts, stress and `<FAP ...>` bookmarks are
  * those pfaptts gives, f0 is measured on the recording (docs/align.md).
  *
- * Audio: S16LE mono. The alignment takes 16000 to 48000 Hz; at another rate (put
+ * Audio: S16LE mono. The alignment takes 16000 to 48000 Hz; below 16000 Hz (put
  * `audioresample` before) the audio still passes and each utterance is one pause, with a
- * warning. Other formats and channel counts are refused at negotiation: put `audioconvert`
- * before.
+ * warning. Rates above 48000 Hz, other formats and channel counts are refused at negotiation:
+ * put `audioresample` and `audioconvert` before.
  *
  * Text: #GstPfapAlign:text, the whole stream's, when `text_sink` is not linked; else
  * `text_sink` (text/x-raw or text/plain), one utterance per buffer, which lasts from its PTS
@@ -75,8 +75,9 @@ GST_DEBUG_CATEGORY_STATIC(pfapalign_debug);
 namespace {
 
 constexpr const char* kDefaultVoice = "en";
-// Audio kept for one alignment at most: 10 minutes. Beyond, the rest is a pause (warned).
-constexpr uint64_t kMaxSeconds = 600;
+// Audio kept for one alignment at most: pfap::align::kMaxAudioSeconds, 10 minutes. Beyond,
+// the rest is a pause (warned).
+constexpr uint64_t kMaxSeconds = pfap::align::kMaxAudioSeconds;
 
 enum {
   PROP_0,
@@ -99,7 +100,7 @@ struct Stream {
   std::vector<int16_t> samples;
   bool overflow_warned = false;
   bool pfap_discont = true;
-  std::array<guint64, 5> problems{};  // per pfap::align::Problem, for pfap_warn_at
+  std::array<guint64, 6> problems{};  // per pfap::align::Problem, for pfap_warn_at
   guint64 bad_bookmarks = 0;
   std::set<std::string> warned_phonemes;          // inexact mnemonics already warned about
   std::array<guint64, 4> recognition_problems{};  // per pfap::align::RecognitionProblem
@@ -140,9 +141,11 @@ struct _GstPfapAlign {
   Stream* stream;
 };
 
+// Above 48 kHz (pfap::align::kMaxRate) refused: the element would keep audio it cannot align.
 #define AUDIO_CAPS                                                                          \
   "audio/x-raw, format = (string) S16LE, layout = (string) interleaved, rate = (int) [ 1, " \
-  "MAX ], channels = (int) 1"
+  "48000 ], channels = (int) 1"
+static_assert(pfap::align::kMaxRate == 48000);
 
 static GstStaticPadTemplate sink_template =
     GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS(AUDIO_CAPS));
@@ -160,6 +163,18 @@ static GstStaticPadTemplate pfap_template = GST_STATIC_PAD_TEMPLATE(
 
 G_DEFINE_TYPE(GstPfapAlign, gst_pfap_align, GST_TYPE_ELEMENT)
 GST_ELEMENT_REGISTER_DEFINE(pfapalign, "pfapalign", GST_RANK_NONE, GST_TYPE_PFAP_ALIGN)
+
+// Runs `work`, which calls align/: what it allocates grows with its input, and under a memory
+// limit std::bad_alloc must not go into GStreamer. An error is posted instead.
+template <typename Work>
+static GstFlowReturn guarded(GstPfapAlign* self, Work&& work) {
+  try {
+    return work();
+  } catch (const std::exception& e) {
+    GST_ELEMENT_ERROR(self, RESOURCE, FAILED, ("Cannot align the audio: %s", e.what()), (nullptr));
+    return GST_FLOW_ERROR;
+  }
+}
 
 // The audio kept and the texts dropped: at a new stream or a flush.
 static void reset(GstPfapAlign* self) {
@@ -422,8 +437,7 @@ static bool live_recognizes(GstPfapAlign* self) {
   GST_OBJECT_LOCK(self);
   const bool has_property = self->text != nullptr;
   GST_OBJECT_UNLOCK(self);
-  return !has_property && !gst_pad_is_linked(self->textpad) &&
-         pfap::align::recognition_available();
+  return !has_property && !gst_pad_is_linked(self->textpad) && pfap::align::recognition_available();
 }
 
 static GstFlowReturn live_push(GstPfapAlign* self,
@@ -598,8 +612,7 @@ static gboolean gst_pfap_align_src_query(GstPad* pad, GstObject* parent, GstQuer
   return gst_pad_query_default(pad, parent, query);
 }
 
-static GstFlowReturn gst_pfap_align_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
-  GstPfapAlign* self = GST_PFAP_ALIGN(parent);
+static GstFlowReturn chain_audio(GstPfapAlign* self, GstBuffer* buffer) {
   Stream& s = *self->stream;
   if (s.rate == 0) {
     gst_buffer_unref(buffer);
@@ -636,6 +649,17 @@ static GstFlowReturn gst_pfap_align_chain(GstPad*, GstObject* parent, GstBuffer*
                                            gst_pad_push(self->srcpad, buffer));
 }
 
+static GstFlowReturn gst_pfap_align_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
+  GstPfapAlign* self = GST_PFAP_ALIGN(parent);
+  return guarded(self, [&] { return chain_audio(self, buffer); });
+}
+
+// The audio ended (EOS, a new segment or rate): its phonemes, aligned now or the live
+// utterance's last.
+static void end_audio(GstPfapAlign* self, bool eos) {
+  guarded(self, [&] { return self->stream->live ? live_end(self) : align_kept(self, eos); });
+}
+
 // `pfap`'s stream-start (in the audio's group, sparse) and caps, when the audio's stream starts.
 static void push_pfap_start(GstPfapAlign* self, GstEvent* audio_start) {
   const gchar* audio_id = nullptr;
@@ -664,11 +688,7 @@ static gboolean gst_pfap_align_sink_event(GstPad* pad, GstObject* parent, GstEve
       gint rate = 0;
       gst_structure_get_int(gst_caps_get_structure(caps, 0), "rate", &rate);
       if (static_cast<unsigned>(rate) != s.rate) {
-        if (s.live) {
-          live_end(self);
-        } else {
-          align_kept(self, false);
-        }
+        end_audio(self, false);
         s.rate = static_cast<unsigned>(rate);
         if (s.rate < pfap::align::kMinRate || s.rate > pfap::align::kMaxRate) {
           GST_ELEMENT_WARNING(self, STREAM, FORMAT,
@@ -680,11 +700,7 @@ static gboolean gst_pfap_align_sink_event(GstPad* pad, GstObject* parent, GstEve
       break;
     }
     case GST_EVENT_SEGMENT: {
-      if (s.live) {
-        live_end(self);
-      } else {
-        align_kept(self, false);
-      }
+      end_audio(self, false);
       const GstSegment* segment = nullptr;
       gst_event_parse_segment(event, &segment);
       gst_segment_copy_into(segment, &s.segment);
@@ -695,11 +711,7 @@ static gboolean gst_pfap_align_sink_event(GstPad* pad, GstObject* parent, GstEve
       gst_pad_push_event(self->pfappad, gst_event_ref(event));
       break;
     case GST_EVENT_EOS:
-      if (s.live) {
-        live_end(self);
-      } else {
-        align_kept(self, true);
-      }
+      end_audio(self, true);
       gst_pad_push_event(self->pfappad, gst_event_new_eos());
       break;
     case GST_EVENT_FLUSH_START: {
@@ -916,8 +928,8 @@ static void gst_pfap_align_class_init(GstPfapAlignClass* klass) {
    * Aligns (or, without a text, recognizes) as the audio comes, for live sources: each
    * phoneme goes out by the time 350 ms (and one upstream buffer) more than its start has
    * come, and the LATENCY query says 400 ms more than upstream's, 700 ms when it recognizes
-   * (docs/align.md, "Live" and "Live without the text"). Off: the phonemes come when the audio ends, aligned on it
-   * whole. Read when the element goes to PAUSED.
+   * (docs/align.md, "Live" and "Live without the text"). Off: the phonemes come when the audio
+   * ends, aligned on it whole. Read when the element goes to PAUSED.
    */
   g_object_class_install_property(
       gobject_class, PROP_LIVE,

@@ -309,8 +309,8 @@ TEST(Aligner, NoiseAndAnotherTextMatchPoorly) {
   const Alignment longer =
       aligned(std::string(kSentences[1]) + " " + kSentences[2] + " " + kSentences[3], s.samples,
               s.sample_rate);
-  const Alignment noisy =
-      aligned(kSentences[0], pfap::testing::white_noise(s.samples.size(), 8000, 12345), s.sample_rate);
+  const Alignment noisy = aligned(
+      kSentences[0], pfap::testing::white_noise(s.samples.size(), 8000, 12345), s.sample_rate);
   std::printf("relative cost: right %.2f, three other sentences %.2f, noise %.2f\n",
               right.relative_cost, longer.relative_cost, noisy.relative_cost);
   EXPECT_EQ(longer.problem, Problem::kPoorMatch);  // the speech ratio
@@ -357,6 +357,59 @@ TEST(Aligner, ShortAudioAndLongText) {
   expect_tiles(a, audio.size(), s.sample_rate);
   const Alignment none = aligned(kSentences[1], {}, s.sample_rate);
   EXPECT_EQ(none.problem, Problem::kNoSpeech);
+}
+
+// Issue 27: a text far longer than its audio is refused before espeak-ng speaks it (a 1 MB
+// text took 7.7 GB and 330 s for 1.9 s of audio); one pause carries its bookmarks.
+TEST(Aligner, TextFarLongerThanTheAudioIsOnePauseUnspoken) {
+  const tts::Speech s = say("Hello world.", {});
+  std::string text = "<FAP 3 1 0 1>";
+  while (text.size() < 20000) text += std::string(kSentences[1]) + " ";
+  const Alignment a = aligned(text, s.samples, s.sample_rate);
+  EXPECT_EQ(a.problem, Problem::kTextTooLong);
+  ASSERT_EQ(a.phonemes.size(), 1u);
+  EXPECT_EQ(a.phonemes[0].event.faps.size(), 1u);
+  expect_tiles(a, s.samples.size(), s.sample_rate);
+  // The longest text the audio holds is spoken and aligned.
+  const double seconds = static_cast<double>(s.samples.size()) / s.sample_rate;
+  const std::string fits = text.substr(0, max_text_characters(seconds) + 13);
+  EXPECT_EQ(aligned(fits, s.samples, s.sample_rate).problem, Problem::kPoorMatch);
+}
+
+// Issue 31: the silence before a sentence, however long, is a pause, and the first sound
+// starts where the speaker's does.
+TEST(Aligner, LeadingSilenceIsAPause) {
+  const tts::Speech truth =
+      phonetic_truth("Always remember the open ocean.", {"en-us", 140, 60, 100});
+  for (const double lead_seconds : {0.0, 2.0}) {
+    SCOPED_TRACE(lead_seconds);
+    const auto lead = static_cast<size_t>(lead_seconds * truth.sample_rate);
+    std::vector<int16_t> audio(lead, 0);
+    audio.insert(audio.end(), truth.samples.begin(), truth.samples.end());
+    audio.resize(audio.size() + truth.sample_rate, 0);  // and a second after
+    const Alignment a = aligned("Always remember the open ocean.", audio, truth.sample_rate);
+    expect_tiles(a, audio.size(), truth.sample_rate);
+    size_t first = 0;  // the first sound
+    while (first < a.phonemes.size() && a.phonemes[first].event.phoneme.symbol == 0) ++first;
+    ASSERT_LT(first, a.phonemes.size());
+    if (lead > 0) {
+      EXPECT_EQ(first, 1u);  // one pause, then the sound
+    }
+    size_t want = lead;
+    for (const tts::SpokenPhoneme& p : truth.phonemes) {
+      if (p.event.phoneme.symbol != 0) {
+        want += p.start;
+        break;
+      }
+    }
+    const double error_ms =
+        std::abs(static_cast<double>(a.phonemes[first].start) - static_cast<double>(want)) * 1000 /
+        truth.sample_rate;
+    std::printf("lead-in %.1f s: first sound %.1f ms off\n", lead_seconds, error_ms);
+    EXPECT_LT(error_ms, 50);
+    EXPECT_EQ(a.phonemes.back().event.phoneme.symbol, 0);  // the second after: a pause
+    EXPECT_TRUE(a.phonemes.back().event.phoneme.end_of_text);
+  }
 }
 
 }  // namespace

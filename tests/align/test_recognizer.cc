@@ -14,10 +14,11 @@
 #include <string>
 #include <vector>
 
+#include "mfcc.h"
 #include "recognizer.h"
 #include "speech_fixtures.h"
-#include "white_noise.h"
 #include "viseme_frames.h"
+#include "white_noise.h"
 
 namespace pfap::align {
 namespace {
@@ -138,6 +139,40 @@ TEST(Recognizer, SilenceNoiseAndBadRatesAreOnePause) {
     r = recognized(s.samples, rate);
     EXPECT_EQ(r.problem, RecognitionProblem::kBadRate);
     expect_one_pause(r, s.samples.size(), rate);
+  }
+}
+
+// Issue 27: pocketsphinx keeps every frame of what it decodes at once (4.7 MB per second of
+// audio), so recognize() decodes long audio in windows of 10..20 s, each cut at the quietest
+// frame: at a pause where there is one. 65 s of a hum with 200 ms gaps at 14, 31 and 47 s, and
+// 45 s of noise without any.
+TEST(Recognizer, LongAudioIsDecodedInWindowsCutAtPauses) {
+  constexpr unsigned kRate = 16000;
+  std::vector<int16_t> hum = pfap::testing::white_noise(65 * kRate, 3000);
+  for (size_t i = 0; i < hum.size(); ++i) {
+    hum[i] = static_cast<int16_t>(hum[i] / 4 + 6000 * std::sin(0.05 * static_cast<double>(i)));
+  }
+  const std::vector<double> gaps = {14, 31, 47};
+  for (const double at : gaps) {
+    std::fill_n(hum.begin() + static_cast<std::ptrdiff_t>(at * kRate), kRate / 5, 0);
+  }
+  const std::vector<size_t> cuts = recognition_windows(mfcc(hum, kRate), hum.size());
+  ASSERT_EQ(cuts.size(), gaps.size() + 1);
+  EXPECT_EQ(cuts[0], 0u);
+  for (size_t k = 0; k < gaps.size(); ++k) {
+    const double at = static_cast<double>(cuts[k + 1]) / kRate;
+    EXPECT_GE(at, gaps[k]) << k;
+    EXPECT_LE(at, gaps[k] + 0.2) << k;
+  }
+  const std::vector<int16_t> noise = pfap::testing::white_noise(45 * kRate, 3000);
+  const std::vector<size_t> noise_cuts = recognition_windows(mfcc(noise, kRate), noise.size());
+  ASSERT_GE(noise_cuts.size(), 3u);
+  for (size_t k = 0; k < noise_cuts.size(); ++k) {
+    const size_t end = k + 1 < noise_cuts.size() ? noise_cuts[k + 1] : noise.size();
+    EXPECT_LE(end - noise_cuts[k], size_t{20} * kRate) << k;
+    if (k + 1 < noise_cuts.size()) {
+      EXPECT_GE(end - noise_cuts[k], size_t{10} * kRate) << k;
+    }
   }
 }
 

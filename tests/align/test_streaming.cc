@@ -13,8 +13,8 @@
 
 #include "boundaries.h"
 #include "speech_fixtures.h"
-#include "white_noise.h"
 #include "streaming.h"
+#include "white_noise.h"
 
 namespace pfap::align {
 namespace {
@@ -209,6 +209,28 @@ TEST(Streaming, NoAudioAndShortAudio) {
   EXPECT_FALSE(out.empty());
   for (const tts::SpokenPhoneme& p : out) EXPECT_EQ(p.n_samples, 0u);
   live(kSentences[1], std::vector<int16_t>(800, 3000), 16000);  // 50 ms: squeezed in
+}
+
+// Issue 31, live: 2 s of silence before a sentence is a pause, and the first sound starts
+// where the speaker's does. espeak-ng starts this text with its first sound, no pause.
+TEST(Streaming, LeadingSilenceIsAPause) {
+  constexpr const char* kText = "Always remember the open ocean.";
+  tts::Speech truth = say(kText, {"en-us", 140, 60, 100});
+  to_phonetic_boundaries(truth);
+  const unsigned rate = truth.sample_rate;
+  const size_t lead = 2 * rate;
+  std::vector<int16_t> audio(lead, 0);
+  audio.insert(audio.end(), truth.samples.begin(), truth.samples.end());
+  audio.resize(audio.size() + rate / 2, 0);
+  const auto got = merged(live(kText, audio, rate), rate);
+  auto want = merged(truth.phonemes, rate, lead);
+  if (want.front().first == 0) want.erase(want.begin());  // espeak-ng's own first pause
+  ASSERT_GE(got.size(), 2u);
+  EXPECT_EQ(got[0].first, 0);  // a pause
+  EXPECT_EQ(got[1].first, want[0].first);
+  const double error_ms = std::abs(got[1].second - want[0].second) * 1000;
+  std::printf("live, lead-in 2 s: first sound %.1f ms off\n", error_ms);
+  EXPECT_LT(error_ms, 50);
 }
 
 }  // namespace

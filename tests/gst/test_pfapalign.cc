@@ -323,6 +323,60 @@ TEST(PfapAlign, StereoIsRefusedAtNegotiation) {
   gst_harness_teardown(h);
 }
 
+// Issue 27: a rate above 48 kHz is refused, not kept whole with a warning that it cannot be
+// aligned; audioresample before it then picks 48 kHz.
+TEST(PfapAlign, RateAbove48kHzIsRefusedAtNegotiation) {
+  GstHarness* h = gst_harness_new_with_padnames("pfapalign", "sink", "src");
+  gst_harness_set_src_caps_str(h, caps_at(96000).c_str());
+  EXPECT_EQ(gst_harness_push(h, gst_buffer_new_allocate(nullptr, 400, nullptr)),
+            GST_FLOW_NOT_NEGOTIATED);
+  gst_harness_teardown(h);
+  pfap::testing::Pipeline p(
+      "audiotestsrc num-buffers=5 ! audio/x-raw,rate=96000 ! audioresample ! pfapalign "
+      "text=Hello. name=a a.src ! queue ! audio/x-raw,rate=48000 ! fakesink a.pfap ! queue ! "
+      "fakesink");
+  ASSERT_TRUE(p.ok()) << p.error();
+  ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+  EXPECT_EQ(p.wait_eos(std::chrono::seconds(30)), "");
+}
+
+// Issue 27: a text far longer than its audio (20 kB for 1.5 s) warns and is one pause,
+// unspoken, where it took seconds and hundreds of MB and gave thousands of phonemes.
+TEST(PfapAlign, TextFarLongerThanTheAudioWarnsAndIsOnePause) {
+  const pfap::tts::Speech s = say(kText);
+  std::string text;
+  while (text.size() < 20000) text += std::string(kText) + " ";
+  const Result r = run(s.samples, s.sample_rate, text.c_str());
+  EXPECT_TRUE(has_warning(r, "far longer than the audio"));
+  ASSERT_EQ(r.events.size(), 1u);
+  expect_tiles(r, gst_util_uint64_scale(s.samples.size(), GST_SECOND, s.sample_rate));
+  EXPECT_EQ(r.audio, s.samples);
+}
+
+// Issue 31: 2 s of silence before a sentence is a pause, offline and live, and the first sound
+// starts within 50 ms of the speaker's (espeak-ng starts this text with no pause of its own).
+TEST(PfapAlign, LeadingSilenceIsAPauseOfflineAndLive) {
+  constexpr const char* kVowelFirst = "Always remember the open ocean.";
+  const pfap::tts::Speech s = say(kVowelFirst);
+  ASSERT_NE(s.phonemes[0].event.phoneme.symbol, 0);
+  std::vector<int16_t> audio(2 * s.sample_rate, 0);
+  audio.insert(audio.end(), s.samples.begin(), s.samples.end());
+  for (const bool live : {false, true}) {
+    SCOPED_TRACE(live ? "live" : "offline");
+    const Result r = run(audio, s.sample_rate, kVowelFirst, {}, "en", live);
+    ASSERT_GE(r.events.size(), 2u);
+    EXPECT_EQ(r.events[0].event.phoneme.symbol, 0);
+    size_t first = 0;  // the first sound (live, the pause comes in pieces)
+    while (first < r.events.size() && r.events[first].event.phoneme.symbol == 0) ++first;
+    ASSERT_LT(first, r.events.size());
+    const double error_ms =
+        std::abs(static_cast<double>(r.events[first].pts) - 2.0 * GST_SECOND) / GST_MSECOND;
+    std::printf("%s, lead-in 2 s: first sound %.1f ms off\n", live ? "live" : "offline", error_ms);
+    EXPECT_LT(error_ms, 50);
+    expect_tiles(r, gst_util_uint64_scale(audio.size(), GST_SECOND, s.sample_rate));
+  }
+}
+
 TEST(PfapAlign, WaitForTheTextsEosEndsWithTheStream) {
   // text_sink linked, its EOS never comes: the audio's EOS waits for it, and stopping the
   // element ends the wait instead of hanging.
