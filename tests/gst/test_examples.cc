@@ -6,22 +6,29 @@
 //    through pfapparse ! pfaptextenc, and is described in docs/examples/README.md.
 //  - Loopback.*: pfap-loopback returns every round-trip sample (all files without comments
 //    or state lines) byte for byte, at several MTUs, and reports bad input.
-//  - Rtsp.ServesAudioAndPhonemes: pfap-rtsp-server as a subprocess and an rtspsrc client: the
-//    SDP and the caps carry the alphabet, audio arrives, every phoneme arrives.
+//  - Rtsp.*: pfap-rtsp-server as a subprocess and an rtspsrc client: the SDP and the caps
+//    carry the alphabet, audio arrives, every phoneme arrives; the audio's first sample and
+//    the phonemes' time 0 are one instant in the RTCP reports.
 //  - DocumentedLines.*: each command block of that docs section, run as written but with free
 //    ports, the source tree's docs/examples/ and temporary output files.
 //  - Readme.*: the pfaptts commands of README.md, "Text to speech", run the same way; its
-//    pfapalign lines are checked to be those of docs/elements.md, which test_pfapalign* run.
+//    pfapalign lines are checked to be those of docs/elements.md, which test_pfapalign* run,
+//    and its "A recording" block is run as written. Every file a README command reads is
+//    there, the Install section names the packages of the GStreamer tools it runs, and each
+//    build tree GST_PLUGIN_PATH of README.md and docs/ finds the plugins from another
+//    directory.
+//  - InstallMd.*: docs/install.md's account of the packages against debian/.
 //  - Story.*: pfap-story, the main job: speech over RTP with loss, rendered and muxed.
 //  - PlayStream.*: generic players, no pipeline written by hand: playbin on the RTSP example
 //    (rtppfapdepay and pfapface plugged by themselves, face within a video frame of the
 //    audio), playbin on a .pfap file (the typefinder), other text left alone, and ffmpeg -t 3
 //    against the example ending.
 //
-// meson passes PFAP_SOURCE_DIR, PFAP_LOOPBACK, PFAP_RTSP_SERVER and PFAP_STORY, and GST_PLUGIN_PATH
-// in the environment (the subprocesses inherit it). Everything is on 127.0.0.1, on port 0 or on
-// free ports found by binding port 0; every wait is bounded.
+// meson passes PFAP_SOURCE_DIR, PFAP_BUILD_DIR, PFAP_LOOPBACK, PFAP_RTSP_SERVER and PFAP_STORY,
+// and GST_PLUGIN_PATH in the environment (the subprocesses inherit it). Everything is on
+// 127.0.0.1, on port 0 or on free ports found by binding port 0; every wait is bounded.
 #include <arpa/inet.h>
+#include <glib/gstdio.h>
 #include <gst/gst.h>
 #include <gst/rtp/gstrtcpbuffer.h>
 #include <gst/sdp/gstsdpmessage.h>
@@ -800,12 +807,185 @@ TEST(Readme, EveryCommandIsTested) {
 // README.md's pfapalign lines are docs/elements.md's, which test_pfapalign and
 // test_pfapalign_live run.
 TEST(Readme, AlignCommandsAreTheDocumentedOnes) {
-  const std::vector<std::string> readme = readme_align_commands();
+  std::vector<std::string> readme = readme_align_commands();
+  std::erase_if(readme, [](const std::string& c) { return c.find(" pfapalign ") == c.npos; });
   ASSERT_EQ(readme.size(), 2u);
   const std::vector<std::string> documented = doc_section("docs/elements.md", "## pfapalign");
   for (const std::string& command : readme) {
     EXPECT_NE(std::find(documented.begin(), documented.end(), command), documented.end())
         << command;
+  }
+}
+
+// The README's commands grouped by the heading they are under, in order.
+std::vector<std::vector<std::string>> readme_command_groups() {
+  std::vector<std::vector<std::string>> groups;
+  std::vector<std::string> lines;
+  bool in_block = false;
+  for (const std::string& line : lines_of(read_file(source_path("README.md")))) {
+    if (line.starts_with("```")) in_block = !in_block;
+    if (!in_block && pfap::testing::heading_level(line) > 0) {
+      groups.push_back(commands_in(lines));
+      lines.clear();
+    }
+    lines.push_back(line);
+  }
+  groups.push_back(commands_in(lines));
+  return groups;
+}
+
+// Every file a README command reads (filesrc) is in the checkout or written (filesink) by a
+// command before it under the same heading: the pfapalign line read a speech.wav that nothing
+// in its section made, and the one "Into files" makes says something else.
+TEST(Readme, EveryFileACommandReadsIsThere) {
+  const std::regex reads("filesrc location=(\\S+)"), writes("filesink location=(\\S+)");
+  size_t checked = 0;
+  for (const std::vector<std::string>& group : readme_command_groups()) {
+    std::vector<std::string> written;
+    for (const std::string& command : group) {
+      for (std::sregex_iterator m(command.begin(), command.end(), reads), end; m != end; ++m) {
+        const std::string file = (*m)[1];
+        ++checked;
+        EXPECT_TRUE(g_file_test(source_path(file).c_str(), G_FILE_TEST_IS_REGULAR) ||
+                    std::find(written.begin(), written.end(), file) != written.end())
+            << file << ", read by: " << command;
+      }
+      for (std::sregex_iterator m(command.begin(), command.end(), writes), end; m != end; ++m) {
+        written.push_back((*m)[1]);
+      }
+    }
+  }
+  EXPECT_GE(checked, 1u);
+}
+
+// The "A recording" block as written: the stand-in recording, then its phonemes.
+TEST(Readme, RecordingBlockRuns) {
+  ASSERT_TRUE(plugin_available(kElements));
+  const std::vector<std::string> commands =
+      documented_commands("README.md", "## PFAP from any speech", "### A recording");
+  ASSERT_EQ(commands.size(), 2u);
+  TempDir dir;
+  Substitution substitute(dir);
+  for (const std::string& command : commands) {
+    Pipeline p(substitute.launch(command));
+    ASSERT_TRUE(p.error().empty()) << p.error();
+    ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+    ASSERT_EQ(p.wait_eos(60s), "") << command;
+  }
+  EXPECT_GT(pfap_lines(read_file(dir.file("speech.pfap"))).size(), 40u);
+}
+
+// The Install section names the Debian package of each GStreamer tool the README's commands
+// run (gst-inspect-1.0 and the rest are in gstreamer1.0-tools, which a fresh Debian lacks).
+TEST(Readme, InstallNamesThePackageOfEachToolItRuns) {
+  const std::string install = [] {
+    std::string text;
+    for (const std::string& line : doc_section("README.md", "## Install")) text += line + "\n";
+    return text;
+  }();
+  ASSERT_FALSE(install.empty());
+  std::vector<std::string> programs;
+  for (const std::vector<std::string>& group : readme_command_groups()) {
+    for (const std::string& command : group) {
+      const std::string program = command.substr(0, command.find(' '));
+      if (program.starts_with("gst-") &&
+          std::find(programs.begin(), programs.end(), program) == programs.end()) {
+        programs.push_back(program);
+      }
+    }
+  }
+  ASSERT_GE(programs.size(), 3u) << "gst-launch-1.0, gst-inspect-1.0, gst-play-1.0";
+  gchar* found = g_find_program_in_path("dpkg");
+  const std::string dpkg = found != nullptr ? found : "";
+  g_free(found);
+  if (dpkg.empty()) GTEST_SKIP() << "no dpkg to ask which package holds each program";
+  for (const std::string& program : programs) {
+    gchar* path = g_find_program_in_path(program.c_str());
+    if (path == nullptr) {
+      ADD_FAILURE() << program << " is not installed: scripts/install-deps installs it";
+      continue;
+    }
+    const ProcessResult owner = run({dpkg, "-S", path});
+    g_free(path);
+    ASSERT_EQ(owner.status, 0) << "dpkg -S: " << owner.err;
+    const std::string package = owner.out.substr(0, owner.out.find(':'));
+    EXPECT_NE(install.find("`" + package + "`"), std::string::npos)
+        << program << " is in " << package << ", which README.md's Install section never names";
+  }
+}
+
+// Each GST_PLUGIN_PATH the README and docs tell users to set for a build tree still finds the
+// plugins from another directory (a user's next `cd`), as a shell would set it in the
+// checkout: $PWD is the checkout, and its build/ this build tree.
+TEST(Readme, BuildTreePluginPathsHoldAfterCd) {
+  const std::string build_root = PFAP_BUILD_DIR;
+  std::vector<std::string> texts;
+  for (const char* file : {"README.md", "docs/apps.md", "docs/install.md"}) {
+    texts.push_back(read_file(source_path(file)));
+  }
+  std::string playing;
+  for (const std::string& line : doc_section("docs/elements.md", "## Playing a stream")) {
+    playing += line + "\n";
+  }
+  texts.push_back(playing);
+  const std::regex setting("GST_PLUGIN_PATH=([^\\s`]*build/[^\\s`]*)");
+  TempDir elsewhere;
+  size_t checked = 0;
+  for (const std::string& text : texts) {
+    for (std::sregex_iterator m(text.begin(), text.end(), setting), end; m != end; ++m) {
+      std::string value = (*m)[1];
+      SCOPED_TRACE("GST_PLUGIN_PATH=" + value);
+      replace_all(value, "$PWD/build/", build_root + "/");
+      gchar** envp = g_get_environ();
+      envp = g_environ_setenv(envp, "GST_PLUGIN_PATH", value.c_str(), TRUE);
+      envp =
+          g_environ_setenv(envp, "GST_REGISTRY_1_0", elsewhere.file("registry.bin").c_str(), TRUE);
+      std::vector<std::string> elements = {"rtppfappay"};
+      constexpr const char* kFace[] = {"pfapface"};
+      if (value.find("/ext") != std::string::npos && plugin_available(kFace)) {
+        elements.push_back("pfapface");
+      }
+      for (std::string& element : elements) {
+        gchar* argv[] = {const_cast<gchar*>("gst-inspect-1.0"), element.data(), nullptr};
+        gint status = -1;
+        GError* error = nullptr;
+        const gboolean ran =
+            g_spawn_sync(elsewhere.path().c_str(), argv, envp,
+                         static_cast<GSpawnFlags>(G_SPAWN_SEARCH_PATH | G_SPAWN_STDOUT_TO_DEV_NULL |
+                                                  G_SPAWN_STDERR_TO_DEV_NULL),
+                         nullptr, nullptr, nullptr, nullptr, &status, &error);
+        if (!ran) {
+          ADD_FAILURE() << "cannot run gst-inspect-1.0: " << error->message;
+          g_error_free(error);
+          continue;
+        }
+        EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0)
+            << "gst-inspect-1.0 " << element << " finds nothing from " << elsewhere.path();
+        ++checked;
+      }
+      g_remove(elsewhere.file("registry.bin").c_str());
+      g_strfreev(envp);
+    }
+  }
+  EXPECT_GE(checked, 4u);
+}
+
+// docs/install.md's account of the packages matches debian/: as many .deb files as stanzas in
+// debian/control, and no lintian warning for manual pages that pfap-tools installs.
+TEST(InstallMd, MatchesThePackaging) {
+  const std::string install = read_file(source_path("docs/install.md"));
+  const std::string control = read_file(source_path("debian/control"));
+  size_t packages = 0;
+  for (const std::string& line : lines_of(control)) packages += line.starts_with("Package: ");
+  const std::vector<std::string> numbers = {"zero", "one",   "two",   "three", "four", "five",
+                                            "six",  "seven", "eight", "nine",  "ten"};
+  ASSERT_LT(packages, numbers.size());
+  std::smatch said;
+  ASSERT_TRUE(std::regex_search(install, said, std::regex("all (\\w+) `\\.deb` files")));
+  EXPECT_EQ(said[1].str(), numbers[packages]) << packages << " packages in debian/control";
+  if (read_file(source_path("debian/pfap-tools.install")).find("/man1/") != std::string::npos) {
+    EXPECT_EQ(install.find("`no-manual-page` for"), std::string::npos)
+        << "the tools' manual pages are installed";
   }
 }
 
