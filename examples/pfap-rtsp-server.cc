@@ -35,7 +35,8 @@
 //     src. ! rtppfapdepay ! pfaptextenc ! fdsink  src. ! rtpL16depay ! fakesink
 //
 // The plugins are found where GStreamer looks: installed, or in GST_PLUGIN_PATH (from a build
-// tree GST_PLUGIN_PATH=build/gst:build/ext, as scripts/demo and `meson devenv` set it).
+// tree GST_PLUGIN_PATH=$PWD/build/gst:$PWD/build/ext in the checkout, as scripts/demo and
+// `meson devenv` set it).
 #include <glib-unix.h>
 #include <gst/gst.h>
 #include <gst/rtsp-server/rtsp-server.h>
@@ -242,7 +243,7 @@ int main(int argc, char** argv) {
     if (factory == nullptr) {
       std::fprintf(stderr,
                    "pfap-rtsp-server: no element %s: set GST_PLUGIN_PATH to the directories "
-                   "of the pfap plugins (for example build/gst:build/ext)\n",
+                   "of the pfap plugins (from a checkout: $PWD/build/gst:$PWD/build/ext)\n",
                    name);
       return 1;
     }
