@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """The example programs in examples/python and examples/gjs, run as a user runs them, against
 the build tree (tests/python/meson.build sets the paths)."""
+import contextlib
 import os
 import re
 import shlex
@@ -111,27 +112,36 @@ def with_port(words, port):
     return [w.replace("5004", str(port)) for w in words]
 
 
-def start_documented_receiver(interpreter):
+@contextlib.contextmanager
+def documented_receiver(interpreter):
     """The documented receiver command run in `interpreter`'s language, as the block has it:
-    from the source tree, the script as the program. Returns (process, port)."""
+    from the source tree, the script as the program. Gives (process, port); kills it if a test
+    left it running."""
     receivers, _ = apps_md_receiver_block()
     (command,) = [r for r in receivers if r[0].startswith("examples/%s/" % interpreter)]
     port = free_udp_port()
     receiver = subprocess.Popen(with_port(command, port), cwd=SOURCE, stdout=subprocess.PIPE,
                                 stderr=subprocess.PIPE, text=True)
-    assert receiver.stdout.readline().startswith("listening on 127.0.0.1:%d" % port)
-    return receiver, port
+    try:
+        assert receiver.stdout.readline().startswith("listening on 127.0.0.1:%d" % port)
+        yield receiver, port
+    finally:
+        if receiver.poll() is None:
+            receiver.kill()
+            receiver.communicate()
 
 
 def stop_with(receiver, signum):
+    """Sends `signum`; the receiver must end within 5 s, with status 0 and nothing on stderr.
+    Returns what else it printed."""
     receiver.send_signal(signum)
     try:
         out, err = receiver.communicate(timeout=5)
     except subprocess.TimeoutExpired:
-        receiver.kill()
-        out, err = receiver.communicate()
-        pytest.fail("still running 5 s after signal %d: %s" % (signum, err))
-    return out, err
+        pytest.fail("still running 5 s after signal %d" % signum)
+    assert receiver.returncode == 0, err
+    assert err == ""
+    return out
 
 
 def test_apps_md_shows_both_receivers():
@@ -146,20 +156,13 @@ def test_apps_md_shows_both_receivers():
 @pytest.mark.parametrize("interpreter", ["python", pytest.param("gjs", marks=needs_gjs)])
 def test_documented_receiver_prints_the_session_and_ends_on_ctrl_c(interpreter):
     expected = phoneme_names(HELLO)
-    receiver, port = start_documented_receiver(interpreter)
-    try:
+    with documented_receiver(interpreter) as (receiver, port):
         _, sender = apps_md_receiver_block()
         sent = subprocess.run(with_port(sender, port), cwd=SOURCE, capture_output=True,
                               text=True, timeout=30)
         assert sent.returncode == 0, sent.stderr
         time.sleep(1)  # what was sent is printed
-        out, err = stop_with(receiver, signal.SIGINT)
-    finally:
-        if receiver.poll() is None:
-            receiver.kill()
-            receiver.wait()
-    assert receiver.returncode == 0, err
-    assert err == ""
+        out = stop_with(receiver, signal.SIGINT)
     got = [line.split()[2] for line in out.splitlines() if " phoneme " in line]
     assert got == expected
 
@@ -168,19 +171,9 @@ def test_documented_receiver_prints_the_session_and_ends_on_ctrl_c(interpreter):
 @pytest.mark.parametrize("interpreter", ["python", pytest.param("gjs", marks=needs_gjs)])
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
 def test_documented_receiver_ends_on_a_signal_while_idle(interpreter, signum):
-    receiver, _ = start_documented_receiver(interpreter)
-    try:
+    with documented_receiver(interpreter) as (receiver, _):
         time.sleep(0.5)
-        started = time.monotonic()
-        out, err = stop_with(receiver, signum)
-        assert time.monotonic() - started < 2
-    finally:
-        if receiver.poll() is None:
-            receiver.kill()
-            receiver.wait()
-    assert receiver.returncode == 0, err
-    assert err == ""
-    assert out == ""
+        assert stop_with(receiver, signum) == ""
 
 
 def test_mouth_opens_and_closes_with_the_jaw():
