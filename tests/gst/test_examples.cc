@@ -929,45 +929,55 @@ TEST(Readme, BuildTreePluginPathsHoldAfterCd) {
   }
   texts.push_back(playing);
   const std::regex setting("GST_PLUGIN_PATH=([^\\s`]*build/[^\\s`]*)");
-  TempDir elsewhere;
-  size_t checked = 0;
+  std::vector<std::string> values;
   for (const std::string& text : texts) {
     for (std::sregex_iterator m(text.begin(), text.end(), setting), end; m != end; ++m) {
-      std::string value = (*m)[1];
-      SCOPED_TRACE("GST_PLUGIN_PATH=" + value);
-      replace_all(value, "$PWD/build/", build_root + "/");
-      gchar** envp = g_get_environ();
-      envp = g_environ_setenv(envp, "GST_PLUGIN_PATH", value.c_str(), TRUE);
-      envp =
-          g_environ_setenv(envp, "GST_REGISTRY_1_0", elsewhere.file("registry.bin").c_str(), TRUE);
-      std::vector<std::string> elements = {"rtppfappay"};
-      constexpr const char* kFace[] = {"pfapface"};
-      if (value.find("/ext") != std::string::npos && plugin_available(kFace)) {
-        elements.push_back("pfapface");
+      if (std::find(values.begin(), values.end(), (*m)[1]) == values.end()) {
+        values.push_back((*m)[1]);
       }
-      for (std::string& element : elements) {
-        gchar* argv[] = {const_cast<gchar*>("gst-inspect-1.0"), element.data(), nullptr};
-        gint status = -1;
-        GError* error = nullptr;
-        const gboolean ran =
-            g_spawn_sync(elsewhere.path().c_str(), argv, envp,
-                         static_cast<GSpawnFlags>(G_SPAWN_SEARCH_PATH | G_SPAWN_STDOUT_TO_DEV_NULL |
-                                                  G_SPAWN_STDERR_TO_DEV_NULL),
-                         nullptr, nullptr, nullptr, nullptr, &status, &error);
-        if (!ran) {
-          ADD_FAILURE() << "cannot run gst-inspect-1.0: " << error->message;
-          g_error_free(error);
-          continue;
-        }
-        EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0)
-            << "gst-inspect-1.0 " << element << " finds nothing from " << elsewhere.path();
-        ++checked;
-      }
-      g_remove(elsewhere.file("registry.bin").c_str());
-      g_strfreev(envp);
     }
   }
-  EXPECT_GE(checked, 4u);
+  // Each value starts from a copy of the tests' registry: a registry drops what the path no
+  // longer finds, and a copy saves scanning every system plugin again (slow under ASan).
+  const char* registry = g_getenv("GST_REGISTRY_1_0");
+  const std::string cached = registry != nullptr ? read_file(registry) : "";
+  TempDir elsewhere;
+  size_t checked = 0;
+  for (std::string value : values) {
+    SCOPED_TRACE("GST_PLUGIN_PATH=" + value);
+    std::ofstream(elsewhere.file("registry.bin"), std::ios::binary) << cached;
+    replace_all(value, "$PWD/build/", build_root + "/");
+    gchar** envp = g_get_environ();
+    envp = g_environ_setenv(envp, "GST_PLUGIN_PATH", value.c_str(), TRUE);
+    envp = g_environ_setenv(envp, "GST_REGISTRY_1_0", elsewhere.file("registry.bin").c_str(), TRUE);
+    std::vector<std::string> elements = {"rtppfappay"};
+    constexpr const char* kFace[] = {"pfapface"};
+    if (value.find("/ext") != std::string::npos && plugin_available(kFace)) {
+      elements.push_back("pfapface");
+    }
+    for (std::string& element : elements) {
+      gchar* argv[] = {const_cast<gchar*>("gst-inspect-1.0"), element.data(), nullptr};
+      gint status = -1;
+      GError* error = nullptr;
+      const gboolean ran =
+          g_spawn_sync(elsewhere.path().c_str(), argv, envp,
+                       static_cast<GSpawnFlags>(G_SPAWN_SEARCH_PATH | G_SPAWN_STDOUT_TO_DEV_NULL |
+                                                G_SPAWN_STDERR_TO_DEV_NULL),
+                       nullptr, nullptr, nullptr, nullptr, &status, &error);
+      if (!ran) {
+        ADD_FAILURE() << "cannot run gst-inspect-1.0: " << error->message;
+        g_error_free(error);
+        continue;
+      }
+      EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0)
+          << "gst-inspect-1.0 " << element << " finds nothing from " << elsewhere.path();
+      ++checked;
+    }
+    g_remove(elsewhere.file("registry.bin").c_str());
+    g_strfreev(envp);
+  }
+  EXPECT_FALSE(values.empty());
+  EXPECT_GE(checked, values.size());
 }
 
 // docs/install.md's account of the packages matches debian/: as many .deb files as stanzas in
