@@ -17,7 +17,8 @@
 //    one every 500 ms from the start, let a listener hear where the phoneme times are, and
 //    let tests/gst/test_examples.cc (PlayStream.*) measure lip sync in playbin.
 //  - identity sync=true paces the file's events in real time from PLAY on, as a live TTS
-//    source would produce them; the audio is live too, so both start at running time 0.
+//    source would produce them; the audio is live too. Its first sample is put at running
+//    time 0, the file's time 0 (AudioFromZero): a live source stamps it later.
 //  - Both streams end together, when the file's last phoneme ends: the audio is cut there
 //    and ends too (EndAudioWithMarkup). Each session then sends its RTCP
 //    BYE, and a client sees the presentation end: rtspsrc and playbin post EOS, and a client
@@ -34,7 +35,8 @@
 //     src. ! rtppfapdepay ! pfaptextenc ! fdsink  src. ! rtpL16depay ! fakesink
 //
 // The plugins are found where GStreamer looks: installed, or in GST_PLUGIN_PATH (from a build
-// tree GST_PLUGIN_PATH=build/gst:build/ext, as scripts/demo and `meson devenv` set it).
+// tree GST_PLUGIN_PATH=$PWD/build/gst:$PWD/build/ext in the checkout, as scripts/demo and
+// `meson devenv` set it).
 #include <glib-unix.h>
 #include <gst/gst.h>
 #include <gst/rtsp-server/rtsp-server.h>
@@ -122,6 +124,38 @@ class EndAudioWithMarkup {
   std::atomic<bool> audio_ended_{false};
 };
 
+// Puts the audio's first sample at running time 0, where the markup's time 0 is. A live
+// audiotestsrc stamps its first buffer with the running time at which it made it, after PLAY:
+// 1 to 13 ms here, 26 ms with the cores busy. The file's events count from 0 (identity keeps
+// the segment), so without this the phonemes went out that much ahead of the speech they
+// describe, in their RTP timestamps and so in the RTCP reports: no client could undo it. The
+// first buffer's running time, once known, becomes a negative offset on the pad into the
+// audio payloader (GStreamer's own way to move a stream's running time).
+class AudioFromZero {
+ public:
+  static void attach(GstElement* audio_source, GstPad* payloader_sink) {
+    GstPad* src = gst_element_get_static_pad(audio_source, "src");
+    gst_pad_add_probe(src, GST_PAD_PROBE_TYPE_BUFFER, on_first_buffer,
+                      gst_pad_get_peer(payloader_sink), gst_object_unref);
+    gst_object_unref(src);
+  }
+
+ private:
+  static GstPadProbeReturn on_first_buffer(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
+    GstEvent* event = gst_pad_get_sticky_event(pad, GST_EVENT_SEGMENT, 0);
+    if (event == nullptr) return GST_PAD_PROBE_OK;
+    const GstSegment* segment = nullptr;
+    gst_event_parse_segment(event, &segment);
+    const GstClockTime start = gst_segment_to_running_time(
+        segment, GST_FORMAT_TIME, GST_BUFFER_PTS(GST_PAD_PROBE_INFO_BUFFER(info)));
+    gst_event_unref(event);
+    if (GST_CLOCK_TIME_IS_VALID(start)) {
+      gst_pad_set_offset(static_cast<GstPad*>(data), -static_cast<gint64>(start));
+    }
+    return GST_PAD_PROBE_REMOVE;
+  }
+};
+
 GstPad* sink_pad_of(GstElement* bin, const char* name) {
   GstElement* element = gst_bin_get_by_name(GST_BIN(bin), name);
   GstPad* pad = gst_element_get_static_pad(element, "sink");
@@ -173,6 +207,7 @@ void on_media_configure(GstRTSPMediaFactory*, GstRTSPMedia* media, gpointer file
   GstElement* audio = gst_bin_get_by_name(GST_BIN(bin), "audio");
   GstPad* markup_pad = sink_pad_of(bin, "pay1");
   GstPad* audio_pad = sink_pad_of(bin, "pay0");
+  AudioFromZero::attach(audio, audio_pad);
   EndAudioWithMarkup::attach(audio, markup_pad, audio_pad);
   g_signal_connect(media, "prepared", G_CALLBACK(on_media_prepared), nullptr);
   gst_object_unref(audio_pad);
@@ -211,7 +246,7 @@ int main(int argc, char** argv) {
     if (factory == nullptr) {
       std::fprintf(stderr,
                    "pfap-rtsp-server: no element %s: set GST_PLUGIN_PATH to the directories "
-                   "of the pfap plugins (for example build/gst:build/ext)\n",
+                   "of the pfap plugins (from a checkout: $PWD/build/gst:$PWD/build/ext)\n",
                    name);
       return 1;
     }

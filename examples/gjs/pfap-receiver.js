@@ -8,7 +8,7 @@
 // (the jitterbuffer's windows fixed, so that a flood of spoofed packets cannot stall it:
 // docs/security.md, "Floods").
 //
-// Usage: pfap-receiver.js [--port PORT] [--idle-exit SECONDS]
+// Usage: pfap-receiver.js [--port PORT] [--idle-exit SECONDS]; Ctrl-C ends it.
 // From a build tree, set GI_TYPELIB_PATH, LD_LIBRARY_PATH and GST_PLUGIN_PATH (docs/apps.md).
 imports.gi.versions.Gst = '1.0';
 imports.gi.versions.GstApp = '1.0';
@@ -62,12 +62,29 @@ function main(argv) {
     pipeline.set_state(Gst.State.PLAYING);
     print(`listening on 127.0.0.1:${args.port}`);
 
-    const idle = args.idleExit > 0 ? args.idleExit * Gst.SECOND : Gst.CLOCK_TIME_NONE;
+    // gjs cannot run JavaScript on appsink's streaming thread (no new-sample handler), so the
+    // main thread pulls, a tenth of a second at a time, and between pulls lets GLib dispatch
+    // SIGINT and SIGTERM: a pull that waited for ever would not see Ctrl-C until a packet came.
+    let quit = false;
+    for (const signal of [2 /* SIGINT */, 15 /* SIGTERM */]) {
+        GLib.unix_signal_add(GLib.PRIORITY_DEFAULT, signal, () => {
+            quit = true;
+            return GLib.SOURCE_REMOVE;
+        });
+    }
+    const context = GLib.MainContext.default();
+    const idleUs = args.idleExit * 1e6;
+    let lastEvent = GLib.get_monotonic_time();
     let alphabet = null;
-    for (;;) {
-        const sample = sink.try_pull_sample(idle);
-        if (sample === null)
-            break;
+    while (!quit) {
+        const sample = sink.try_pull_sample(100 * Gst.MSECOND);
+        while (context.iteration(false)) { /* dispatch what is pending */ }
+        if (sample === null) {
+            if (idleUs > 0 && GLib.get_monotonic_time() - lastEvent >= idleUs)
+                break;
+            continue;
+        }
+        lastEvent = GLib.get_monotonic_time();
         if (alphabet === null) {
             const name = sample.get_caps().get_structure(0).get_string('alphabet');
             alphabet = GstPfap.Alphabet.find(name ?? GstPfap.ALPHABET_ARPABET);

@@ -12,10 +12,12 @@ GObject-Introspection), phoneme symbols named with the stream's alphabet. Send i
     gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfapparse alphabet=x-pfap-arpabet ! \\
         rtppfappay ! udpsink host=127.0.0.1 port=5004
 
-From a build tree, point GI_TYPELIB_PATH and LD_LIBRARY_PATH at build/gst-libs/gst/pfap (and
-build/lib) and GST_PLUGIN_PATH at build/gst (docs/apps.md).
+It runs until Ctrl-C (or --idle-exit). From a build tree, point GI_TYPELIB_PATH and
+LD_LIBRARY_PATH at build/gst-libs/gst/pfap (and build/lib) and GST_PLUGIN_PATH at build/gst
+(docs/apps.md).
 """
 import argparse
+import signal
 import sys
 
 import gi
@@ -69,40 +71,74 @@ def main():
     pipeline = Gst.parse_launch(
         "udpsrc name=src ! rtpjitterbuffer max-dropout-time=0 max-misorder-time=0 "
         "! rtppfapdepay ! "
-        "appsink name=sink caps=%s sync=false" % GstPfap.CAPS)
+        "appsink name=sink caps=%s sync=false emit-signals=true" % GstPfap.CAPS)
     src = pipeline.get_by_name("src")
     src.set_property("address", args.address)
     src.set_property("port", args.port)
     src.set_property("caps", Gst.Caps.from_string(
         "application/x-rtp,media=application,encoding-name=PFAP,clock-rate=%d" % args.clock_rate))
     sink = pipeline.get_by_name("sink")
+
+    # Everything runs in a GLib main loop, as GStreamer applications do: a thread blocked in
+    # a pull would not see Ctrl-C until a packet came. appsink's streaming thread only hands
+    # each sample to the loop; SIGINT and SIGTERM quit it.
+    loop = GLib.MainLoop()
+    status = [0]
+    alphabet = [None]
+    idle_timeout = [0]
+
+    def quit_loop():
+        loop.quit()
+        return GLib.SOURCE_REMOVE
+
+    def restart_idle_timeout():
+        if args.idle_exit <= 0:
+            return
+        if idle_timeout[0]:
+            GLib.source_remove(idle_timeout[0])
+        idle_timeout[0] = GLib.timeout_add(int(args.idle_exit * 1000), quit_loop)
+
+    def on_event(sample):
+        restart_idle_timeout()
+        if alphabet[0] is None:
+            caps = sample.get_caps().get_structure(0)
+            name = caps.get_string("alphabet") or args.alphabet or GstPfap.ALPHABET_ARPABET
+            alphabet[0] = GstPfap.Alphabet.find(name)
+            if alphabet[0] is None:
+                print("unknown alphabet %s: symbols shown as numbers" % name, file=sys.stderr)
+        buffer = sample.get_buffer()
+        try:
+            event = GstPfap.Event.new_from_buffer(buffer)
+        except GLib.Error as e:
+            print("dropped: %s" % e.message, file=sys.stderr)
+            return GLib.SOURCE_REMOVE
+        print(describe(event, buffer.pts, alphabet[0]), flush=True)
+        return GLib.SOURCE_REMOVE
+
+    def on_new_sample(appsink):  # appsink's streaming thread
+        GLib.idle_add(on_event, appsink.pull_sample())
+        return Gst.FlowReturn.OK
+
+    def on_error(bus, message):
+        error, _ = message.parse_error()
+        print("error: %s" % error.message, file=sys.stderr)
+        status[0] = 1
+        loop.quit()
+
+    sink.connect("new-sample", on_new_sample)
+    bus = pipeline.get_bus()
+    bus.add_signal_watch()
+    bus.connect("message::error", on_error)
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        GLib.unix_signal_add(GLib.PRIORITY_DEFAULT, signum, quit_loop)
     pipeline.set_state(Gst.State.PLAYING)
     print("listening on %s:%d" % (args.address, args.port), flush=True)
-
-    alphabet = None
-    idle_ns = int(args.idle_exit * Gst.SECOND) if args.idle_exit > 0 else Gst.CLOCK_TIME_NONE
-    try:
-        while True:
-            sample = sink.try_pull_sample(idle_ns)
-            if sample is None:
-                break
-            if alphabet is None:
-                caps = sample.get_caps().get_structure(0)
-                name = caps.get_string("alphabet") or args.alphabet or GstPfap.ALPHABET_ARPABET
-                alphabet = GstPfap.Alphabet.find(name)
-                if alphabet is None:
-                    print("unknown alphabet %s: symbols shown as numbers" % name, file=sys.stderr)
-            buffer = sample.get_buffer()
-            try:
-                event = GstPfap.Event.new_from_buffer(buffer)
-            except GLib.Error as e:
-                print("dropped: %s" % e.message, file=sys.stderr)
-                continue
-            print(describe(event, buffer.pts, alphabet), flush=True)
-    except KeyboardInterrupt:
-        pass
+    restart_idle_timeout()
+    loop.run()
     pipeline.set_state(Gst.State.NULL)
+    bus.remove_signal_watch()
+    return status[0]
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

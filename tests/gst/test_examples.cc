@@ -6,23 +6,31 @@
 //    through pfapparse ! pfaptextenc, and is described in docs/examples/README.md.
 //  - Loopback.*: pfap-loopback returns every round-trip sample (all files without comments
 //    or state lines) byte for byte, at several MTUs, and reports bad input.
-//  - Rtsp.ServesAudioAndPhonemes: pfap-rtsp-server as a subprocess and an rtspsrc client: the
-//    SDP and the caps carry the alphabet, audio arrives, every phoneme arrives.
+//  - Rtsp.*: pfap-rtsp-server as a subprocess and an rtspsrc client: the SDP and the caps
+//    carry the alphabet, audio arrives, every phoneme arrives; the audio's first sample and
+//    the phonemes' time 0 are one instant in the RTCP reports.
 //  - DocumentedLines.*: each command block of that docs section, run as written but with free
 //    ports, the source tree's docs/examples/ and temporary output files.
 //  - Readme.*: the pfaptts commands of README.md, "Text to speech", run the same way; its
-//    pfapalign lines are checked to be those of docs/elements.md, which test_pfapalign* run.
+//    pfapalign lines are checked to be those of docs/elements.md, which test_pfapalign* run,
+//    and its "A recording" block is run as written. Every file a README command reads is
+//    there, the Install section names the packages of the GStreamer tools it runs, and each
+//    build tree GST_PLUGIN_PATH of README.md and docs/ finds the plugins from another
+//    directory.
+//  - InstallMd.*: docs/install.md's account of the packages against debian/.
 //  - Story.*: pfap-story, the main job: speech over RTP with loss, rendered and muxed.
 //  - PlayStream.*: generic players, no pipeline written by hand: playbin on the RTSP example
 //    (rtppfapdepay and pfapface plugged by themselves, face within a video frame of the
 //    audio), playbin on a .pfap file (the typefinder), other text left alone, and ffmpeg -t 3
 //    against the example ending.
 //
-// meson passes PFAP_SOURCE_DIR, PFAP_LOOPBACK, PFAP_RTSP_SERVER and PFAP_STORY, and GST_PLUGIN_PATH
-// in the environment (the subprocesses inherit it). Everything is on 127.0.0.1, on port 0 or on
-// free ports found by binding port 0; every wait is bounded.
+// meson passes PFAP_SOURCE_DIR, PFAP_BUILD_DIR, PFAP_LOOPBACK, PFAP_RTSP_SERVER and PFAP_STORY,
+// and GST_PLUGIN_PATH in the environment (the subprocesses inherit it). Everything is on
+// 127.0.0.1, on port 0 or on free ports found by binding port 0; every wait is bounded.
 #include <arpa/inet.h>
+#include <glib/gstdio.h>
 #include <gst/gst.h>
+#include <gst/rtp/gstrtcpbuffer.h>
 #include <gst/sdp/gstsdpmessage.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
@@ -531,6 +539,86 @@ TEST(Rtsp, ServesAudioAndPhonemes) {
   EXPECT_EQ(server.stop(), 0) << "the server ends with status 0 on SIGTERM";
 }
 
+// The sender's wall-clock time (NTP, ns) of each stream's first RTP timestamp, from its RTCP
+// sender reports: per report, its NTP time less the RTP time elapsed since the first packet.
+struct TimeZeros {
+  std::mutex mutex;
+  std::vector<int64_t> of[2];  // per session: 0 the audio, 1 the PFAP stream
+
+  static void on_new_manager(GstElement*, GstElement* manager, gpointer data) {
+    g_signal_connect(manager, "new-jitterbuffer", G_CALLBACK(on_new_jitterbuffer), data);
+  }
+  static void on_new_jitterbuffer(GstElement*, GstElement* jitterbuffer, guint session, guint,
+                                  gpointer data) {
+    if (session > 1) return;
+    g_object_set_data(G_OBJECT(jitterbuffer), "session", GUINT_TO_POINTER(session));
+    g_signal_connect(jitterbuffer, "handle-sync", G_CALLBACK(on_handle_sync), data);
+  }
+  static void on_handle_sync(GstElement* jitterbuffer, GstStructure* s, gpointer data) {
+    auto* self = static_cast<TimeZeros*>(data);
+    guint64 base = 0, sr_rtp = 0;
+    guint rate = 0;
+    const GValue* value = gst_structure_get_value(s, "sr-buffer");
+    if (!gst_structure_get(s, "base-rtptime", G_TYPE_UINT64, &base, "sr-ext-rtptime", G_TYPE_UINT64,
+                           &sr_rtp, "clock-rate", G_TYPE_UINT, &rate, nullptr) ||
+        value == nullptr || rate == 0) {
+      return;
+    }
+    GstRTCPBuffer rtcp = GST_RTCP_BUFFER_INIT;
+    GstRTCPPacket packet;
+    guint64 ntp = 0;
+    if (!gst_rtcp_buffer_map(gst_value_get_buffer(value), GST_MAP_READ, &rtcp)) return;
+    const bool sr = gst_rtcp_buffer_get_first_packet(&rtcp, &packet) &&
+                    gst_rtcp_packet_get_type(&packet) == GST_RTCP_TYPE_SR;
+    if (sr) gst_rtcp_packet_sr_get_sender_info(&packet, nullptr, &ntp, nullptr, nullptr, nullptr);
+    gst_rtcp_buffer_unmap(&rtcp);
+    if (!sr) return;
+    const auto ntp_ns =
+        static_cast<int64_t>(gst_util_uint64_scale(ntp, GST_SECOND, G_GUINT64_CONSTANT(1) << 32));
+    const auto since_first =
+        static_cast<int64_t>(gst_util_uint64_scale(sr_rtp - base, GST_SECOND, rate));
+    const guint session = GPOINTER_TO_UINT(g_object_get_data(G_OBJECT(jitterbuffer), "session"));
+    std::lock_guard lock(self->mutex);
+    self->of[session].push_back(ntp_ns - since_first);
+  }
+  // The median of a stream's time zeros (one per report), or -1 with fewer than `n` reports.
+  int64_t median(int session, size_t n) {
+    std::lock_guard lock(mutex);
+    std::vector<int64_t> v = of[session];
+    if (v.size() < n) return -1;
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  }
+};
+
+// The server's audio and phonemes count from one instant: the RTP timestamp of the first
+// audio sample and that of the first phoneme (time 0 of the file) map, by each session's RTCP
+// reports, to the same wall-clock time. Before, the audio's first sample went out stamped a
+// few ms to tens of ms after the phonemes' zero (the running time at which the live source
+// started), so every client put the face that much ahead of the speech.
+TEST(Rtsp, AudioAndPhonemesShareTheirTimeZero) {
+  ASSERT_TRUE(plugin_available(kElements));
+  RtspServer server(source_path("docs/examples/hello.pfap"));
+  ASSERT_EQ(server.url().rfind("rtsp://127.0.0.1:", 0), 0u) << "URL: " << server.url();
+  Pipeline client("rtspsrc name=src buffer-mode=synced location=" + server.url() +
+                  " src. ! rtpL16depay ! fakesink src. ! rtppfapdepay ! fakesink");
+  ASSERT_TRUE(client.error().empty()) << client.error();
+  TimeZeros zeros;
+  g_signal_connect(client.find("rtspsrc"), "new-manager", G_CALLBACK(TimeZeros::on_new_manager),
+                   &zeros);
+  ASSERT_EQ(client.set_state(GST_STATE_PLAYING), "");
+  constexpr size_t kReports = 5;  // the server sends one every ~100 ms per session
+  ASSERT_TRUE(wait_until(
+      {&client}, [&] { return zeros.median(0, kReports) >= 0 && zeros.median(1, kReports) >= 0; },
+      15s, "RTCP sender reports of both sessions"));
+  gst_element_set_state(client.get(), GST_STATE_NULL);
+  EXPECT_EQ(server.stop(), 0);
+  const int64_t difference = zeros.median(0, kReports) - zeros.median(1, kReports);
+  EXPECT_LT(std::abs(difference), static_cast<int64_t>(GST_MSECOND))
+      << "the audio's first sample is " << static_cast<double>(difference) / 1e6
+      << " ms after the phonemes' time 0";
+}
+
 // ---------------------------------------------------------------------------------------------
 // DocumentedLines: docs/elements.md, "Text markup: sending and receiving a session"
 
@@ -725,12 +813,195 @@ TEST(Readme, EveryCommandIsTested) {
 // README.md's pfapalign lines are docs/elements.md's, which test_pfapalign and
 // test_pfapalign_live run.
 TEST(Readme, AlignCommandsAreTheDocumentedOnes) {
-  const std::vector<std::string> readme = readme_align_commands();
+  std::vector<std::string> readme = readme_align_commands();
+  std::erase_if(readme, [](const std::string& c) { return c.find(" pfapalign ") == c.npos; });
   ASSERT_EQ(readme.size(), 2u);
   const std::vector<std::string> documented = doc_section("docs/elements.md", "## pfapalign");
   for (const std::string& command : readme) {
     EXPECT_NE(std::find(documented.begin(), documented.end(), command), documented.end())
         << command;
+  }
+}
+
+// The README's commands grouped by the heading they are under, in order.
+std::vector<std::vector<std::string>> readme_command_groups() {
+  std::vector<std::vector<std::string>> groups;
+  std::vector<std::string> lines;
+  bool in_block = false;
+  for (const std::string& line : lines_of(read_file(source_path("README.md")))) {
+    if (line.starts_with("```")) in_block = !in_block;
+    if (!in_block && pfap::testing::heading_level(line) > 0) {
+      groups.push_back(commands_in(lines));
+      lines.clear();
+    }
+    lines.push_back(line);
+  }
+  groups.push_back(commands_in(lines));
+  return groups;
+}
+
+// Every file a README command reads (filesrc) is in the checkout or written (filesink) by a
+// command before it under the same heading: the pfapalign line read a speech.wav that nothing
+// in its section made, and the one "Into files" makes says something else.
+TEST(Readme, EveryFileACommandReadsIsThere) {
+  const std::regex reads("filesrc location=(\\S+)"), writes("filesink location=(\\S+)");
+  size_t checked = 0;
+  for (const std::vector<std::string>& group : readme_command_groups()) {
+    std::vector<std::string> written;
+    for (const std::string& command : group) {
+      for (std::sregex_iterator m(command.begin(), command.end(), reads), end; m != end; ++m) {
+        const std::string file = (*m)[1];
+        ++checked;
+        EXPECT_TRUE(g_file_test(source_path(file).c_str(), G_FILE_TEST_IS_REGULAR) ||
+                    std::find(written.begin(), written.end(), file) != written.end())
+            << file << ", read by: " << command;
+      }
+      for (std::sregex_iterator m(command.begin(), command.end(), writes), end; m != end; ++m) {
+        written.push_back((*m)[1]);
+      }
+    }
+  }
+  EXPECT_GE(checked, 1u);
+}
+
+// The "A recording" block as written: the stand-in recording, then its phonemes.
+TEST(Readme, RecordingBlockRuns) {
+  ASSERT_TRUE(plugin_available(kElements));
+  const std::vector<std::string> commands =
+      documented_commands("README.md", "## PFAP from any speech", "### A recording");
+  ASSERT_EQ(commands.size(), 2u);
+  TempDir dir;
+  Substitution substitute(dir);
+  for (const std::string& command : commands) {
+    Pipeline p(substitute.launch(command));
+    ASSERT_TRUE(p.error().empty()) << p.error();
+    ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
+    ASSERT_EQ(p.wait_eos(60s), "") << command;
+  }
+  EXPECT_GT(pfap_lines(read_file(dir.file("speech.pfap"))).size(), 40u);
+}
+
+// The Install section names the Debian package of each GStreamer tool the README's commands
+// run (gst-inspect-1.0 and the rest are in gstreamer1.0-tools, which a fresh Debian lacks).
+TEST(Readme, InstallNamesThePackageOfEachToolItRuns) {
+  const std::string install = [] {
+    std::string text;
+    for (const std::string& line : doc_section("README.md", "## Install")) text += line + "\n";
+    return text;
+  }();
+  ASSERT_FALSE(install.empty());
+  std::vector<std::string> programs;
+  for (const std::vector<std::string>& group : readme_command_groups()) {
+    for (const std::string& command : group) {
+      const std::string program = command.substr(0, command.find(' '));
+      if (program.starts_with("gst-") &&
+          std::find(programs.begin(), programs.end(), program) == programs.end()) {
+        programs.push_back(program);
+      }
+    }
+  }
+  ASSERT_GE(programs.size(), 3u) << "gst-launch-1.0, gst-inspect-1.0, gst-play-1.0";
+  gchar* found = g_find_program_in_path("dpkg");
+  const std::string dpkg = found != nullptr ? found : "";
+  g_free(found);
+  if (dpkg.empty()) GTEST_SKIP() << "no dpkg to ask which package holds each program";
+  for (const std::string& program : programs) {
+    gchar* path = g_find_program_in_path(program.c_str());
+    if (path == nullptr) {
+      ADD_FAILURE() << program << " is not installed: scripts/install-deps installs it";
+      continue;
+    }
+    const ProcessResult owner = run({dpkg, "-S", path});
+    g_free(path);
+    ASSERT_EQ(owner.status, 0) << "dpkg -S: " << owner.err;
+    const std::string package = owner.out.substr(0, owner.out.find(':'));
+    EXPECT_NE(install.find("`" + package + "`"), std::string::npos)
+        << program << " is in " << package << ", which README.md's Install section never names";
+  }
+}
+
+// Each GST_PLUGIN_PATH the README and docs tell users to set for a build tree still finds the
+// plugins from another directory (a user's next `cd`), as a shell would set it in the
+// checkout: $PWD is the checkout, and its build/ this build tree.
+TEST(Readme, BuildTreePluginPathsHoldAfterCd) {
+  const std::string build_root = PFAP_BUILD_DIR;
+  std::vector<std::string> texts;
+  for (const char* file : {"README.md", "docs/apps.md", "docs/install.md"}) {
+    texts.push_back(read_file(source_path(file)));
+  }
+  std::string playing;
+  for (const std::string& line : doc_section("docs/elements.md", "## Playing a stream")) {
+    playing += line + "\n";
+  }
+  texts.push_back(playing);
+  const std::regex setting("GST_PLUGIN_PATH=([^\\s`]*build/[^\\s`]*)");
+  std::vector<std::string> values;
+  for (const std::string& text : texts) {
+    for (std::sregex_iterator m(text.begin(), text.end(), setting), end; m != end; ++m) {
+      if (std::find(values.begin(), values.end(), (*m)[1]) == values.end()) {
+        values.push_back((*m)[1]);
+      }
+    }
+  }
+  // Each value starts from a copy of the tests' registry: a registry drops what the path no
+  // longer finds, and a copy saves scanning every system plugin again (slow under ASan).
+  const char* registry = g_getenv("GST_REGISTRY_1_0");
+  const std::string cached = registry != nullptr ? read_file(registry) : "";
+  TempDir elsewhere;
+  size_t checked = 0;
+  for (std::string value : values) {
+    SCOPED_TRACE("GST_PLUGIN_PATH=" + value);
+    std::ofstream(elsewhere.file("registry.bin"), std::ios::binary) << cached;
+    replace_all(value, "$PWD/build/", build_root + "/");
+    gchar** envp = g_get_environ();
+    envp = g_environ_setenv(envp, "GST_PLUGIN_PATH", value.c_str(), TRUE);
+    envp = g_environ_setenv(envp, "GST_REGISTRY_1_0", elsewhere.file("registry.bin").c_str(), TRUE);
+    std::vector<std::string> elements = {"rtppfappay"};
+    constexpr const char* kFace[] = {"pfapface"};
+    if (value.find("/ext") != std::string::npos && plugin_available(kFace)) {
+      elements.push_back("pfapface");
+    }
+    for (std::string& element : elements) {
+      gchar* argv[] = {const_cast<gchar*>("gst-inspect-1.0"), element.data(), nullptr};
+      gint status = -1;
+      GError* error = nullptr;
+      const gboolean ran =
+          g_spawn_sync(elsewhere.path().c_str(), argv, envp,
+                       static_cast<GSpawnFlags>(G_SPAWN_SEARCH_PATH | G_SPAWN_STDOUT_TO_DEV_NULL |
+                                                G_SPAWN_STDERR_TO_DEV_NULL),
+                       nullptr, nullptr, nullptr, nullptr, &status, &error);
+      if (!ran) {
+        ADD_FAILURE() << "cannot run gst-inspect-1.0: " << error->message;
+        g_error_free(error);
+        continue;
+      }
+      EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0)
+          << "gst-inspect-1.0 " << element << " finds nothing from " << elsewhere.path();
+      ++checked;
+    }
+    g_remove(elsewhere.file("registry.bin").c_str());
+    g_strfreev(envp);
+  }
+  EXPECT_FALSE(values.empty());
+  EXPECT_GE(checked, values.size());
+}
+
+// docs/install.md's account of the packages matches debian/: as many .deb files as stanzas in
+// debian/control, and no lintian warning for manual pages that pfap-tools installs.
+TEST(InstallMd, MatchesThePackaging) {
+  const std::string install = read_file(source_path("docs/install.md"));
+  const std::string control = read_file(source_path("debian/control"));
+  size_t packages = 0;
+  for (const std::string& line : lines_of(control)) packages += line.starts_with("Package: ");
+  const std::vector<std::string> numbers = {"zero", "one",   "two",   "three", "four", "five",
+                                            "six",  "seven", "eight", "nine",  "ten"};
+  ASSERT_LT(packages, numbers.size());
+  std::smatch said;
+  ASSERT_TRUE(std::regex_search(install, said, std::regex("all (\\w+) `\\.deb` files")));
+  EXPECT_EQ(said[1].str(), numbers[packages]) << packages << " packages in debian/control";
+  if (read_file(source_path("debian/pfap-tools.install")).find("/man1/") != std::string::npos) {
+    EXPECT_EQ(install.find("`no-manual-page` for"), std::string::npos)
+        << "the tools' manual pages are installed";
   }
 }
 
@@ -925,10 +1196,14 @@ class Player {
   std::function<void(GstElement*, const std::string&)> on_added;
 
  private:
-  // rtspsrc's default 2 s of jitterbuffer latency would only make the test longer.
+  // rtspsrc's default 2 s of jitterbuffer latency would only make the test longer. Its
+  // default buffer-mode, slave, times packets by their arrival, which a loaded machine
+  // delays by tens of ms; synced times them by their RTP timestamps from the first packet
+  // on, so what is measured is what the server sent (docs/elements.md, "Playing a stream").
   static void on_source_setup(GstElement*, GstElement* source, gpointer) {
     if (g_object_class_find_property(G_OBJECT_GET_CLASS(source), "latency") != nullptr) {
       g_object_set(source, "latency", 200u, nullptr);
+      gst_util_set_object_arg(G_OBJECT(source), "buffer-mode", "synced");
     }
   }
   static void on_element_added(GstBin*, GstBin*, GstElement* element, gpointer data) {
@@ -1014,10 +1289,10 @@ struct FaceLog {
   }
 };
 
-// The example server's audio: audiotestsrc ticks, one every kTickInterval from its start
-// (sender running time 0). Each tick's first sample, found after depayloading, gives the
-// receiver's running time of a known sender time.
-constexpr GstClockTime kTickInterval = 500 * GST_MSECOND;
+// The example server's audio: audiotestsrc ticks, its first sample at sender running time 0.
+// Each tick's first sample, found after depayloading, gives the receiver's running time of a
+// known sender time (sent_tick_times).
+constexpr const char* kServerAudio = "audiotestsrc wave=ticks tick-interval=500000000";
 constexpr int kAudioRate = 44100;
 
 struct TickLog {
@@ -1059,6 +1334,23 @@ struct TickLog {
     return GST_PAD_PROBE_OK;
   }
 };
+
+// Where the server's audio has its ticks, in sender time: audiotestsrc with the server's
+// settings, run here, not live. It puts them one buffer (1024 samples, 23.2 ms) before each
+// interval's end and none at 0: 476.8, 976.8 ... ms. (Taking them to be at 500, 1000 ... ms
+// put every phoneme 23 ms behind its sound in this test, on a machine that kept them in step.)
+std::vector<GstClockTime> sent_tick_times(GstClockTime until) {
+  Pipeline source(std::string(kServerAudio) + " ! audio/x-raw,format=S16BE,rate=" +
+                  std::to_string(kAudioRate) + ",channels=1 ! identity ! fakesink");
+  TickLog log;
+  log.attach(source.find("identity"));
+  g_object_set(source.find("audiotestsrc"), "num-buffers",
+               static_cast<int>(gst_util_uint64_scale(until, kAudioRate, GST_SECOND * 1024)) + 1,
+               nullptr);
+  if (!source.set_state(GST_STATE_PLAYING).empty() || !source.wait_eos(10s).empty()) return {};
+  std::lock_guard lock(log.mutex);
+  return log.onsets;
+}
 
 // The start times (ms) of the phoneme lines of a .pfap text, in order.
 std::vector<int64_t> phoneme_starts(const std::string& text) {
@@ -1107,16 +1399,23 @@ TEST(PlayStream, PlaybinShowsTheTalkingHeadInSyncWithTheAudio) {
   EXPECT_TRUE(player.has("rtpL16depay"));
 
   // The audio's offset, receiver running time minus sender time, at every tick: the first
-  // audio is the stream's start (sender time 0, give or take a lost packet), which numbers
-  // the ticks. rtpbin moves the streams by a few ms when the first RTCP reports come.
+  // audio is the stream's start (sender time 0, give or take a lost packet), which finds each
+  // tick among the sent ones. rtpbin moves the streams by a few ms when the first RTCP
+  // reports come.
+  const std::vector<GstClockTime> sent_ticks = play::sent_tick_times(2 * GST_SECOND);
+  ASSERT_GE(sent_ticks.size(), 3u);
   std::vector<std::pair<int64_t, int64_t>> audio_offsets;  // (sender time, offset)
   for (GstClockTime onset : ticks.onsets) {
-    const auto k = static_cast<int64_t>((onset - ticks.first_buffer + play::kTickInterval / 2) /
-                                        play::kTickInterval);
-    const int64_t sent = k * static_cast<int64_t>(play::kTickInterval);
+    const auto since_start = static_cast<int64_t>(onset - ticks.first_buffer);
+    const auto nearest =
+        std::min_element(sent_ticks.begin(), sent_ticks.end(), [&](GstClockTime a, GstClockTime b) {
+          return std::abs(static_cast<int64_t>(a) - since_start) <
+                 std::abs(static_cast<int64_t>(b) - since_start);
+        });
+    const auto sent = static_cast<int64_t>(*nearest);
     audio_offsets.emplace_back(sent, static_cast<int64_t>(onset) - sent);
   }
-  ASSERT_GE(audio_offsets.size(), 3u) << "ticks at 0, 0.5, 1 and 1.5 s";
+  ASSERT_GE(audio_offsets.size(), 3u) << "ticks at 0.48, 0.98 and 1.48 s";
   // The offset of the audio at sender time `sent`: that of the last tick before it.
   auto audio_offset_at = [&](int64_t sent) {
     int64_t offset = audio_offsets.front().second;

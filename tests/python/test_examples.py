@@ -1,12 +1,16 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """The example programs in examples/python and examples/gjs, run as a user runs them, against
 the build tree (tests/python/meson.build sets the paths)."""
+import contextlib
 import os
 import re
+import shlex
 import shutil
+import signal
 import socket
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import gi
@@ -91,6 +95,85 @@ def test_receiver_prints_every_phoneme_by_name(command):
     got = [line.split()[2] for line in out.splitlines() if " phoneme " in line]
     assert got == expected
     assert "    FAP 69 -> 30 over 400 ms" in out  # hello.pfap's first bookmark
+
+
+def apps_md_receiver_block():
+    """docs/apps.md's shell block for the receivers: the receiver commands (the Python one, and
+    the gjs one in its comment) and the sender's gst-launch-1.0 command, each as words."""
+    (block,) = [b for b in apps_md_blocks("sh") if "pfap-receiver" in b]
+    lines = block.replace("\\\n", " ").splitlines()
+    documented = r"(examples/\S+ --port 5004) &"
+    receivers = [shlex.split(command) for line in lines for command in re.findall(documented, line)]
+    (sender,) = [shlex.split(line) for line in lines if line.startswith("gst-launch-1.0 ")]
+    return receivers, sender
+
+
+def with_port(words, port):
+    return [w.replace("5004", str(port)) for w in words]
+
+
+@contextlib.contextmanager
+def documented_receiver(interpreter):
+    """The documented receiver command run in `interpreter`'s language, as the block has it:
+    from the source tree, the script as the program. Gives (process, port); kills it if a test
+    left it running."""
+    receivers, _ = apps_md_receiver_block()
+    (command,) = [r for r in receivers if r[0].startswith("examples/%s/" % interpreter)]
+    port = free_udp_port()
+    receiver = subprocess.Popen(with_port(command, port), cwd=SOURCE, stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True)
+    try:
+        assert receiver.stdout.readline().startswith("listening on 127.0.0.1:%d" % port)
+        yield receiver, port
+    finally:
+        if receiver.poll() is None:
+            receiver.kill()
+            receiver.communicate()
+
+
+def stop_with(receiver, signum):
+    """Sends `signum`; the receiver must end within 5 s, with status 0 and nothing on stderr.
+    Returns what else it printed."""
+    receiver.send_signal(signum)
+    try:
+        out, err = receiver.communicate(timeout=5)
+    except subprocess.TimeoutExpired:
+        pytest.fail("still running 5 s after signal %d" % signum)
+    assert receiver.returncode == 0, err
+    assert err == ""
+    return out
+
+
+def test_apps_md_shows_both_receivers():
+    receivers, sender = apps_md_receiver_block()
+    assert [r[0] for r in receivers] == ["examples/python/pfap-receiver.py",
+                                         "examples/gjs/pfap-receiver.js"]
+    assert sender[0] == "gst-launch-1.0"
+
+
+# The documented block as a user runs it, with no --idle-exit: the receiver prints every phoneme
+# the documented sender sends, and Ctrl-C then ends it with status 0 and nothing on stderr.
+@pytest.mark.parametrize("interpreter", ["python", pytest.param("gjs", marks=needs_gjs)])
+def test_documented_receiver_prints_the_session_and_ends_on_ctrl_c(interpreter):
+    expected = phoneme_names(HELLO)
+    with documented_receiver(interpreter) as (receiver, port):
+        _, sender = apps_md_receiver_block()
+        sent = subprocess.run(with_port(sender, port), cwd=SOURCE, capture_output=True,
+                              text=True, timeout=30)
+        assert sent.returncode == 0, sent.stderr
+        time.sleep(1)  # what was sent is printed
+        out = stop_with(receiver, signal.SIGINT)
+    got = [line.split()[2] for line in out.splitlines() if " phoneme " in line]
+    assert got == expected
+
+
+# Ctrl-C (SIGINT) or kill (SIGTERM) while nothing comes: the receiver ends at once, status 0.
+@pytest.mark.parametrize("interpreter", ["python", pytest.param("gjs", marks=needs_gjs)])
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_documented_receiver_ends_on_a_signal_while_idle(interpreter, signum):
+    with documented_receiver(interpreter) as (receiver, _):
+        time.sleep(0.5)
+        assert stop_with(receiver, signum) == ""
 
 
 def test_mouth_opens_and_closes_with_the_jaw():
