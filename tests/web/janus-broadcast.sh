@@ -6,7 +6,8 @@
 # 10.28.0.2, both ends inside it), since Janus gathers no ICE candidate on a loopback
 # interface; its ICE uses 10.28.0.1 (PFAP_JANUS_ICE_ADDRESS). unshare -n needs root: elsewhere
 # the test is skipped (exit 77) saying so; CI runs as root.
-# Arguments: node, the test file. PFAP_BROADCAST names the sender.
+# Arguments: node, the test file. PFAP_BROADCAST names the sender; PFAP_TIMEOUT (170 s)
+# bounds the whole (the benchmark, web/bench/janus-viewers.browser.js, takes longer).
 set -eu
 if [ "$(id -u)" -ne 0 ]; then
   echo "SKIP: needs root: unshare -n makes the network namespace that Janus and WebRTC run in (CI runs as root)"
@@ -22,7 +23,7 @@ done
 # not into node, sh, janus or chromium, which are not ours; pfap-broadcast links its own.
 unset LD_PRELOAD
 export PFAP_JANUS_ICE_ADDRESS=10.28.0.1
-exec timeout 170 unshare -n sh -c '
+exec timeout "${PFAP_TIMEOUT:-170}" unshare -n sh -c '
   ip link set lo up &&
   ip link add pfap0 type veth peer name pfap1 &&
   ip addr add 10.28.0.1/24 dev pfap0 && ip addr add 10.28.0.2/24 dev pfap1 &&

@@ -141,7 +141,14 @@ export function start({ canvas, audio, status, janusServer }) {
       stream.base = estimate - rtpMs;
     }
     // The chunk it names is heard from its timestamp plus the output's latency on.
-    clock.reading(handedAt + clock.latencyMs(), rtpMs + stream.base);
+    const heardFrom = handedAt + clock.latencyMs();
+    clock.reading(heardFrom, rtpMs + stream.base);
+    if (!stats.matched && clock.matched) {
+      // How far the first estimate was from the level's match (docs/web.md).
+      stats.estimateOffMs = rtpMs + stream.base - heardFrom - clock.mappingAt(heardFrom);
+      stats.firstMatchAt = now;
+      stats.jitterBufferMs = jitterBufferMs;
+    }
     stats.matched = clock.matched !== null;
     return Math.round((clock.runningMs(now) - stream.firstPfapMs) * 1e6);
   }
