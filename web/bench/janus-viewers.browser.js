@@ -2,9 +2,9 @@
 // Benchmark (figures printed, nothing timed asserted): N viewers of one talking head through
 // Janus beside N sessions of pfap-web, in one run on this machine (docs/web.md, "Broadcast
 // through Janus: measured"). N is PFAP_VIEWERS (20). For each side it prints the server's CPU
-// time per second of speech (Janus's, with 1 viewer and with N; pfap-web's with N sessions),
-// and for each page whether it is whole and its lip-sync errors (median, 95th percentile of
-// |error|, ms).
+// time for one text said to every viewer (Janus's with 1 viewer and with N, in all and during
+// the speech alone; pfap-web's with N sessions) and for each page whether it is whole and its
+// lip-sync errors (median, 95th percentile of |error|, ms).
 //
 //   sudo PFAP_VIEWERS=20 PFAP_TIMEOUT=900 PFAP_BROADCAST=build/tools/pfap-broadcast \
 //     PFAP_WEB=build/tools/pfap-web GST_PLUGIN_PATH=build/gst:build/ext \
@@ -68,15 +68,17 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
     // Janus: once with one viewer, once with N.
     const janus = await startJanus();
     const pageServer = await servePages();
+    // Janus's CPU time over the whole (the viewers' sessions set up, the speech relayed) and
+    // over the speech alone (the sender's run, in real time).
     const broadcast = async (count) => {
-      const pages = await inBatches(count, 5, () => openViewer(browser, pageServer, janus));
-      const m = await measured(janus.pid, async () => {
+      const whole = await measured(janus.pid, async () => {
+        const pages = await inBatches(count, 5, () => openViewer(browser, pageServer, janus));
         const sender = startSender(TEXT);
+        const speech = await measured(janus.pid, () => exited(sender));
         const all = await Promise.all(pages.map((p) => figures(p, { timeout: 120000 })));
-        await exited(sender);
-        return { all, sent: JSON.parse(sender.out.trim().split('\n').at(-1)) };
+        return { all, speech, sent: JSON.parse(sender.out.trim().split('\n').at(-1)) };
       });
-      return { cpu: m.cpu, wall: m.wall, ...m.result };
+      return { cpu: whole.cpu, wall: whole.wall, ...whole.result };
     };
     const one = await broadcast(1);
     const many = await broadcast(VIEWERS);
@@ -102,16 +104,19 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
     await stop(server);
     out.pfapWeb = web;
 
-    const perSecond = (m) => m.cpu / m.wall;
-    const janusPerViewer = (perSecond(many) - perSecond(one)) / (VIEWERS - 1);
-    const webPerViewer = perSecond(web) / VIEWERS;
+    const ms = (seconds) => `${(1000 * seconds).toFixed(1)} ms`;
+    const janusPerViewer = (many.cpu - one.cpu) / (VIEWERS - 1);
+    const relayPerViewer = (many.speech.cpu - one.speech.cpu) / (VIEWERS - 1);
+    const webPerViewer = web.cpu / VIEWERS;
     lines.push(
-      `Janus, 1 viewer: ${(100 * perSecond(one)).toFixed(2)} % of a core over ${one.wall.toFixed(1)} s`,
-      `Janus, ${VIEWERS} viewers: ${(100 * perSecond(many)).toFixed(2)} % of a core over ${many.wall.toFixed(1)} s`,
-      `Janus per added viewer: ${(100 * janusPerViewer).toFixed(3)} % of a core`,
-      `pfap-web, ${VIEWERS} sessions: ${(100 * perSecond(web)).toFixed(2)} % of a core over ${web.wall.toFixed(1)} s, ` +
-        `${(100 * webPerViewer).toFixed(3)} % per session`,
-      `pfap-web per session / Janus per viewer: ${(webPerViewer / janusPerViewer).toFixed(1)}`,
+      `the text: ${one.speech.wall.toFixed(1)} s of speech (the sender's run), ${one.sent.packets} PFAP packets`,
+      `Janus, 1 viewer: ${ms(one.cpu)} of CPU in all, ${ms(one.speech.cpu)} during the speech`,
+      `Janus, ${VIEWERS} viewers: ${ms(many.cpu)} of CPU in all, ${ms(many.speech.cpu)} during the speech ` +
+        `(${(100 * many.speech.cpu / many.speech.wall).toFixed(2)} % of a core)`,
+      `Janus per added viewer: ${ms(janusPerViewer)} in all (session set up and the text relayed), ` +
+        `${ms(relayPerViewer)} during the speech`,
+      `pfap-web, ${VIEWERS} sessions: ${ms(web.cpu)} of CPU in all, ${ms(webPerViewer)} per session (set up, the text spoken and sent)`,
+      `pfap-web per session / Janus per added viewer: ${(webPerViewer / janusPerViewer).toFixed(1)}`,
       ...pageRows('Janus viewer', many.all, whole(many.sent)),
       ...pageRows('pfap-web page', web.result, (s) => s.phonemes === s.sender.phonemes && s.fapStateMatchesSender),
     );
