@@ -16,7 +16,7 @@
 // window.pfapStats holds the figures the browser test reads.
 import { PfapReceiver, Viseme, parseRtp } from '../src/index.js';
 import { lipSyncErrors } from '../live/live.js';
-import { DrawnPhonemes, PlayoutClock } from '../live/playout.js';
+import { DrawnPhonemes, PlayoutClock, drawInTime, showCounts } from '../live/playout.js';
 
 const MOUNTPOINT = 1;
 const PFAP_CLOCK_RATE = 44100;
@@ -32,7 +32,6 @@ export function start({ canvas, audio, status, janusServer }) {
     envelope: [], frames: [],
   };
   window.pfapStats = stats;
-  const ctx = canvas.getContext('2d');
   // The first match may be off by the jitter buffer's delay misjudged: it searches wider.
   const clock = new PlayoutClock({ envelope: stats.envelope, audioClockRate: AUDIO_CLOCK_RATE, firstSearchMs: 100 });
   const drawnPhonemes = new DrawnPhonemes(stats.frames);
@@ -69,14 +68,7 @@ export function start({ canvas, audio, status, janusServer }) {
     onWarning: (w) => console.warn(w),
   });
 
-  const show = () => {
-    const s = receiver.stats;
-    Object.assign(stats, { packets: s.packets, lost: s.lost, recovered: s.recovered, complete: s.completeStates, late: s.late });
-    for (const key of ['phonemes', 'packets', 'lost', 'late', 'recovered', 'complete', 'uncertain']) {
-      document.getElementById(key).textContent = String(stats[key]);
-    }
-    document.getElementById('matches').textContent = stats.sender ? (stats.fapStateMatchesSender ? 'yes' : 'no') : '-';
-  };
+  const show = () => showCounts(receiver, stats);
 
   // The sender's state at the end of its stream: every packet has come before it (one port,
   // one ordered channel), and the stream ends with a complete state.
@@ -153,18 +145,11 @@ export function start({ canvas, audio, status, janusServer }) {
     return Math.round((clock.runningMs(now) - stream.firstPfapMs) * 1e6);
   }
 
-  const frame = (now) => {
-    const ns = streamNs(now);
-    if (ns !== null) {
-      stats.streamNs = ns;
-      stats.endNs = receiver.animator.endNs;
-      receiver.draw(ctx, ns, { style: 'cartoon' });
-      drawnPhonemes.frame(now, ns);
-    }
-    requestAnimationFrame(frame);
+  drawInTime({ receiver, canvas, stats, streamNs, drawn: drawnPhonemes });
+  stats.measureLipSync = () => {
+    stats.corrections = clock.corrections;
+    stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames);
   };
-  requestAnimationFrame(frame);
-  stats.measureLipSync = () => (stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames));
 
   const onTrack = (track, mid, on) => {
     if (!on || track.kind !== 'audio' || audioReceiver) return;

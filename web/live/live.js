@@ -13,7 +13,7 @@
 //
 // window.pfapStats holds the figures the browser test reads.
 import { PfapReceiver, Viseme, parseRtp } from '../src/index.js';
-import { DrawnPhonemes, PlayoutClock } from './playout.js';
+import { DrawnPhonemes, PlayoutClock, drawInTime, showCounts } from './playout.js';
 
 /**
  * Lip sync measured against the sound: each speech onset (the level passing 3 % of the
@@ -65,7 +65,6 @@ export function start({ canvas, audio, form, input, status, saying }) {
   const ws = new WebSocket(`ws://${location.host}/ws`);
   const send = (m) => ws.readyState === WebSocket.OPEN && ws.send(JSON.stringify(m));
   const pc = new RTCPeerConnection({ iceServers: [] });
-  const ctx = canvas.getContext('2d');
   let timing = null;
   let firstPfapTimestamp = null;
   let lastSequenceNumber = null;
@@ -90,14 +89,7 @@ export function start({ canvas, audio, form, input, status, saying }) {
     onWarning: (w) => console.warn(w),
   });
 
-  const show = () => {
-    const s = receiver.stats;
-    Object.assign(stats, { packets: s.packets, lost: s.lost, recovered: s.recovered, complete: s.completeStates, late: s.late });
-    for (const key of ['phonemes', 'packets', 'lost', 'late', 'recovered', 'complete', 'uncertain']) {
-      document.getElementById(key).textContent = String(stats[key]);
-    }
-    document.getElementById('matches').textContent = stats.sender ? (stats.fapStateMatchesSender ? 'yes' : 'no') : '-';
-  };
+  const show = () => showCounts(receiver, stats);
 
   // The sender's FAP state after a text: equal to ours once every packet, or the recovery
   // of those lost, has come. Packets lost at the end have nothing after them to recover
@@ -213,16 +205,6 @@ export function start({ canvas, audio, form, input, status, saying }) {
     return Math.round((running - first) * 1e9);
   }
 
-  const frame = (now) => {
-    const ns = streamNs(now);
-    if (ns !== null) {
-      stats.streamNs = ns;
-      stats.endNs = receiver.animator.endNs;
-      receiver.draw(ctx, ns, { style: 'cartoon' });
-      drawnPhonemes.frame(now, ns);
-    }
-    requestAnimationFrame(frame);
-  };
-  requestAnimationFrame(frame);
+  drawInTime({ receiver, canvas, stats, streamNs, drawn: drawnPhonemes });
   stats.measureLipSync = () => (stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames));
 }

@@ -24,13 +24,17 @@ export class PlayoutClock {
    * @param {{envelope: {t: number, rms: number}[], audioClockRate?: number, searchMs?: number,
    *   firstSearchMs?: number}} options `envelope` receives the tap's level of what is heard
    *   (1 ms blocks, performance time); the first match searches ±firstSearchMs around the
-   *   readings, later ones ±searchMs around the last match.
+   *   readings, later ones ±searchMs around the last match, and ±lostSearchMs after 300 ms of
+   *   sound heard without a match (the clock is lost: NetEq's concealment when packets come
+   *   late moves the audio by more than the search, and getStats' stretch counts leave it
+   *   out).
    */
-  constructor({ envelope, audioClockRate = 48000, searchMs = 50, firstSearchMs = searchMs }) {
+  constructor({ envelope, audioClockRate = 48000, searchMs = 50, firstSearchMs = searchMs, lostSearchMs = 150 }) {
     this.envelope = envelope;
     this.audioClockRate = audioClockRate;
     this.searchMs = searchMs;
     this.firstSearchMs = firstSearchMs;
+    this.lostSearchMs = lostSearchMs;
     this.context = null;
     this.reset();
   }
@@ -41,6 +45,8 @@ export class PlayoutClock {
     this.readings = [];  // [heard from, running time less heard time]
     this.stretches = [];  // [heard from, samples removed less inserted]
     this.matched = null;  // {m: running time less heard time, stretch: the stretch then}
+    this.corrections = [];  // {t: heard time, lag: ms}
+    this.misses = 0;  // tap messages since the last match whose window held sound
   }
 
   /**
@@ -119,9 +125,18 @@ export class PlayoutClock {
     for (let i = env.length - 1; i >= 0 && env[i].t >= newest - 150; --i) {
       heard.push({ x: env[i].t + this.mappingAt(env[i].t), rms: env[i].rms });
     }
-    const searchMs = this.matched ? this.searchMs : this.firstSearchMs;
+    const searchMs = !this.matched ? this.firstSearchMs : this.misses >= 30 ? this.lostSearchMs : this.searchMs;
     const lag = matchLevels(heard.reverse(), (ms) => this.sent.at(ms), { searchMs });
-    if (lag !== null) this.matched = { m: this.mappingAt(newest) + lag, stretch: valueAt(this.stretches, newest, 0) };
+    if (lag === null) {
+      const peak = heard.reduce((m, h) => Math.max(m, h.rms), 0);
+      if (this.matched && peak > 1e-3 && heard.filter((h) => h.rms > peak * 0.1).length >= 20) ++this.misses;
+      return;
+    }
+    this.misses = 0;
+    this.matched = { m: this.mappingAt(newest) + lag, stretch: valueAt(this.stretches, newest, 0) };
+    // Each match's correction, for the figures (docs/web.md).
+    this.corrections.push({ t: newest, lag });
+    if (this.corrections.length > 2000) this.corrections.splice(0, 1000);
   }
 }
 
@@ -154,4 +169,34 @@ export class DrawnPhonemes {
     this.frames.push({ t: now, pressed });
     if (this.frames.length > 20000) this.frames.splice(0, 10000);
   }
+}
+
+/**
+ * Draws the face at each animation frame at the stream time `streamNs(now)` gives (null: not
+ * yet), and keeps what the browser tests read: which phoneme each frame draws (`drawn`, a
+ * DrawnPhonemes), `stats.streamNs` and `stats.endNs`.
+ */
+export function drawInTime({ receiver, canvas, stats, streamNs, drawn }) {
+  const ctx = canvas.getContext('2d');
+  const frame = (now) => {
+    const ns = streamNs(now);
+    if (ns !== null) {
+      stats.streamNs = ns;
+      stats.endNs = receiver.animator.endNs;
+      receiver.draw(ctx, ns, { style: 'cartoon' });
+      drawn.frame(now, ns);
+    }
+    requestAnimationFrame(frame);
+  };
+  requestAnimationFrame(frame);
+}
+
+/** The receiver's counts, into `stats` and the page's table (a cell with each key as its id). */
+export function showCounts(receiver, stats) {
+  const s = receiver.stats;
+  Object.assign(stats, { packets: s.packets, lost: s.lost, recovered: s.recovered, complete: s.completeStates, late: s.late });
+  for (const key of ['phonemes', 'packets', 'lost', 'late', 'recovered', 'complete', 'uncertain']) {
+    document.getElementById(key).textContent = String(stats[key]);
+  }
+  document.getElementById('matches').textContent = stats.sender ? (stats.fapStateMatchesSender ? 'yes' : 'no') : '-';
 }
