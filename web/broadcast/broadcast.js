@@ -32,8 +32,9 @@ export function start({ canvas, audio, status, janusServer }) {
     envelope: [], frames: [],
   };
   window.pfapStats = stats;
-  // The first match may be off by the jitter buffer's delay misjudged: it searches wider.
-  const clock = new PlayoutClock({ envelope: stats.envelope, audioClockRate: AUDIO_CLOCK_RATE, firstSearchMs: 100 });
+  // The first estimate may be off by the jitter buffer's delay misjudged, and by the page's
+  // own delays under load: the first match searches as wide as a lost clock's.
+  const clock = new PlayoutClock({ envelope: stats.envelope, audioClockRate: AUDIO_CLOCK_RATE, firstSearchMs: 150 });
   const drawnPhonemes = new DrawnPhonemes(stats.frames);
   const decoder = new TextDecoder();
   let handle = null;
