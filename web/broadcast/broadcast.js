@@ -28,6 +28,7 @@ export function start({ canvas, audio, status, janusServer }) {
     phonemes: 0, packets: 0, lost: 0, recovered: 0, complete: 0, uncertain: 0, late: 0,
     lipSyncErrorsMs: [], fapStateMatchesSender: false, sender: null, done: 0, streams: 0,
     wholeAfterMs: null,  // stream time from the first packet to a whole FAP state
+    malformed: 0,  // JSON messages dropped (PfapReceiver counts the RTP packets it drops)
     connected: false, dataOpen: false, matched: false, streamNs: 0, endNs: 0,
     envelope: [], frames: [],
   };
@@ -80,7 +81,15 @@ export function start({ canvas, audio, status, janusServer }) {
 
   const onMessage = (bytes) => {
     if (bytes[0] === JSON_FIRST_BYTE) {
-      const m = JSON.parse(decoder.decode(bytes));
+      let m;
+      try {
+        m = JSON.parse(decoder.decode(bytes));
+        if (!Number.isInteger(m.ssrc)) throw new Error('no ssrc');
+      } catch (e) {
+        // Dropped whole and counted; the stream goes on.
+        if ((++stats.malformed & (stats.malformed - 1)) === 0) console.warn(`dropped malformed message ${stats.malformed}: ${e.message}`);
+        return;
+      }
       streamOf(m.ssrc, m.timestamp ?? 0);
       if (m.type === 'level') {
         clock.sent.add(msOf(m.timestamp) * 1e6, m.rms);
