@@ -9,11 +9,12 @@
 // PFAP_SOURCE_ROOT and GST_PLUGIN_PATH set. PFAP_BROADCAST_OUT=FILE writes every page's
 // figures there.
 import assert from 'node:assert/strict';
+import dgram from 'node:dgram';
 import { writeFileSync } from 'node:fs';
 import { after, before, test } from 'node:test';
 
 import {
-  COMPLETE_INTERVAL_MS, exited, figures, launchChromium, openViewer, servePages, startJanus, startSender, stop,
+  COMPLETE_INTERVAL_MS, DATA_PORT, exited, figures, launchChromium, openViewer, servePages, startJanus, startSender, stop,
 } from './janus.js';
 
 // Sharp onsets after silence for the lip-sync measurement (each "pa" sounds as its closed
@@ -49,8 +50,16 @@ test('three viewers through Janus, a tenth of the PFAP datagrams dropped before 
   const open = () => openViewer(browser, pageServer, janus);
   const viewers = await Promise.all([open(), open(), open()]);
   const sender = startSender(TEXT, ['--drop=0.1', '--seed=3']);
+  // Bad input on the data port, as from a confused or hostile sender: each page drops both
+  // messages whole, counts them, and goes on.
+  await new Promise((r) => setTimeout(r, 1000));
+  const socket = dgram.createSocket('udp4');
+  for (const bad of ['{not json', '{"type": "level", "rms": [1, 2, 3]}']) {
+    await new Promise((r) => socket.send(bad, DATA_PORT, '127.0.0.1', r));
+  }
+  socket.close();
   // A fourth joins 1.5 s into the speech.
-  await new Promise((r) => setTimeout(r, 1500));
+  await new Promise((r) => setTimeout(r, 500));
   const late = await open();
   const all = await Promise.all([...viewers, late].map((page) => figures(page)));
   assert.equal(await exited(sender), 0, sender.log);
@@ -65,6 +74,7 @@ test('three viewers through Janus, a tenth of the PFAP datagrams dropped before 
     assert.equal(s.streams, 1, which);
     assert.ok(s.matched, `the played level found in the sender's: ${which}`);
     if (i === 3) continue;
+    assert.equal(s.malformed, 2, which);
     // Every phoneme Janus had to relay: all but those of the datagrams dropped before it.
     assert.equal(s.phonemes, sent.phonemes - sent.phonemesDropped, which);
     assert.equal(s.packets, sent.packets - sent.dropped, which);
