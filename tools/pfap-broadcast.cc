@@ -21,7 +21,6 @@
 #include <gst/rtp/gstrtpbuffer.h>
 #include <gst/video/video-event.h>
 
-#include <cmath>
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
@@ -37,6 +36,7 @@
 #include "pfap/model.h"
 #include "pfap/payload.h"
 #include "pfap/recovery.h"
+#include "speech_level.h"
 
 namespace {
 
@@ -48,9 +48,6 @@ constexpr uint32_t kPfapClockRate = 44100;
 // PFAP packets go this far ahead of their time (as pfap-web's): the page holds their events
 // until the audio reaches them.
 constexpr GstClockTimeDiff kPfapLead = 400 * GST_MSECOND;
-// The speech's level: the RMS of each millisecond of 48 kHz S16 mono, 50 ms to a message.
-constexpr int kSamplesPerLevel = 48;
-constexpr size_t kLevelsPerMessage = 50;
 // A "clock" message every this many audio packets (10 ms each).
 constexpr int kClockEvery = 10;
 
@@ -128,10 +125,8 @@ struct Sender {
   int exit_status = 0;
 
   // The level probe's (the audio's streaming thread before the queue).
-  GstClockTime level_start = GST_CLOCK_TIME_NONE;  // running time of levels[0]
-  std::vector<int64_t> levels;
-  double sum = 0.0;
-  int count = 0;
+  GstClockTime level_start = GST_CLOCK_TIME_NONE;  // running time of the first level waiting
+  SpeechLevel level;
   int audio_packets = 0;  // the audio sink's thread
 
   // The appsink's thread: the loss, and the state as sent (every packet, before the loss,
@@ -180,20 +175,20 @@ GstClockTime running_time_of(GstPad* pad, GstBuffer* buffer) {
 // -- The level: the RMS of each ms by PFAP timestamp, sent as the audio enters the queue ------
 
 void send_levels(Sender& s) {
-  if (s.levels.empty()) return;
+  if (s.level.empty()) return;
+  const std::vector<int64_t> levels = s.level.take();
   bool silent = true;
-  for (int64_t v : s.levels) silent = silent && v == 0;
+  for (int64_t v : levels) silent = silent && v == 0;
   if (!silent) {
     std::string json = "{\"type\":\"level\",\"ssrc\":" + std::to_string(s.ssrc) +
                        ",\"timestamp\":" + std::to_string(pfap_timestamp(s, s.level_start)) +
                        ",\"rms\":[";
-    for (size_t i = 0; i < s.levels.size(); ++i) {
-      json += (i == 0 ? "" : ",") + std::to_string(s.levels[i]);
+    for (size_t i = 0; i < levels.size(); ++i) {
+      json += (i == 0 ? "" : ",") + std::to_string(levels[i]);
     }
     send_text(s, json + "]}");
   }
-  s.level_start += s.levels.size() * GST_MSECOND;
-  s.levels.clear();
+  s.level_start += levels.size() * GST_MSECOND;
 }
 
 GstPadProbeReturn on_speech(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
@@ -209,16 +204,7 @@ GstPadProbeReturn on_speech(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
   }
   GstMapInfo map;
   if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) return GST_PAD_PROBE_OK;
-  const auto* samples = reinterpret_cast<const int16_t*>(map.data);
-  for (size_t i = 0; i < map.size / 2; ++i) {
-    s.sum += static_cast<double>(samples[i]) * samples[i];
-    if (++s.count == kSamplesPerLevel) {
-      s.levels.push_back(std::lround(std::sqrt(s.sum / kSamplesPerLevel)));
-      s.sum = 0.0;
-      s.count = 0;
-      if (s.levels.size() == kLevelsPerMessage) send_levels(s);
-    }
-  }
+  s.level.add({reinterpret_cast<const int16_t*>(map.data), map.size / 2}, [&] { send_levels(s); });
   gst_buffer_unmap(buffer, &map);
   return GST_PAD_PROBE_OK;
 }
@@ -316,8 +302,8 @@ GstPadProbeReturn on_pfap_eos(GstPad*, GstPadProbeInfo* info, gpointer data) {
       "request-complete",
       [](gpointer pay) -> gpointer {
         GstPad* src = gst_element_get_static_pad(static_cast<GstElement*>(pay), "src");
-        gst_pad_send_event(src,
-                           gst_video_event_new_upstream_force_key_unit(GST_CLOCK_TIME_NONE, TRUE, 0));
+        gst_pad_send_event(
+            src, gst_video_event_new_upstream_force_key_unit(GST_CLOCK_TIME_NONE, TRUE, 0));
         gst_object_unref(src);
         return nullptr;
       },
@@ -416,12 +402,13 @@ int main(int argc, char** argv) {
     gst_object_unref(pad);
   };
   probe("level", "sink",
-        GstPadProbeType(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM), on_speech);
+        GstPadProbeType(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM),
+        on_speech);
   probe("audiosink", "sink", GST_PAD_PROBE_TYPE_BUFFER, on_audio_packet);
   probe("pay", "sink", GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM, on_pfap_eos);
 
-  s.socket = g_socket_new(G_SOCKET_FAMILY_IPV4, G_SOCKET_TYPE_DATAGRAM, G_SOCKET_PROTOCOL_UDP,
-                          &error);
+  s.socket =
+      g_socket_new(G_SOCKET_FAMILY_IPV4, G_SOCKET_TYPE_DATAGRAM, G_SOCKET_PROTOCOL_UDP, &error);
   if (s.socket == nullptr) {
     g_printerr("pfap-broadcast: %s\n", error->message);
     g_error_free(error);
@@ -436,7 +423,7 @@ int main(int argc, char** argv) {
   g_unix_signal_add(SIGTERM, on_signal, &s);
   gst_element_set_state(s.pipeline, GST_STATE_PLAYING);
   g_printerr("pfap-broadcast: sending to 127.0.0.1: audio port %d, data port %d\n", o.audio_port,
-          o.data_port);
+             o.data_port);
   g_main_loop_run(s.loop);
   gst_element_set_state(s.pipeline, GST_STATE_NULL);
   gst_bus_remove_watch(bus);
