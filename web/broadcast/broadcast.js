@@ -29,6 +29,7 @@ export function start({ canvas, audio, status, janusServer }) {
     lipSyncErrorsMs: [], fapStateMatchesSender: false, sender: null, done: 0, streams: 0,
     wholeAfterMs: null,  // stream time from the first packet to a whole FAP state
     malformed: 0,  // JSON messages dropped (PfapReceiver counts the RTP packets it drops)
+    reconnects: 0,  // sessions with Janus lost and watched again
     connected: false, dataOpen: false, matched: false, streamNs: 0, endNs: 0,
     envelope: [], frames: [],
   };
@@ -187,42 +188,53 @@ export function start({ canvas, audio, status, janusServer }) {
     console.warn(status.textContent);
   };
 
+  // Watches the mountpoint; when the session with Janus is lost (Janus restarted), watches it
+  // again a second later, as a new stream: a new audio track, whose timestamps Janus starts
+  // afresh.
   const Janus = window.Janus;
-  Janus.init({
-    debug: false,
-    callback: () => {
-      const janus = new Janus({
-        server: janusServer,
-        error: fail('Janus'),
-        success: () => janus.attach({
-          plugin: 'janus.plugin.streaming',
-          error: fail('streaming plugin'),
-          success: (h) => {
-            handle = h;
-            handle.send({ message: { request: 'watch', id: MOUNTPOINT } });
-          },
-          onmessage: (message, jsep) => {
-            if (message.error) fail('watch')(message.error);
-            if (!jsep) return;
-            handle.createAnswer({
-              jsep,
-              tracks: [{ type: 'data' }],
-              success: (answer) => handle.send({ message: { request: 'start' }, jsep: answer }),
-              error: fail('answer'),
-            });
-          },
-          iceState: (state) => {
-            status.textContent = state;
-            stats.connected = state === 'connected' || state === 'completed';
-          },
-          onremotetrack: onTrack,
-          ondataopen: (label) => {
-            handle.webrtcStuff.dataChannel[label].binaryType = 'arraybuffer';
-            stats.dataOpen = true;
-          },
-          ondata: (data) => onMessage(new Uint8Array(data)),
-        }),
-      });
-    },
-  });
+  const watch = () => {
+    const janus = new Janus({
+      server: janusServer,
+      error: (e) => {
+        fail('Janus')(e);
+        if (handle) {
+          handle = null;
+          audioReceiver = null;
+          stream = null;
+          stats.dataOpen = false;
+          ++stats.reconnects;
+        }
+        setTimeout(watch, 1000);
+      },
+      success: () => janus.attach({
+        plugin: 'janus.plugin.streaming',
+        error: fail('streaming plugin'),
+        success: (h) => {
+          handle = h;
+          handle.send({ message: { request: 'watch', id: MOUNTPOINT } });
+        },
+        onmessage: (message, jsep) => {
+          if (message.error) fail('watch')(message.error);
+          if (!jsep) return;
+          handle.createAnswer({
+            jsep,
+            tracks: [{ type: 'data' }],
+            success: (answer) => handle.send({ message: { request: 'start' }, jsep: answer }),
+            error: fail('answer'),
+          });
+        },
+        iceState: (state) => {
+          status.textContent = state;
+          stats.connected = state === 'connected' || state === 'completed';
+        },
+        onremotetrack: onTrack,
+        ondataopen: (label) => {
+          handle.webrtcStuff.dataChannel[label].binaryType = 'arraybuffer';
+          stats.dataOpen = true;
+        },
+        ondata: (data) => onMessage(new Uint8Array(data)),
+      }),
+    });
+  };
+  Janus.init({ debug: false, callback: watch });
 }

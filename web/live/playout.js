@@ -55,6 +55,7 @@ export class PlayoutClock {
    * unless the browser allows autoplay.
    */
   play(stream) {
+    this.context?.close();  // a page that plays a new track (a new session) plays it alone
     this.context = new AudioContext({ latencyHint: 'interactive', sampleRate: 48000 });
     const source = this.context.createMediaStreamSource(stream);
     source.connect(this.context.destination);

@@ -115,3 +115,23 @@ test('the sender restarts mid-sentence: each viewer takes the new stream and end
     assert.ok(s.matched, which);
   }
 });
+
+test('Janus restarts mid-sentence: each viewer watches again and ends whole with the stream', async () => {
+  const open = () => openViewer(browser, pageServer, janus);
+  const viewers = await Promise.all([open(), open()]);
+  const sender = startSender(TEXT);
+  await new Promise((r) => setTimeout(r, 2000));
+  assert.equal(await stop(janus), 0, janus.log);
+  janus.cleanup();
+  janus = await startJanus();
+  const all = await Promise.all(viewers.map((page) => figures(page)));
+  assert.equal(await exited(sender), 0, sender.log);
+  const sent = JSON.parse(sender.out.trim().split('\n').at(-1));
+  for (const [i, s] of all.entries()) {
+    const which = `page ${i + 1}: ${JSON.stringify(s)}`;
+    assert.equal(s.reconnects, 1, which);
+    assert.equal(s.sender.ssrc, sent.ssrc, which);
+    assert.equal(s.fapStateMatchesSender, true, which);
+    assert.ok(s.matched, which);
+  }
+});
