@@ -48,6 +48,8 @@
 #include <initializer_list>
 #include <memory>
 
+#include "command_line.h"
+
 namespace {
 
 constexpr const char* kLaunch =
@@ -182,21 +184,22 @@ void on_media_configure(GstRTSPMediaFactory*, GstRTSPMedia* media, gpointer file
 }  // namespace
 
 int main(int argc, char** argv) {
-  gst_init(&argc, &argv);
-
-  if (argc == 2 && (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0)) {
-    std::printf(
-        "usage: pfap-rtsp-server FILE.pfap [PORT]   (PORT 0: any free port)\n"
-        "Serves audio and the PFAP stream of FILE.pfap at rtsp://127.0.0.1:PORT/pfap, prints\n"
-        "that URL, and serves until SIGINT or SIGTERM. The pfap plugin must be installed or\n"
-        "in GST_PLUGIN_PATH.\n");
-    return 0;
+  // GOptionContext with GStreamer's option group, as GStreamer's own tools take theirs
+  // (tools/command_line.h): --help, --help-gst, and GStreamer initialized by the parse.
+  const GOptionEntry entries[] = {{}};
+  if (const int status = parse_command_line(
+          &argc, &argv, "FILE.pfap [PORT]",
+          "Serves audio and the PFAP stream of FILE.pfap at rtsp://127.0.0.1:PORT/pfap, prints\n"
+          "that URL, and serves until SIGINT or SIGTERM. PORT 0 or none: any free port. The\n"
+          "pfap plugin must be installed or in GST_PLUGIN_PATH.",
+          entries, gst_init_get_option_group());
+      status != 0) {
+    return status;
   }
   char* end = nullptr;
   const long port = argc == 3 ? std::strtol(argv[2], &end, 10) : 0;
   if (argc < 2 || argc > 3 || (argc == 3 && (*end != '\0' || port < 0 || port > 65535))) {
-    std::fprintf(stderr, "usage: pfap-rtsp-server FILE.pfap [PORT]   (PORT 0: any free port)\n");
-    return 2;
+    return usage_error("wants FILE.pfap and, optionally, a PORT in 0..65535");
   }
   const char* file = argv[1];
   if (!g_file_test(file, G_FILE_TEST_IS_REGULAR)) {

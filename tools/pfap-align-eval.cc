@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "aligner.h"
+#include "command_line.h"
 #include "pfap/phoneme_table.h"
 #include "recognizer.h"
 #include "streaming.h"
@@ -225,10 +226,22 @@ bool recognize_live(const std::vector<int16_t>& samples, unsigned rate,
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 3) {
-    std::fprintf(stderr, "usage: %s DIR NAME...\n", argv[0]);
-    return 2;
+  // It runs no GStreamer, so it takes none of GStreamer's options.
+  const GOptionEntry entries[] = {{}};
+  if (const int status = parse_command_line(
+          &argc, &argv, "DIR NAME...",
+          "Measures the forced alignment (and, where built, the text-free recognition) against\n"
+          "the phoneme times of DIR/NAME.segs for DIR/NAME.wav and DIR/NAME.txt\n"
+          "(tools/align-eval-festival makes DIR and runs this; docs/align.md). The environment:\n"
+          "PFAP_ALIGN_EVAL_VOICE the espeak-ng voice (default en); PFAP_ALIGN_EVAL_LIVE set:\n"
+          "align and recognize live too; PFAP_ALIGN_EVAL_TEXT_ONLY set: no text-free modes;\n"
+          "PFAP_ALIGN_EVAL_WRONG_TEXT=K: each recording with the text K places on;\n"
+          "PFAP_ALIGN_EVAL_VERBOSE set: every phoneme sequence with its starts in ms.",
+          entries, nullptr);
+      status != 0) {
+    return status;
   }
+  if (argc < 3) return usage_error("wants a DIR and at least one NAME");
   const std::string dir = argv[1];
   // PFAP_ALIGN_EVAL_VOICE: the espeak-ng voice to align with (pfapalign's voice property).
   pfap::tts::VoiceSettings voice;

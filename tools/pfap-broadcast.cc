@@ -32,6 +32,7 @@
 #include <string>
 #include <vector>
 
+#include "command_line.h"
 #include "launch_value.h"
 #include "pfap/model.h"
 #include "pfap/payload.h"
@@ -60,58 +61,47 @@ struct Options {
   uint32_t seed = 1;
 };
 
-void usage(FILE* out) {
-  std::fprintf(
-      out,
-      "usage: pfap-broadcast --audio-port=N --data-port=N [--text=TEXT | --source=DESC]\n"
-      "                      [--drop=P] [--seed=S]\n"
-      "Speaks TEXT with pfaptts (or plays DESC, a launch description whose elements named\n"
-      "'audio' and 'pfap' give raw audio and application/x-pfap) in real time and sends it\n"
-      "to Janus's streaming plugin on 127.0.0.1: Opus RTP to port N (--audio-port), each\n"
-      "PFAP RTP packet as one datagram to the data port, with the speech's level and clock\n"
-      "as JSON datagrams. A share P (0 to 1) of the PFAP packets is dropped, seeded by S.\n"
-      "At the end it prints the state as sent (JSON) and exits.\n");
-}
-
-bool parse_options(int argc, char** argv, Options& o) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&](const char* name, std::string& out) {
-      const std::string prefix = std::string("--") + name + "=";
-      if (arg.rfind(prefix, 0) != 0) return false;
-      out = arg.substr(prefix.size());
-      return true;
-    };
-    std::string v;
-    if (arg == "--help") {
-      usage(stdout);
-      std::exit(0);
-    } else if (value("audio-port", v)) {
-      o.audio_port = std::atoi(v.c_str());
-    } else if (value("data-port", v)) {
-      o.data_port = std::atoi(v.c_str());
-    } else if (value("text", v)) {
-      o.text = v;
-    } else if (value("source", v)) {
-      o.source = v;
-    } else if (value("drop", v)) {
-      o.drop = std::atof(v.c_str());
-    } else if (value("seed", v)) {
-      o.seed = static_cast<uint32_t>(std::strtoul(v.c_str(), nullptr, 10));
-    } else {
-      std::fprintf(stderr, "pfap-broadcast: unknown argument %s\n", arg.c_str());
-      return false;
-    }
+// 0 when the arguments are good, else the exit status. GStreamer is initialized by the parse.
+int parse_options(int* argc, char*** argv, Options& o) {
+  gint audio_port = 0, data_port = 0, seed = 1;
+  gdouble drop = 0.0;
+  gchar* text = nullptr;
+  gchar* source = nullptr;
+  const GOptionEntry entries[] = {
+      {"audio-port", 0, 0, G_OPTION_ARG_INT, &audio_port, "Janus's audio port (Opus RTP)", "N"},
+      {"data-port", 0, 0, G_OPTION_ARG_INT, &data_port,
+       "Janus's data port (PFAP RTP packets, and the level, clock and state as JSON)", "N"},
+      {"text", 0, 0, G_OPTION_ARG_STRING, &text, "What pfaptts says (MPEG-4 bookmarks welcome)",
+       "TEXT"},
+      {"source", 0, 0, G_OPTION_ARG_STRING, &source,
+       "A launch description instead, whose elements named 'audio' and 'pfap' give raw audio "
+       "and application/x-pfap",
+       "DESC"},
+      {"drop", 0, 0, G_OPTION_ARG_DOUBLE, &drop, "The share of PFAP packets dropped (0 to 1)", "P"},
+      {"seed", 0, 0, G_OPTION_ARG_INT, &seed, "The seed of the drops (default 1)", "S"},
+      {}};
+  const int status = parse_command_line(
+      argc, argv, "",
+      "Speaks TEXT with pfaptts (or plays DESC) in real time and sends it to Janus's streaming\n"
+      "plugin on 127.0.0.1: Opus RTP to the audio port, each PFAP RTP packet as one datagram\n"
+      "to the data port, with the speech's level and clock as JSON datagrams. At the end it\n"
+      "prints the state as sent (JSON) and exits.",
+      entries, gst_init_get_option_group());
+  if (text != nullptr) o.text = text;
+  if (source != nullptr) o.source = source;
+  g_free(text);
+  g_free(source);
+  if (status != 0) return status;
+  if (*argc != 1) return usage_error("takes no operand: %s", (*argv)[1]);
+  if (audio_port <= 0 || audio_port > 65535 || data_port <= 0 || data_port > 65535) {
+    return usage_error("--audio-port and --data-port are needed (1 to 65535)");
   }
-  if (o.audio_port <= 0 || o.audio_port > 65535 || o.data_port <= 0 || o.data_port > 65535) {
-    std::fprintf(stderr, "pfap-broadcast: --audio-port and --data-port are needed (1 to 65535)\n");
-    return false;
-  }
-  if (!(o.drop >= 0.0 && o.drop <= 1.0)) {
-    std::fprintf(stderr, "pfap-broadcast: --drop must be from 0 to 1\n");
-    return false;
-  }
-  return true;
+  if (!(drop >= 0.0 && drop <= 1.0)) return usage_error("--drop wants 0 to 1: %g", drop);
+  o.audio_port = audio_port;
+  o.data_port = data_port;
+  o.drop = drop;
+  o.seed = static_cast<uint32_t>(seed);
+  return 0;
 }
 
 struct Sender {
@@ -351,12 +341,8 @@ gboolean on_signal(gpointer data) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  gst_init(&argc, &argv);
   Options o;
-  if (!parse_options(argc, argv, o)) {
-    usage(stderr);
-    return 2;
-  }
+  if (const int status = parse_options(&argc, &argv, o); status != 0) return status;
   Sender s;
   s.drop = o.drop;
   s.rng.seed(o.seed);

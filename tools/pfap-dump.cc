@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "command_line.h"
 #include "pfap/bookmark.h"
 #include "pfap/payload.h"
 
@@ -75,23 +76,19 @@ void print(const pfap::Packet& packet) {
 
 }  // namespace
 
-void usage(std::FILE* out) {
-  std::fprintf(out,
-               "usage: pfap-dump FILE|-\n"
-               "Decodes PFAP payloads, one per line in hex ('#' starts a comment), from FILE or\n"
-               "standard input, and prints every descriptor. Exit status: 0 when every payload\n"
-               "decoded, 1 when some did not, 2 on a usage or input error.\n");
-}
-
 int main(int argc, char** argv) {
-  if (argc == 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
-    usage(stdout);
-    return 0;
+  // No options of its own; it runs no GStreamer, so it takes none of GStreamer's.
+  const GOptionEntry entries[] = {{}};
+  if (const int status = parse_command_line(
+          &argc, &argv, "FILE|-",
+          "Decodes PFAP payloads, one per line in hex ('#' starts a comment), from FILE or\n"
+          "standard input (-), and prints every descriptor. Exit status: 0 when every payload\n"
+          "decoded, 1 when some did not, 2 on a usage or input error.",
+          entries, nullptr);
+      status != 0) {
+    return status;
   }
-  if (argc != 2) {
-    usage(stderr);
-    return 2;
-  }
+  if (argc != 2) return usage_error("wants one FILE, or - for standard input");
   const std::string path = argv[1];
   std::ifstream file;
   if (path != "-") {

@@ -44,6 +44,8 @@
 #include <initializer_list>
 #include <string>
 
+#include "command_line.h"
+
 namespace {
 
 constexpr const char* kRtpCaps =
@@ -74,54 +76,29 @@ struct Loopback {
   std::string failure;
 };
 
-void usage(FILE* to) {
-  std::fprintf(to,
-               "usage: pfap-loopback [--mtu=BYTES] [--timeout=SECONDS] FILE.pfap\n"
-               "Sends FILE through pfapparse ! rtppfappay ! udpsink to 127.0.0.1 and prints\n"
-               "what udpsrc ! rtpjitterbuffer ! rtppfapdepay ! pfaptextenc receives.\n");
-}
-
-bool parse_uint(const char* text, guint& out) {
-  char* end = nullptr;
-  const unsigned long value = std::strtoul(text, &end, 10);
-  if (end == text || *end != '\0' || value > G_MAXUINT) return false;
-  out = static_cast<guint>(value);
-  return true;
-}
-
-// 0 when the arguments are good, -1 after --help, 2 on a usage error.
-int parse_options(int argc, char** argv, Options& options) {
-  for (int i = 1; i < argc; ++i) {
-    const char* arg = argv[i];
-    if (std::strcmp(arg, "--help") == 0 || std::strcmp(arg, "-h") == 0) {
-      usage(stdout);
-      return -1;
-    }
-    if (std::strncmp(arg, "--mtu=", 6) == 0) {
-      if (!parse_uint(arg + 6, options.mtu) || options.mtu < 28) {
-        std::fprintf(stderr, "pfap-loopback: bad --mtu: %s\n", arg + 6);
-        return 2;
-      }
-    } else if (std::strncmp(arg, "--timeout=", 10) == 0) {
-      if (!parse_uint(arg + 10, options.timeout_s) || options.timeout_s == 0) {
-        std::fprintf(stderr, "pfap-loopback: bad --timeout: %s\n", arg + 10);
-        return 2;
-      }
-    } else if (arg[0] == '-' && arg[1] != '\0') {
-      std::fprintf(stderr, "pfap-loopback: unknown option %s\n", arg);
-      usage(stderr);
-      return 2;
-    } else if (options.file == nullptr) {
-      options.file = arg;
-    } else {
-      usage(stderr);
-      return 2;
-    }
+// 0 when the arguments are good, else the exit status. GStreamer is initialized by the parse.
+int parse_options(int* argc, char*** argv, Options& options) {
+  gint mtu = -1, timeout_s = static_cast<gint>(options.timeout_s);  // -1: not given
+  const GOptionEntry entries[] = {
+      {"mtu", 0, 0, G_OPTION_ARG_INT, &mtu, "The payloader's MTU (28 or more; default its own)",
+       "BYTES"},
+      {"timeout", 0, 0, G_OPTION_ARG_INT, &timeout_s,
+       "Give up when nothing has moved for this long (default 10)", "SECONDS"},
+      {}};
+  if (const int status = parse_command_line(
+          argc, argv, "FILE.pfap",
+          "Sends FILE through pfapparse ! rtppfappay ! udpsink to 127.0.0.1 and prints\n"
+          "what udpsrc ! rtpjitterbuffer ! rtppfapdepay ! pfaptextenc receives.",
+          entries, gst_init_get_option_group());
+      status != 0) {
+    return status;
   }
-  if (options.file == nullptr) {
-    usage(stderr);
-    return 2;
-  }
+  if (mtu != -1 && mtu < 28) return usage_error("--mtu wants 28 bytes or more: %d", mtu);
+  if (timeout_s <= 0) return usage_error("--timeout wants 1 second or more: %d", timeout_s);
+  if (*argc != 2) return usage_error("wants one FILE.pfap");
+  if (mtu != -1) options.mtu = static_cast<guint>(mtu);
+  options.timeout_s = static_cast<guint>(timeout_s);
+  options.file = (*argv)[1];
   return 0;
 }
 
@@ -274,12 +251,8 @@ std::string depay_summary(GstElement* receiver) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  gst_init(&argc, &argv);
-
   Options options;
-  if (const int status = parse_options(argc, argv, options); status != 0) {
-    return status < 0 ? 0 : status;
-  }
+  if (const int status = parse_options(&argc, &argv, options); status != 0) return status;
   for (const char* name : {"pfapparse", "rtppfappay", "rtppfapdepay", "pfaptextenc"}) {
     GstElementFactory* factory = gst_element_factory_find(name);
     if (factory == nullptr) {

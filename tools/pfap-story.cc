@@ -25,6 +25,7 @@
 #include <cstring>
 #include <string>
 
+#include "command_line.h"
 #include "launch_value.h"
 
 namespace {
@@ -59,54 +60,47 @@ struct Story {
   std::string failure;
 };
 
-void usage(FILE* to) {
-  std::fprintf(to,
-               "usage: pfap-story [--text=TEXT] [--out=FILE.webm] [--drop=PROBABILITY]\n"
-               "                  [--size=WIDTHxHEIGHT] [--frames=DIR]\n"
-               "Speaks TEXT with pfaptts, sends audio and PFAP over loopback RTP losing PFAP\n"
-               "packets with PROBABILITY (default 0.1), and renders what arrives with pfapface\n"
-               "into FILE.webm (default story.webm), beside the audio. --frames also writes\n"
-               "each frame as DIR/NNNN.png.\n");
-}
-
-// 0 when the arguments are good, -1 after --help, 2 on a usage error.
-int parse_options(int argc, char** argv, Options& options) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&](const char* name) -> const char* {
-      const size_t n = std::strlen(name);
-      return arg.compare(0, n, name) == 0 ? argv[i] + n : nullptr;
-    };
-    if (arg == "--help" || arg == "-h") {
-      usage(stdout);
-      return -1;
-    }
-    if (const char* v = value("--text=")) {
-      options.text = v;
-    } else if (const char* v = value("--out=")) {
-      options.out = v;
-    } else if (const char* v = value("--frames=")) {
-      options.frames = v;
-    } else if (const char* v = value("--drop=")) {
-      char* end = nullptr;
-      options.drop = std::strtod(v, &end);
-      if (end == v || *end != '\0' || !(options.drop >= 0 && options.drop < 1)) {
-        std::fprintf(stderr, "pfap-story: --drop wants a probability in [0, 1): %s\n", v);
-        return 2;
-      }
-    } else if (const char* v = value("--size=")) {
-      if (std::sscanf(v, "%ux%u", &options.width, &options.height) != 2 || options.width < 16 ||
-          options.height < 16) {
-        std::fprintf(stderr, "pfap-story: --size wants WIDTHxHEIGHT: %s\n", v);
-        return 2;
-      }
-    } else {
-      std::fprintf(stderr, "pfap-story: unknown argument %s\n", argv[i]);
-      usage(stderr);
-      return 2;
+// 0 when the arguments are good, else the exit status. GStreamer is initialized by the parse.
+int parse_options(int* argc, char*** argv, Options& options) {
+  gchar *text = nullptr, *out = nullptr, *frames = nullptr, *size = nullptr;
+  gdouble drop = options.drop;
+  const GOptionEntry entries[] = {
+      {"text", 0, 0, G_OPTION_ARG_STRING, &text, "The text to speak", "TEXT"},
+      {"out", 0, 0, G_OPTION_ARG_FILENAME, &out, "The video to write (default story.webm)",
+       "FILE.webm"},
+      {"drop", 0, 0, G_OPTION_ARG_DOUBLE, &drop,
+       "The share of PFAP packets lost, in [0, 1) (default 0.1)", "PROBABILITY"},
+      {"size", 0, 0, G_OPTION_ARG_STRING, &size, "The video's size (default 320x240)",
+       "WIDTHxHEIGHT"},
+      {"frames", 0, 0, G_OPTION_ARG_FILENAME, &frames, "Also write each frame as DIR/NNNN.png",
+       "DIR"},
+      {}};
+  int status = parse_command_line(
+      argc, argv, "",
+      "Speaks TEXT with pfaptts, sends audio and PFAP over loopback RTP losing PFAP\n"
+      "packets with PROBABILITY, and renders what arrives with pfapface into FILE.webm,\n"
+      "beside the audio.",
+      entries, gst_init_get_option_group());
+  if (status == 0) {
+    if (text != nullptr) options.text = text;
+    if (out != nullptr) options.out = out;
+    if (frames != nullptr) options.frames = frames;
+    options.drop = drop;
+    if (!(drop >= 0 && drop < 1)) {
+      status = usage_error("--drop wants a probability in [0, 1): %g", drop);
+    } else if (size != nullptr &&
+               (std::sscanf(size, "%ux%u", &options.width, &options.height) != 2 ||
+                options.width < 16 || options.height < 16)) {
+      status = usage_error("--size wants WIDTHxHEIGHT, each 16 or more: %s", size);
+    } else if (*argc > 1) {
+      status = usage_error("takes no operands: %s", (*argv)[1]);
     }
   }
-  return 0;
+  g_free(text);
+  g_free(out);
+  g_free(frames);
+  g_free(size);
+  return status;
 }
 
 std::string sender_description(const Options& o) {
@@ -300,11 +294,8 @@ GstElement* parse(const std::string& description, const char* what) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  gst_init(&argc, &argv);
   Options options;
-  if (const int status = parse_options(argc, argv, options); status != 0) {
-    return status < 0 ? 0 : status;
-  }
+  if (const int status = parse_options(&argc, &argv, options); status != 0) return status;
 
   Story story;
   story.sender = parse(sender_description(options), "sender");

@@ -14,6 +14,12 @@
 // WebSocket also carries the SDP offer and answer, ICE candidates, the texts to say and, at
 // the end of each, the sender's FAP state and counts (the page compares them with its own),
 // and the speech's level, which the page finds in the audio it plays to know what it hears.
+//
+// What a page sends is checked against its schema before anything acts on it
+// (pfap-web-signal.h); a WebSocket is accepted only from the server's own origin and those
+// allowed; sessions are capped by the file descriptors they take, and one that does not connect
+// in time is closed (docs/security.md, "pfap-web"). A STUN server beside the HTTP one gives
+// the page its own address when the browser hides it (pfap-web-stun.h, docs/web.md).
 #include <glib-unix.h>
 #include <gst/app/gstappsink.h>
 #include <gst/gst.h>
@@ -24,6 +30,7 @@
 #include <gst/webrtc/webrtc.h>
 #include <json-glib/json-glib.h>
 #include <libsoup/soup.h>
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <cmath>
@@ -39,10 +46,14 @@
 #include <string>
 #include <vector>
 
+#include "command_line.h"
 #include "launch_value.h"
+#include "pfap-web-signal.h"
+#include "pfap-web-stun.h"
 #include "pfap/model.h"
 #include "pfap/payload.h"
 #include "pfap/recovery.h"
+#include "ratelimit.h"
 #include "speech_level.h"
 
 namespace {
@@ -59,6 +70,12 @@ constexpr GstClockTime kSpeakLead = 300 * GST_MSECOND;
 // PFAP packets go this far ahead of their time: the page holds their events until the audio
 // reaches them, and what comes late is drawn late.
 constexpr GstClockTimeDiff kPfapLead = 400 * GST_MSECOND;
+// The file descriptors one session takes at most (measured, docs/security.md: 16 waiting for
+// the answer, up to 24.1 connected and speaking), and those kept for the server itself (its
+// listening sockets, the page's HTTP connections, GLib's and GStreamer's own) when the
+// session cap is derived from the limit.
+constexpr int kFdsPerSession = 25;
+constexpr int kReservedFds = 64;
 
 struct Options {
   int port = 8080;
@@ -66,24 +83,18 @@ struct Options {
   double drop = 0.0;
   uint32_t seed = 1;
   std::string web_dir;
+  int max_sessions = 0;  // 0: as many as the file descriptor limit allows
+  double connect_timeout_s = 30.0;
+  std::vector<std::string> allowed_origins;  // besides the server's own
 };
 
-void usage(FILE* out) {
-  std::fprintf(out,
-               "usage: pfap-web [--port=N] [--text=TEXT] [--drop=P] [--seed=S] [--web-dir=DIR]\n"
-               "Serves the talking head on http://127.0.0.1:N/ (default 8080; 0 picks a free\n"
-               "port) and prints the URL. Each browser that opens it gets its own WebRTC\n"
-               "session: TEXT (or what the page asks for) spoken by pfaptts, the speech as\n"
-               "Opus audio, the PFAP stream as RTP packets on an unordered, unreliable data\n"
-               "channel, of which a share P (0 to 1) is dropped, seeded by S (each session\n"
-               "adds its number). DIR holds the page (live/) and pfap.js (src/): by default\n"
-               "$PFAP_WEB_DIR, else the installed one.\n");
-}
+struct Server;
 
 // A WebRTC session with one browser. Lives on the main thread; GStreamer's threads post
 // what they have to say there (post()).
 struct Session : std::enable_shared_from_this<Session> {
   int id = 0;
+  Server* server = nullptr;
   SoupWebsocketConnection* ws = nullptr;
   GstElement* pipeline = nullptr;
   GstElement* webrtc = nullptr;
@@ -96,6 +107,8 @@ struct Session : std::enable_shared_from_this<Session> {
   bool playing = false;  // the page says it plays the audio track
   bool audio_flowing = false;
   bool closed = false;
+  bool answered = false;
+  guint connect_timer = 0;   // until the data channel opens
   std::string pending_text;  // said when the audio starts or the current text ends
   uint32_t audio_ts_offset = 0;
   uint32_t pfap_ts_offset = 0;
@@ -121,12 +134,21 @@ std::string text_of(JsonNode* node) {
   return out;
 }
 
-void send_json(Session& s, JsonBuilder* b) {
+// Sends the message `b` holds, if `ws` is open, and frees `b`.
+void send_message(SoupWebsocketConnection* ws, JsonBuilder* b) {
   JsonNode* node = json_builder_get_root(b);
   g_object_unref(b);
   const std::string text = text_of(node);
-  if (s.closed || soup_websocket_connection_get_state(s.ws) != SOUP_WEBSOCKET_STATE_OPEN) return;
-  soup_websocket_connection_send_text(s.ws, text.c_str());
+  if (soup_websocket_connection_get_state(ws) != SOUP_WEBSOCKET_STATE_OPEN) return;
+  soup_websocket_connection_send_text(ws, text.c_str());
+}
+
+void send_json(Session& s, JsonBuilder* b) {
+  if (s.closed) {
+    g_object_unref(b);
+    return;
+  }
+  send_message(s.ws, b);
 }
 
 JsonBuilder* message(const char* type) {
@@ -174,7 +196,9 @@ std::shared_ptr<Session> session_of(gpointer data) {
 
 gpointer weak(const std::shared_ptr<Session>& s) { return new std::weak_ptr<Session>(s); }
 
-void free_weak(gpointer data, GClosure*) { delete static_cast<std::weak_ptr<Session>*>(data); }
+void free_weak_data(gpointer data) { delete static_cast<std::weak_ptr<Session>*>(data); }
+
+void free_weak(gpointer data, GClosure*) { free_weak_data(data); }
 
 // -- Signalling ---------------------------------------------------------------------------
 
@@ -229,17 +253,20 @@ void on_ice_candidate(GstElement*, guint mline, gchar* candidate, gpointer data)
   });
 }
 
-void set_answer(Session& s, const char* sdp_text) {
+// False when the SDP cannot be read or has no media (GstSDP reads any text, skipping lines it
+// does not know).
+bool set_answer(Session& s, const std::string& sdp_text) {
   GstSDPMessage* sdp = nullptr;
-  if (gst_sdp_message_new_from_text(sdp_text, &sdp) != GST_SDP_OK) {
-    g_printerr("pfap-web: session %d: unreadable SDP answer\n", s.id);
+  if (gst_sdp_message_new_from_text(sdp_text.c_str(), &sdp) != GST_SDP_OK ||
+      gst_sdp_message_medias_len(sdp) == 0) {
     if (sdp != nullptr) gst_sdp_message_free(sdp);
-    return;
+    return false;
   }
   GstWebRTCSessionDescription* answer =
       gst_webrtc_session_description_new(GST_WEBRTC_SDP_TYPE_ANSWER, sdp);
   set_description(s.webrtc, "set-remote-description", answer);
   gst_webrtc_session_description_free(answer);
+  return true;
 }
 
 // -- The PFAP stream ----------------------------------------------------------------------
@@ -497,6 +524,8 @@ void on_channel_open(GstWebRTCDataChannel*, gpointer data) {
   if (std::shared_ptr<Session> session = session_of(data)) {
     post(session, [](Session& s) {
       s.channel_open = true;
+      if (s.connect_timer != 0) g_source_remove(s.connect_timer);
+      s.connect_timer = 0;
       start_when_ready(s);
     });
   }
@@ -506,7 +535,8 @@ void on_channel_open(GstWebRTCDataChannel*, gpointer data) {
 // rtppfappay answers an upstream GstForceKeyUnit at once when idle.
 void request_complete(Session& s) {
   GstPad* src = gst_element_get_static_pad(s.pay, "src");
-  gst_pad_send_event(src, gst_video_event_new_upstream_force_key_unit(GST_CLOCK_TIME_NONE, TRUE, 0));
+  gst_pad_send_event(src,
+                     gst_video_event_new_upstream_force_key_unit(GST_CLOCK_TIME_NONE, TRUE, 0));
   gst_object_unref(src);
   send_state(s, "state");
 }
@@ -517,7 +547,38 @@ struct Server {
   Options options;
   int sessions = 0;
   std::vector<std::weak_ptr<Session>> open;  // stopped when the server stops
+  int max_sessions = 0;
+  std::vector<std::string> origins;  // accepted Origin headers: its own and those allowed
+  // What was refused, each logged at its 1st, 2nd, 4th, ... (pfap_warn_at).
+  uint64_t bad_messages = 0;
+  uint64_t foreign_origins = 0;
+  uint64_t full = 0;
+  uint64_t not_connected = 0;
+  // The STUN server the page is given (pfap-web-stun.h).
+  GSocket* stun = nullptr;
+  GSource* stun_source = nullptr;
+  guint16 stun_port = 0;
 };
+
+// Logs a refusal of a kind that a client can repeat at will, rate-limited: `count` counts
+// that kind.
+void warn_refused(uint64_t& count, const std::string& what) {
+  if (pfap_warn_at(++count)) {
+    g_printerr("pfap-web: %s (%" G_GUINT64_FORMAT " of this kind so far)\n", what.c_str(), count);
+  }
+}
+
+// Tells the page why, then closes its WebSocket with `code` (1008, policy violation, for every
+// refusal but a binary message's 1003: libsoup 3.2 sends 1002 for the registry's later codes,
+// such as 1013 "try again later").
+void send_error_and_close(SoupWebsocketConnection* ws, const std::string& why, gushort code) {
+  if (soup_websocket_connection_get_state(ws) != SOUP_WEBSOCKET_STATE_OPEN) return;
+  JsonBuilder* b = message("error");
+  member(b, "message", why.c_str());
+  json_builder_end_object(b);
+  send_message(ws, b);
+  soup_websocket_connection_close(ws, code, nullptr);
+}
 
 gboolean on_bus(GstBus*, GstMessage* m, gpointer data) {
   std::shared_ptr<Session> session = session_of(data);
@@ -541,6 +602,8 @@ gboolean on_bus(GstBus*, GstMessage* m, gpointer data) {
 void close_session(const std::shared_ptr<Session>& s) {
   if (s->closed) return;
   s->closed = true;
+  if (s->connect_timer != 0) g_source_remove(s->connect_timer);
+  s->connect_timer = 0;
   gst_element_set_state(s->pipeline, GST_STATE_NULL);
   gst_bus_remove_watch(GST_ELEMENT_BUS(s->pipeline));
   if (s->speaker_mixer_pad != nullptr) gst_object_unref(s->speaker_mixer_pad);
@@ -550,9 +613,33 @@ void close_session(const std::shared_ptr<Session>& s) {
   g_print("pfap-web: session %d closed\n", s->id);
 }
 
+// Ends a session the server will not go on with: the page is told why, the WebSocket closes
+// with `code`, the pipeline stops; the server and the other sessions go on.
+void refuse_session(const std::shared_ptr<Session>& s, uint64_t& count, const std::string& why,
+                    gushort code) {
+  warn_refused(count, "session " + std::to_string(s->id) + " closed: " + why);
+  send_error_and_close(s->ws, why, code);
+  close_session(s);
+}
+
+gboolean on_connect_timeout(gpointer data) {
+  std::shared_ptr<Session> s = session_of(data);
+  if (s == nullptr || s->closed) return G_SOURCE_REMOVE;
+  s->connect_timer = 0;
+  char seconds[G_ASCII_DTOSTR_BUF_SIZE];
+  g_ascii_dtostr(seconds, sizeof seconds, s->server->options.connect_timeout_s);
+  refuse_session(
+      s, s->server->not_connected,
+      std::string(s->answered ? "no data channel opened in " : "no answer to the offer in ") +
+          seconds + " s",
+      SOUP_WEBSOCKET_CLOSE_POLICY_VIOLATION);
+  return G_SOURCE_REMOVE;
+}
+
 std::shared_ptr<Session> open_session(Server& server, SoupWebsocketConnection* ws) {
   auto s = std::make_shared<Session>();
   s->id = ++server.sessions;
+  s->server = &server;
   s->ws = SOUP_WEBSOCKET_CONNECTION(g_object_ref(ws));
   s->drop = server.options.drop;
   s->rng.seed(server.options.seed + static_cast<uint32_t>(s->id));
@@ -590,11 +677,10 @@ std::shared_ptr<Session> open_session(Server& server, SoupWebsocketConnection* w
   g_object_set(sink, "ts-offset", -kPfapLead, nullptr);
   GstAppSinkCallbacks callbacks{};
   callbacks.new_sample = on_pfap_packet;
-  gst_app_sink_set_callbacks(GST_APP_SINK(sink), &callbacks, weak(s),
-                             [](gpointer data) { delete static_cast<std::weak_ptr<Session>*>(data); });
+  gst_app_sink_set_callbacks(GST_APP_SINK(sink), &callbacks, weak(s), free_weak_data);
   GstPad* sink_pad = gst_element_get_static_pad(sink, "sink");
   gst_pad_add_probe(sink_pad, GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM, on_sink_gap, weak(s),
-                    [](gpointer data) { delete static_cast<std::weak_ptr<Session>*>(data); });
+                    free_weak_data);
   gst_object_unref(sink_pad);
 
   // ICE on 127.0.0.1 only, as the HTTP server: the page is on this machine (a browser offers
@@ -621,7 +707,7 @@ std::shared_ptr<Session> open_session(Server& server, SoupWebsocketConnection* w
   g_signal_connect_data(s->webrtc, "on-ice-candidate", G_CALLBACK(on_ice_candidate), weak(s),
                         free_weak, GConnectFlags(0));
   gst_bus_add_watch_full(GST_ELEMENT_BUS(s->pipeline), G_PRIORITY_DEFAULT, on_bus, weak(s),
-                         [](gpointer data) { delete static_cast<std::weak_ptr<Session>*>(data); });
+                         free_weak_data);
 
   gst_element_set_state(s->pipeline, GST_STATE_READY);
   GstStructure* options = gst_structure_new("options", "ordered", G_TYPE_BOOLEAN, FALSE,
@@ -635,6 +721,9 @@ std::shared_ptr<Session> open_session(Server& server, SoupWebsocketConnection* w
                           GConnectFlags(0));
   }
   s->pending_text = server.options.text;
+  s->connect_timer = g_timeout_add_full(
+      G_PRIORITY_DEFAULT, static_cast<guint>(std::lround(server.options.connect_timeout_s * 1000)),
+      on_connect_timeout, weak(s), free_weak_data);
 
   JsonBuilder* b = message("timing");
   member(b, "audioClockRate", kAudioClockRate);
@@ -642,6 +731,7 @@ std::shared_ptr<Session> open_session(Server& server, SoupWebsocketConnection* w
   member(b, "pfapClockRate", kPfapClockRate);
   member(b, "pfapTimestampOffset", s->pfap_ts_offset);
   member(b, "drop", static_cast<int64_t>(server.options.drop * 1000));
+  member(b, "stunPort", server.stun_port);
   finish(*s, b);
 
   gst_element_set_state(s->pipeline, GST_STATE_PLAYING);
@@ -650,40 +740,49 @@ std::shared_ptr<Session> open_session(Server& server, SoupWebsocketConnection* w
 }
 
 void on_ws_message(SoupWebsocketConnection*, gint type, GBytes* bytes, gpointer data) {
-  std::shared_ptr<Session> session = *static_cast<std::shared_ptr<Session>*>(data);
-  if (session->closed || type != SOUP_WEBSOCKET_DATA_TEXT) return;
+  const std::shared_ptr<Session>& session = *static_cast<std::shared_ptr<Session>*>(data);
+  if (session->closed) return;
   Session& s = *session;
-  gsize size = 0;
-  const char* text = static_cast<const char*>(g_bytes_get_data(bytes, &size));
-  JsonParser* parser = json_parser_new();
-  if (!json_parser_load_from_data(parser, text, static_cast<gssize>(size), nullptr) ||
-      !JSON_NODE_HOLDS_OBJECT(json_parser_get_root(parser))) {
-    g_printerr("pfap-web: session %d: a message that is not a JSON object\n", s.id);
-    g_object_unref(parser);
+  Server& server = *s.server;
+  if (type != SOUP_WEBSOCKET_DATA_TEXT) {
+    refuse_session(session, server.bad_messages, "a binary message",
+                   SOUP_WEBSOCKET_CLOSE_UNSUPPORTED_DATA);
     return;
   }
-  JsonObject* m = json_node_get_object(json_parser_get_root(parser));
-  const char* kind = json_object_get_string_member_with_default(m, "type", "");
-  if (std::strcmp(kind, "answer") == 0) {
-    set_answer(s, json_object_get_string_member_with_default(m, "sdp", ""));
-  } else if (std::strcmp(kind, "ice") == 0) {
-    const char* candidate = json_object_get_string_member_with_default(m, "candidate", "");
-    const gint64 mline = json_object_get_int_member_with_default(m, "sdpMLineIndex", 0);
-    if (*candidate != '\0') {
-      g_signal_emit_by_name(s.webrtc, "add-ice-candidate", static_cast<guint>(mline), candidate);
-    }
-  } else if (std::strcmp(kind, "say") == 0) {
-    const char* said = json_object_get_string_member_with_default(m, "text", "");
-    if (*said != '\0') say(s, said);
-  } else if (std::strcmp(kind, "playing") == 0) {
-    s.playing = true;
-    start_when_ready(s);
-  } else if (std::strcmp(kind, "complete") == 0) {
-    request_complete(s);
-  } else {
-    g_printerr("pfap-web: session %d: unknown message type \"%s\"\n", s.id, kind);
+  gsize size = 0;
+  const char* text = static_cast<const char*>(g_bytes_get_data(bytes, &size));
+  pfap_web::Signal m;
+  std::string error;
+  if (!pfap_web::parse_signal(std::string_view(text, size), m, error)) {
+    refuse_session(session, server.bad_messages, "a bad message: " + error,
+                   SOUP_WEBSOCKET_CLOSE_POLICY_VIOLATION);
+    return;
   }
-  g_object_unref(parser);
+  switch (m.kind) {
+    case pfap_web::SignalKind::kAnswer:
+      if (!set_answer(s, m.sdp)) {
+        refuse_session(session, server.bad_messages, "a bad message: an unreadable SDP answer",
+                       SOUP_WEBSOCKET_CLOSE_POLICY_VIOLATION);
+        return;
+      }
+      s.answered = true;
+      break;
+    case pfap_web::SignalKind::kIce:
+      if (!m.candidate.empty()) {
+        g_signal_emit_by_name(s.webrtc, "add-ice-candidate", m.mline, m.candidate.c_str());
+      }
+      break;
+    case pfap_web::SignalKind::kSay:
+      if (!m.text.empty()) say(s, m.text);
+      break;
+    case pfap_web::SignalKind::kPlaying:
+      s.playing = true;
+      start_when_ready(s);
+      break;
+    case pfap_web::SignalKind::kComplete:
+      request_complete(s);
+      break;
+  }
 }
 
 void on_ws_closed(SoupWebsocketConnection*, gpointer data) {
@@ -693,9 +792,19 @@ void on_ws_closed(SoupWebsocketConnection*, gpointer data) {
 void on_websocket(SoupServer*, SoupServerMessage*, const char*, SoupWebsocketConnection* ws,
                   gpointer data) {
   Server& server = *static_cast<Server*>(data);
+  std::erase_if(server.open, [](const std::weak_ptr<Session>& w) {
+    const std::shared_ptr<Session> s = w.lock();
+    return s == nullptr || s->closed;
+  });
+  if (static_cast<int>(server.open.size()) >= server.max_sessions) {
+    const std::string why = "the server is full: " + std::to_string(server.max_sessions) +
+                            " sessions at once (try again later)";
+    warn_refused(server.full, "a connection refused: " + why);
+    send_error_and_close(ws, why, SOUP_WEBSOCKET_CLOSE_POLICY_VIOLATION);
+    return;
+  }
   std::shared_ptr<Session> session = open_session(server, ws);
   if (session == nullptr) return;
-  std::erase_if(server.open, [](const std::weak_ptr<Session>& s) { return s.expired(); });
   server.open.push_back(session);
   // The connection's handlers own the session (released when they are disconnected).
   auto* holder = new std::shared_ptr<Session>(session);
@@ -707,7 +816,85 @@ void on_websocket(SoupServer*, SoupServerMessage*, const char*, SoupWebsocketCon
       GConnectFlags(0));
 }
 
+// -- STUN ---------------------------------------------------------------------------------
+
+// A datagram on the STUN socket: a binding request is answered, anything else dropped.
+gboolean on_stun(GSocket* socket, GIOCondition, gpointer) {
+  uint8_t buffer[548];  // RFC 8489's smallest MTU's worth; a longer request is cut, dropped
+  GSocketAddress* from = nullptr;
+  const gssize n = g_socket_receive_from(socket, &from, reinterpret_cast<gchar*>(buffer),
+                                         sizeof buffer, nullptr, nullptr);
+  if (n >= 0 && from != nullptr && G_IS_INET_SOCKET_ADDRESS(from)) {
+    auto* inet = G_INET_SOCKET_ADDRESS(from);
+    GInetAddress* address = g_inet_socket_address_get_address(inet);
+    if (g_inet_address_get_family(address) == G_SOCKET_FAMILY_IPV4) {
+      const guint8* a = g_inet_address_to_bytes(address);
+      const uint32_t ipv4 = static_cast<uint32_t>(a[0]) << 24 | static_cast<uint32_t>(a[1]) << 16 |
+                            static_cast<uint32_t>(a[2]) << 8 | a[3];
+      const auto response =
+          pfap_web::stun_binding_response(std::span<const uint8_t>(buffer, static_cast<size_t>(n)),
+                                          ipv4, g_inet_socket_address_get_port(inet));
+      if (response.has_value()) {
+        g_socket_send_to(socket, from, reinterpret_cast<const gchar*>(response->data()),
+                         response->size(), nullptr, nullptr);
+      }
+    }
+  }
+  if (from != nullptr) g_object_unref(from);
+  return G_SOURCE_CONTINUE;
+}
+
+// Listens for STUN on 127.0.0.1, UDP, on the HTTP port's number if it is free, else on any.
+// False when it cannot.
+bool start_stun(Server& server, guint16 http_port) {
+  GSocket* socket =
+      g_socket_new(G_SOCKET_FAMILY_IPV4, G_SOCKET_TYPE_DATAGRAM, G_SOCKET_PROTOCOL_UDP, nullptr);
+  if (socket == nullptr) return false;
+  GInetAddress* loopback = g_inet_address_new_loopback(G_SOCKET_FAMILY_IPV4);
+  bool bound = false;
+  for (const guint16 port : {http_port, guint16{0}}) {
+    GSocketAddress* address = g_inet_socket_address_new(loopback, port);
+    bound = g_socket_bind(socket, address, FALSE, nullptr);
+    g_object_unref(address);
+    if (bound) break;
+  }
+  g_object_unref(loopback);
+  GSocketAddress* local = bound ? g_socket_get_local_address(socket, nullptr) : nullptr;
+  if (local == nullptr) {
+    g_object_unref(socket);
+    return false;
+  }
+  server.stun_port = g_inet_socket_address_get_port(G_INET_SOCKET_ADDRESS(local));
+  g_object_unref(local);
+  g_socket_set_blocking(socket, FALSE);
+  server.stun = socket;
+  server.stun_source = g_socket_create_source(socket, G_IO_IN, nullptr);
+  g_source_set_callback(server.stun_source, G_SOURCE_FUNC(on_stun), nullptr, nullptr);
+  g_source_attach(server.stun_source, nullptr);
+  return true;
+}
+
 // -- HTTP ---------------------------------------------------------------------------------
+
+// The WebSocket's request, before libsoup's handshake: a browser says which page opens it in
+// Origin, and only the server's own page and those allowed may (any page the user visits
+// could open ws://127.0.0.1:8080/ws otherwise). A 403 here stops the handshake. A client that
+// sends no Origin is not a browser, which always sends one: it could send any.
+void on_ws_request(SoupServer*, SoupServerMessage* msg, const char*, GHashTable*, gpointer data) {
+  Server& server = *static_cast<Server*>(data);
+  const char* origin =
+      soup_message_headers_get_one(soup_server_message_get_request_headers(msg), "Origin");
+  if (origin == nullptr ||
+      std::find(server.origins.begin(), server.origins.end(), origin) != server.origins.end()) {
+    return;
+  }
+  warn_refused(server.foreign_origins, "a WebSocket refused: a page of another origin");
+  static constexpr char kForbidden[] =
+      "pfap-web: this origin may not open the WebSocket (pfap-web --allow-origin)\n";
+  soup_server_message_set_status(msg, SOUP_STATUS_FORBIDDEN, nullptr);
+  soup_server_message_set_response(msg, "text/plain; charset=utf-8", SOUP_MEMORY_STATIC, kForbidden,
+                                   sizeof kForbidden - 1);
+}
 
 const char* content_type(const std::string& path) {
   if (g_str_has_suffix(path.c_str(), ".html")) return "text/html; charset=utf-8";
@@ -721,9 +908,9 @@ void on_http(SoupServer*, SoupServerMessage* msg, const char* path, GHashTable*,
   const Server& server = *static_cast<Server*>(data);
   std::string file = path;
   if (file == "/") file = "/live/index.html";
-  const bool allowed = (g_str_has_prefix(file.c_str(), "/live/") ||
-                        g_str_has_prefix(file.c_str(), "/src/")) &&
-                       file.find("..") == std::string::npos;
+  const bool allowed =
+      (g_str_has_prefix(file.c_str(), "/live/") || g_str_has_prefix(file.c_str(), "/src/")) &&
+      file.find("..") == std::string::npos;
   gchar* contents = nullptr;
   gsize length = 0;
   if (!allowed || soup_server_message_get_method(msg) != std::string("GET") ||
@@ -742,49 +929,103 @@ std::string default_web_dir() {
   return dir != nullptr && *dir != '\0' ? dir : PFAP_WEB_INSTALL_DIR;
 }
 
-// 0 when the arguments are good, -1 after --help, 2 on a usage error.
-int parse_options(int argc, char** argv, Options& o) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&](const char* name) -> const char* {
-      const size_t n = std::strlen(name);
-      return arg.compare(0, n, name) == 0 ? argv[i] + n : nullptr;
-    };
-    char* end = nullptr;
-    if (arg == "--help" || arg == "-h") {
-      usage(stdout);
-      return -1;
+// 0 when the arguments are good, else the exit status. GStreamer is initialized by the parse.
+int parse_options(int* argc, char*** argv, Options& o) {
+  gint port = o.port;
+  gint64 seed = o.seed;
+  gdouble drop = o.drop;
+  gint max_sessions = -1;  // not given
+  gdouble connect_timeout_s = o.connect_timeout_s;
+  gchar *text = nullptr, *web_dir = nullptr;
+  gchar** origins = nullptr;
+  const GOptionEntry entries[] = {
+      {"port", 0, 0, G_OPTION_ARG_INT, &port,
+       "The HTTP port on 127.0.0.1, 0..65535 (default 8080; 0 picks a free one)", "N"},
+      {"text", 0, 0, G_OPTION_ARG_STRING, &text, "The text to speak when the page asks for none",
+       "TEXT"},
+      {"drop", 0, 0, G_OPTION_ARG_DOUBLE, &drop,
+       "The share of PFAP packets dropped, in [0, 1) (default 0)", "P"},
+      {"seed", 0, 0, G_OPTION_ARG_INT64, &seed,
+       "The seed of the drops (default 1; each session adds its number)", "S"},
+      {"web-dir", 0, 0, G_OPTION_ARG_FILENAME, &web_dir,
+       "The page (live/) and pfap.js (src/) (default $PFAP_WEB_DIR, else the installed one)",
+       "DIR"},
+      {"max-sessions", 0, 0, G_OPTION_ARG_INT, &max_sessions,
+       "At most N sessions at once, 1..1000000 (default: as many as the open file limit allows)",
+       "N"},
+      {"connect-timeout", 0, 0, G_OPTION_ARG_DOUBLE, &connect_timeout_s,
+       "Close a session whose page has not answered the offer and opened the data channel in S "
+       "seconds, above 0 up to 86400 (default 30)",
+       "S"},
+      {"allow-origin", 0, 0, G_OPTION_ARG_STRING_ARRAY, &origins,
+       "Accept WebSockets from ORIGIN (scheme://host[:port], or null) besides the page's own "
+       "(http://127.0.0.1:N, http://localhost:N) and clients that send none; repeatable",
+       "ORIGIN"},
+      {}};
+  int status = parse_command_line(
+      argc, argv, "",
+      "Serves the talking head on http://127.0.0.1:N/ and prints the URL. Each browser\n"
+      "that opens it gets its own WebRTC session: TEXT (or what the page asks for)\n"
+      "spoken by pfaptts, the speech as Opus audio, the PFAP stream as RTP packets on an\n"
+      "unordered, unreliable data channel, of which a share P is dropped.",
+      entries, gst_init_get_option_group());
+  if (status == 0) {
+    if (port < 0 || port > 65535) {
+      status = usage_error("--port wants 0..65535: %d", port);
+    } else if (!(drop >= 0.0 && drop < 1.0)) {
+      status = usage_error("--drop wants a probability in [0, 1): %g", drop);
+    } else if (seed < 0 || seed > G_MAXUINT32) {
+      status = usage_error("--seed wants 0..%u: %" G_GINT64_FORMAT, G_MAXUINT32, seed);
+    } else if (max_sessions != -1 && (max_sessions < 1 || max_sessions > 1000000)) {
+      status = usage_error("--max-sessions wants 1..1000000: %d", max_sessions);
+    } else if (!(connect_timeout_s > 0 && connect_timeout_s <= 86400)) {
+      status = usage_error("--connect-timeout wants seconds, above 0 up to 86400: %g",
+                           connect_timeout_s);
+    } else if (*argc > 1) {
+      status = usage_error("takes no operands: %s", (*argv)[1]);
     }
-    if (const char* v = value("--port=")) {
-      o.port = static_cast<int>(std::strtol(v, &end, 10));
-      if (end == v || *end != '\0' || o.port < 0 || o.port > 65535) {
-        std::fprintf(stderr, "pfap-web: --port wants 0..65535: %s\n", v);
-        return 2;
+    for (gchar** v = origins; status == 0 && v != nullptr && *v != nullptr; ++v) {
+      // scheme://host[:port] as browsers send it, or "null" (sandboxed and file: pages).
+      const char* host = std::strstr(*v, "://");
+      if (std::strcmp(*v, "null") != 0 && (host == nullptr || host == *v || host[3] == '\0' ||
+                                           std::strchr(host + 3, '/') != nullptr)) {
+        status = usage_error("--allow-origin wants scheme://host[:port]: %s", *v);
+      } else {
+        o.allowed_origins.emplace_back(*v);
       }
-    } else if (const char* v = value("--drop=")) {
-      o.drop = std::strtod(v, &end);
-      if (end == v || *end != '\0' || !(o.drop >= 0.0 && o.drop < 1.0)) {
-        std::fprintf(stderr, "pfap-web: --drop wants a probability in [0, 1): %s\n", v);
-        return 2;
-      }
-    } else if (const char* v = value("--seed=")) {
-      o.seed = static_cast<uint32_t>(std::strtoul(v, &end, 10));
-      if (end == v || *end != '\0') {
-        std::fprintf(stderr, "pfap-web: --seed wants a number: %s\n", v);
-        return 2;
-      }
-    } else if (const char* v = value("--text=")) {
-      o.text = v;
-    } else if (const char* v = value("--web-dir=")) {
-      o.web_dir = v;
-    } else {
-      std::fprintf(stderr, "pfap-web: unknown argument %s\n", arg.c_str());
-      usage(stderr);
-      return 2;
     }
+    o.port = port;
+    o.max_sessions = max_sessions == -1 ? 0 : max_sessions;
+    o.connect_timeout_s = connect_timeout_s;
+    o.drop = drop;
+    o.seed = static_cast<uint32_t>(seed);
+    if (text != nullptr) o.text = text;
+    o.web_dir = web_dir != nullptr && *web_dir != '\0' ? web_dir : default_web_dir();
   }
-  if (o.web_dir.empty()) o.web_dir = default_web_dir();
-  return 0;
+  g_free(text);
+  g_free(web_dir);
+  g_strfreev(origins);
+  return status;
+}
+
+// The sessions the open file limit leaves room for, kReservedFds kept; `wanted` (if not 0)
+// when it is fewer, since a session past the limit would abort the whole server (GLib cannot
+// make a GWakeup's pipe).
+int session_cap(int wanted) {
+  rlimit limit{};
+  rlim_t fds = 1024;
+  if (getrlimit(RLIMIT_NOFILE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
+    fds = limit.rlim_cur;
+  }
+  const rlim_t room = fds > kReservedFds ? (fds - kReservedFds) / kFdsPerSession : 0;
+  const int allowed = static_cast<int>(std::clamp<rlim_t>(room, 1, 1000000));
+  if (wanted != 0 && wanted > allowed) {
+    g_printerr(
+        "pfap-web: --max-sessions=%d lowered to %d: the open file limit (ulimit -n) is %lu, "
+        "a session takes up to %d\n",
+        wanted, allowed, static_cast<unsigned long>(fds), kFdsPerSession);
+  }
+  return wanted != 0 ? std::min(wanted, allowed) : allowed;
 }
 
 // Ctrl-C or SIGTERM: each session's pipeline stops, its browser is told, and what the
@@ -807,6 +1048,9 @@ void stop(Server& server, SoupServer* soup) {
     g_object_unref(ws);
   }
   server.open.clear();
+  g_source_destroy(server.stun_source);
+  g_source_unref(server.stun_source);
+  g_object_unref(server.stun);
   soup_server_disconnect(soup);
   g_object_unref(soup);
   // What the closing left to do (the close frames, finalizing the connections).
@@ -817,11 +1061,8 @@ void stop(Server& server, SoupServer* soup) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  gst_init(&argc, &argv);
   Server server;
-  if (int status = parse_options(argc, argv, server.options); status != 0) {
-    return status < 0 ? 0 : status;
-  }
+  if (int status = parse_options(&argc, &argv, server.options); status != 0) return status;
   for (const char* element : {"webrtcbin", "pfaptts", "rtppfappay", "opusenc", "rtpopuspay"}) {
     GstElementFactory* factory = gst_element_factory_find(element);
     if (factory == nullptr) {
@@ -831,12 +1072,14 @@ int main(int argc, char** argv) {
     gst_object_unref(factory);
   }
   SoupServer* soup = soup_server_new("server-header", "pfap-web", nullptr);
+  soup_server_add_handler(soup, "/ws", on_ws_request, &server, nullptr);
   soup_server_add_websocket_handler(soup, "/ws", nullptr, nullptr, on_websocket, &server, nullptr);
   soup_server_add_handler(soup, nullptr, on_http, &server, nullptr);
   GError* error = nullptr;
   // Loopback only: the page and its sessions are for this machine.
   GInetAddress* loopback = g_inet_address_new_loopback(G_SOCKET_FAMILY_IPV4);
-  GSocketAddress* address = g_inet_socket_address_new(loopback, static_cast<guint16>(server.options.port));
+  GSocketAddress* address =
+      g_inet_socket_address_new(loopback, static_cast<guint16>(server.options.port));
   g_object_unref(loopback);
   const bool listening = soup_server_listen(soup, address, SoupServerListenOptions(0), &error);
   g_object_unref(address);
@@ -854,6 +1097,18 @@ int main(int argc, char** argv) {
   const guint16 port =
       local != nullptr ? g_inet_socket_address_get_port(G_INET_SOCKET_ADDRESS(local)) : 0;
   if (local != nullptr) g_object_unref(local);
+  if (!start_stun(server, port)) {
+    std::fprintf(stderr, "pfap-web: cannot listen for STUN on 127.0.0.1 (UDP)\n");
+    soup_server_disconnect(soup);
+    g_object_unref(soup);
+    return 1;
+  }
+  server.origins = {"http://127.0.0.1:" + std::to_string(port),
+                    "http://localhost:" + std::to_string(port)};
+  server.origins.insert(server.origins.end(), server.options.allowed_origins.begin(),
+                        server.options.allowed_origins.end());
+  server.max_sessions = session_cap(server.options.max_sessions);
+  g_print("pfap-web: at most %d sessions at once\n", server.max_sessions);
   g_print("pfap-web: open http://127.0.0.1:%u/ in a browser (Ctrl-C stops)\n", port);
   GMainLoop* loop = g_main_loop_new(nullptr, FALSE);
   auto quit = [](gpointer loop) -> gboolean {

@@ -27,14 +27,15 @@
  * spans a frame with changes is split there into pieces of the same symbol, and silence
  * phonemes carry only the frames where no one speaks. Both are timed from their segment's
  * start. The two inputs are kept until both have ended (at most 100000 speech events), then
- * the merged stream goes out; the caps take the speech's alphabet when it has one.
+ * the merged stream goes out, merged a window of at least 4096 file events at a time; the caps
+ * take the speech's alphabet when it has one.
  *
  * A bad file (an unsupported version, a mask without 68 flags, a value past the draft's
  * amplitude range, frame numbers out of order, an absurd frame count or rate, fewer frames
  * than the header says) is an error naming the file, its line, field and FAP: a FAP file's
  * frames depend on the lines before, so there is nothing to skip to. The limits against
  * hostile files are those of pfap/fap_file.h: lines of at most 64 KiB, 360000 frames, 1 to
- * 1000 frames a second.
+ * 1000 frames a second. A UTF-8 byte order mark at the start of the file is skipped.
  *
  * ## Example pipelines
  * |[
@@ -53,6 +54,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstdint>
+#include <iterator>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -103,6 +105,8 @@ struct Merge {
 
 // Far above an hour of speech (about 12 phonemes a second): bounds what the speech pad keeps.
 constexpr size_t kMaxSpeechEvents = 100'000;
+// The file events merged at a time (at least; up to the next place a window can end).
+constexpr size_t kMergeWindowEvents = 4096;
 
 }  // namespace
 
@@ -253,6 +257,75 @@ static GstFlowReturn push_frame(GstFapParse* self, const pfap::FapFrame& frame) 
   return push_events(self, s.events);
 }
 
+// The merge of `file` (consumed) with `speech`, pushed a window at a time so that at most a
+// window's events are held twice (pfap::merge_with_speech holds its inputs' FAPs twice more).
+// A window ends at a frame with changes that no speech phoneme spans: there the whole merge
+// is the windows' merges one after the other, but for two flags that `carry` puts back:
+// merge_with_speech ends the text at each window's last phoneme, and starts a sentence with a
+// silence that opens a window. `carry` is what the whole merge has there: the end of text of
+// the last speech phoneme before the cut, none after a silence, and true before anything.
+static GstFlowReturn push_merged(GstFapParse* self, std::vector<pfap::TextEvent>& file,
+                                 const std::vector<pfap::TextEvent>& speech, uint8_t symbol) {
+  const auto is_phoneme = [](const pfap::TextEvent& e) {
+    return e.event.kind == PFAP_EVENT_PHONEME;
+  };
+  const auto end_of = [](const pfap::TextEvent& e) {
+    return e.time_ms + e.event.phoneme.duration_ms;
+  };
+  size_t f = 0, s = 0;
+  bool carry = true;
+  GstFlowReturn ret = GST_FLOW_OK;
+  while (ret == GST_FLOW_OK && (f < file.size() || s < speech.size())) {
+    size_t f_end = file.size(), s_end = speech.size();
+    int64_t speech_end = 0;  // where the speech phonemes before the candidate cut end
+    size_t scanned = s;
+    for (size_t i = f + kMergeWindowEvents; i < file.size(); ++i) {
+      const pfap::TextEvent& e = file[i];
+      if (e.event.faps.empty() || e.time_ms == file[i - 1].time_ms) continue;  // not a cut
+      for (; scanned < speech.size() && speech[scanned].time_ms < e.time_ms; ++scanned) {
+        if (is_phoneme(speech[scanned])) speech_end = end_of(speech[scanned]);
+      }
+      if (speech_end > e.time_ms) continue;  // a speech phoneme spans it
+      f_end = i;
+      s_end = scanned;
+      break;
+    }
+    GST_DEBUG_OBJECT(self, "merging file events %zu..%zu with speech events %zu..%zu", f, f_end, s,
+                     s_end);
+    const std::vector<pfap::TextEvent> speech_window(speech.begin() + s, speech.begin() + s_end);
+    std::vector<pfap::TextEvent> merged;
+    int64_t last_cut = -1;
+    {
+      const std::vector<pfap::TextEvent> file_window(std::make_move_iterator(file.begin() + f),
+                                                     std::make_move_iterator(file.begin() + f_end));
+      for (const pfap::TextEvent& e : file_window) {
+        if (!e.event.faps.empty()) last_cut = e.time_ms;
+      }
+      merged = pfap::merge_with_speech(speech_window, file_window, symbol);
+    }
+    const auto first_speech = std::find_if(speech_window.begin(), speech_window.end(), is_phoneme);
+    const auto last_speech = std::find_if(speech_window.rbegin(), speech_window.rend(), is_phoneme);
+    const auto first = std::find_if(merged.begin(), merged.end(), is_phoneme);
+    const auto last = std::find_if(merged.rbegin(), merged.rend(), is_phoneme);
+    // A window after the first opens with its cut's silence unless a speech phoneme starts there.
+    if (f > 0 && first != merged.end() &&
+        (first_speech == speech_window.end() || first_speech->time_ms != file[f].time_ms)) {
+      first->event.sentence_start = carry;
+    }
+    if (last_speech != speech_window.rend() && (last_cut < 0 || last_cut < end_of(*last_speech))) {
+      carry = last_speech->event.phoneme.end_of_text;
+    } else if (last_cut >= 0) {
+      carry = false;
+    }
+    const bool final_window = f_end == file.size() && s_end == speech.size();
+    if (!final_window && last != merged.rend()) last->event.phoneme.end_of_text = carry;
+    ret = push_events(self, merged);
+    f = f_end;
+    s = s_end;
+  }
+  return ret;
+}
+
 // At the end of the file or of the speech: once both have ended, the merged events and EOS
 // go downstream. Returns whether this call sent them (else the other input's end will).
 static bool end_of_input(GstFapParse* self, bool file) {
@@ -269,9 +342,7 @@ static bool end_of_input(GstFapParse* self, bool file) {
   GST_OBJECT_LOCK(self);
   const auto symbol = static_cast<uint8_t>(self->silence_symbol);
   GST_OBJECT_UNLOCK(self);
-  GST_DEBUG_OBJECT(self, "merging %zu file events with %zu speech events", file_events.size(),
-                   speech.size());
-  push_events(self, pfap::merge_with_speech(speech, file_events, symbol));
+  push_merged(self, file_events, speech, symbol);
   gst_pad_push_event(gst_pfap_base_parse_srcpad(GST_PFAP_BASE_PARSE(self)), gst_event_new_eos());
   return true;
 }

@@ -23,9 +23,9 @@
  * were dropped or clamped). Every FAP that is ever non-zero is set in every frame's mask, so
  * that readers that hold a FAP the mask leaves out and readers that take it for 0 agree.
  *
- * The header line holds the number of frames, so the file is written in one buffer at EOS;
- * up to #GstPfapFapEnc:max-frames frames are kept (a warning says when later events are not
- * written). A malformed buffer is dropped with a warning and the stream goes on. An event
+ * The header line holds the number of frames, so the file is written at EOS, in buffers of
+ * about 64 KiB; until then up to #GstPfapFapEnc:max-frames frames are kept, 300 bytes each (a
+ * warning says when later events are not written). A malformed buffer is dropped with a warning and the stream goes on. An event
  * without a PTS starts where the previous one ended; one earlier than the one before it is
  * taken at that one's time, with a warning at the 1st, 2nd, 4th, 8th, ... such event. A
  * flush, or going from READY to PAUSED, starts a new file.
@@ -59,6 +59,8 @@ enum { PROP_0, PROP_FRAME_RATE, PROP_NAME, PROP_MAX_FRAMES };
 
 constexpr double kDefaultFrameRate = 25.0;
 constexpr const char* kDefaultName = "gst-pfap";
+// The file's text goes out in buffers of about this size.
+constexpr size_t kPieceBytes = 64 * 1024;
 
 // What the streaming thread keeps between buffers. GObject runs no C++ constructors, so it
 // lives behind a pointer made in init and deleted in finalize.
@@ -149,8 +151,24 @@ static void gst_pfap_fap_enc_finish(GstPfapBaseEnc* enc) {
   GST_OBJECT_LOCK(self);
   const std::string name = self->name != nullptr ? self->name : kDefaultName;
   GST_OBJECT_UNLOCK(self);
+  // The text goes out in pieces as it is written, so that it is never whole in memory: only
+  // the frames' amplitudes are (300 bytes a frame).
+  const pfap::FapRecorder& recorder = *s.recorder;
+  const pfap::FapRecorder::Mask mask = recorder.mask();
   pfap::NotWritten not_written;
-  const std::string text = pfap::write_fap_file(s.recorder->file(name, &not_written));
+  std::string text;
+  pfap::format_fap_header(recorder.header(name), text);
+  size_t bytes = 0;
+  GstFlowReturn ret = GST_FLOW_OK;
+  for (uint32_t k = 0; k < recorder.frames() && ret == GST_FLOW_OK; ++k) {
+    pfap::format_fap_frame(recorder.frame(k, mask, not_written), text);
+    if (text.size() >= kPieceBytes || k + 1 == recorder.frames()) {
+      bytes += text.size();
+      ret = gst_pad_push(srcpad, gst_buffer_new_memdup(text.data(), text.size()));
+      text.clear();
+    }
+  }
+  GST_DEBUG_OBJECT(self, "%u frames, %zu bytes", recorder.frames(), bytes);
   if (not_written.expressions_dropped != 0 || not_written.intensities_clamped != 0) {
     GST_ELEMENT_WARNING(
         self, STREAM, ENCODE,
@@ -159,8 +177,6 @@ static void gst_pfap_fap_enc_finish(GstPfapBaseEnc* enc) {
          not_written.expressions_dropped, not_written.intensities_clamped),
         (nullptr));
   }
-  GST_DEBUG_OBJECT(self, "%u frames, %zu bytes", s.recorder->frames(), text.size());
-  gst_pad_push(srcpad, gst_buffer_new_memdup(text.data(), text.size()));
 }
 
 // The file is bytes from its start; frame 0 is the first segment's start.

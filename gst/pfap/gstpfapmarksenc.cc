@@ -24,7 +24,9 @@
  * the viseme alphabets pfapmarksparse makes); a phoneme with no known viseme is written as a
  * half-open mouth, with a warning. Times are ms from the first event, as pfaptextenc's.
  * Marks come out per utterance (at each end of text), Rhubarb JSON as one document at EOS,
- * blendshape frames as time passes. A malformed buffer is dropped with a warning.
+ * blendshape frames as time passes. Once nothing moves, frames go on for 1 s of rest at most;
+ * the frames after a longer rest keep their times, with a warning (the 1st, 2nd, 4th, ...), so
+ * that a gap costs no more frames. A malformed buffer is dropped with a warning.
  *
  * ## Example pipelines
  * |[
@@ -64,6 +66,7 @@ struct Stream {
   std::optional<int64_t> origin_ns;  // the first event's running time: time 0
   uint64_t unknown_warned = 0;       // unknown phonemes already counted in a warning
   uint64_t unknown_warnings = 0;
+  uint64_t cut_rests = 0;  // the writer's count when last looked at
   GstFlowReturn flow = GST_FLOW_OK;
 };
 
@@ -155,6 +158,16 @@ static GstFlowReturn gst_pfap_marks_enc_handle_event(GstPfapBaseEnc* enc, GstBuf
       return GST_FLOW_ERROR;
     }
     return s.flow;
+  }
+  // The writer cuts at most one rest per event.
+  if (s.writer.cut_rests() != s.cut_rests && pfap_warn_at(s.cut_rests = s.writer.cut_rests())) {
+    GST_ELEMENT_WARNING(self, STREAM, ENCODE,
+                        ("A rest longer than %" G_GINT64_FORMAT " ms: its frames after that are "
+                         "left out, and the next frame's time jumps.",
+                         pfap::MarksWriter::kMaxRestNs / pfap::kNsPerMs),
+                        ("%" G_GUINT64_FORMAT " rests cut so far (warned at the 1st, 2nd, 4th, "
+                         "...); this bounds the frames an event can make",
+                         s.cut_rests));
   }
   const uint64_t unknown = s.writer.unknown_phonemes();
   if (unknown > s.unknown_warned && pfap_warn_at(++s.unknown_warnings)) {

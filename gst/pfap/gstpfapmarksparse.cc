@@ -26,7 +26,9 @@
  * A bad line (not JSON, a missing field, an unknown viseme, time going back, more than 64 KiB)
  * is an error naming its line, its column (bytes, from 1) and what is wrong; with
  * #GstPfapMarksParse:skip-bad-lines it is a warning (rate-limited: the 1st, 2nd, 4th, ...) and
- * reading goes on.
+ * reading goes on. In a Rhubarb JSON document the bad item is a cue: skipped, every other cue
+ * is kept (the time it held is a rest); a document past 16 MiB is one bad item. A UTF-8 byte
+ * order mark at the start of the input is skipped.
  *
  * ## Example pipeline
  * |[
@@ -65,6 +67,7 @@ struct Stream {
   bool skipping = false;  // dropping the rest of an over-long line
   bool started = false;   // the first non-blank byte has been seen
   bool document = false;  // Rhubarb JSON: the input is kept whole until EOS
+  bool oversized = false;  // the document grew past its limit: one bad item, the rest dropped
   uint64_t bad_lines = 0;
   std::vector<pfap::TextEvent> events;
 };
@@ -132,13 +135,17 @@ static GstFlowReturn push_events(GstPfapMarksParse* self) {
   return ret;
 }
 
-// An error, or with skip-bad-lines a rate-limited warning and reading goes on.
-static GstFlowReturn bad_input(GstPfapMarksParse* self, size_t column, const std::string& what) {
+// An error, or with skip-bad-lines a rate-limited warning and reading goes on. `cue`: a cue
+// of a Rhubarb JSON document, not the whole document.
+static GstFlowReturn bad_input(GstPfapMarksParse* self, size_t column, const std::string& what,
+                               bool cue = false) {
   GST_OBJECT_LOCK(self);
   const bool skip = self->skip_bad_lines;
   GST_OBJECT_UNLOCK(self);
   Stream& s = *self->stream;
-  const char* kind = s.document ? "Rhubarb JSON document" : "line";
+  const char* kind = !s.document ? "line"
+                     : cue       ? "cue of Rhubarb JSON document"
+                                 : "Rhubarb JSON document";
   const uint64_t line = s.document ? 1 : s.line;
   if (skip) {
     if (pfap_warn_at(++s.bad_lines)) {
@@ -182,7 +189,10 @@ static GstFlowReturn gst_pfap_marks_parse_read_chunk(GstPfapBaseParse* parse,
     s.document = data[first] == '{' && s.reader.alphabet() == pfap::kRhubarbShapeAlphabet;
   }
   if (s.document) {
+    if (s.oversized) return GST_FLOW_OK;
     if (s.tail.size() + data.size() > pfap::MarksReader::kMaxDocumentBytes) {
+      s.oversized = true;
+      s.tail.clear();
       return bad_input(self, pfap::MarksReader::kMaxDocumentBytes, "larger than 16 MiB");
     }
     s.tail.append(data);
@@ -220,11 +230,19 @@ static GstFlowReturn gst_pfap_marks_parse_finish(GstPfapBaseParse* parse) {
   GstPfapMarksParse* self = GST_PFAP_MARKS_PARSE(parse);
   Stream& s = *self->stream;
   GstFlowReturn ret = GST_FLOW_OK;
-  if (s.document) {
-    const pfap::MarksResult result = s.reader.read_document(s.tail, s.events);
+  if (s.document && !s.oversized) {
+    GST_OBJECT_LOCK(self);
+    const bool skip = self->skip_bad_lines;
+    GST_OBJECT_UNLOCK(self);
+    // A bad cue is skipped with a warning, or stops the document after the cues before it.
+    const pfap::MarksResult result =
+        s.reader.read_document(s.tail, s.events, [&](const pfap::MarksResult& bad) {
+          if (skip) bad_input(self, bad.column, describe(bad), true);
+          return skip;
+        });
     ret = push_events(self);
     if (!result.ok() && ret == GST_FLOW_OK) ret = bad_input(self, result.column, describe(result));
-  } else {
+  } else if (!s.document) {
     if (!s.skipping && !s.tail.empty()) ret = read_line(self, s.tail);
     if (ret == GST_FLOW_OK) {
       s.reader.finish(s.events);

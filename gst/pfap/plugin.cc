@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// The pfap plugin: RTP payloading of PFAP streams (draft-ietf-avt-rtp-pfap-00) and their text
-// markup. Needs only GStreamer core, base and rtp.
+// The pfap plugin: RTP payloading of PFAP streams (draft-ietf-avt-rtp-pfap-00), and their
+// readers and writers of .pfap text, MPEG-4 FAP files and speech marks. Needs only GStreamer
+// core, base and rtp.
 #include <gst/gst.h>
 
 #include "gstfapparse.h"
@@ -28,6 +29,6 @@ static gboolean plugin_init(GstPlugin* plugin) {
 }
 
 GST_PLUGIN_DEFINE(GST_VERSION_MAJOR, GST_VERSION_MINOR, pfap,
-                  "Phoneme and facial animation parameter (PFAP) streams: RTP payloading and "
-                  "text markup",
+                  "Phoneme and facial animation parameter (PFAP) streams: RTP payloading, "
+                  ".pfap text, MPEG-4 FAP files and speech marks",
                   plugin_init, VERSION, "LGPL", GST_PACKAGE_NAME, GST_PACKAGE_ORIGIN)

@@ -227,47 +227,58 @@ bool FapRecorder::finish(int64_t end_ns) {
   return true;
 }
 
-FapFile FapRecorder::file(const std::string& name, NotWritten* not_written) const {
-  FapFile file;
-  file.header.version = "2.1";
-  file.header.name = name;
-  file.header.frame_rate = frame_rate_;
-  file.header.frame_count = frames();
-  std::array<bool, kFapFileFaps + 1> used{};
+FapFileHeader FapRecorder::header(const std::string& name) const {
+  return {"2.1", name, frame_rate_, frames()};
+}
+
+FapRecorder::Mask FapRecorder::mask() const {
+  Mask used{};
   for (const FapAmplitudes& amplitudes : frames_) {
     for (int index = kMinFapIndex; index <= kMaxFapIndex; ++index) {
       if (amplitudes[index] == 0) continue;
       used[index < kFirstExpressionIndex ? index : kExpressionFap] = true;
     }
   }
-  NotWritten dropped;
-  for (const FapAmplitudes& amplitudes : frames_) {
-    FapFrame& frame = file.frames.emplace_back();
-    frame.number = static_cast<uint32_t>(file.frames.size() - 1);
-    frame.set = used;
-    for (int fap = kMinFapIndex; fap <= kFapFileFaps; ++fap) {
-      if (used[fap]) frame.value[fap] = amplitudes[fap];
-    }
-    if (!used[kExpressionFap]) continue;
-    // The two strongest expressions, as select and intensity pairs.
-    std::array<int, 6> order = {0, 1, 2, 3, 4, 5};
-    std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
-      return std::abs(amplitudes[kFirstExpressionIndex + a]) >
-             std::abs(amplitudes[kFirstExpressionIndex + b]);
-    });
-    for (int slot = 0; slot < 6; ++slot) {
-      const int32_t amplitude = amplitudes[kFirstExpressionIndex + order[slot]];
-      if (amplitude == 0) continue;
-      if (slot >= 2) {
-        ++dropped.expressions_dropped;
-        continue;
-      }
-      const int32_t intensity = std::clamp(amplitude, 0, kMaxExpressionIntensity);
-      if (intensity != amplitude) ++dropped.intensities_clamped;
-      frame.expression[2 * slot] = order[slot] + 1;
-      frame.expression[2 * slot + 1] = intensity;
-    }
+  return used;
+}
+
+FapFrame FapRecorder::frame(uint32_t number, const Mask& mask, NotWritten& not_written) const {
+  const FapAmplitudes& amplitudes = frames_[number];
+  FapFrame frame;
+  frame.number = number;
+  frame.set = mask;
+  for (int fap = kMinFapIndex; fap <= kFapFileFaps; ++fap) {
+    if (mask[fap]) frame.value[fap] = amplitudes[fap];
   }
+  if (!mask[kExpressionFap]) return frame;
+  // The two strongest expressions, as select and intensity pairs.
+  std::array<int, 6> order = {0, 1, 2, 3, 4, 5};
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return std::abs(amplitudes[kFirstExpressionIndex + a]) >
+           std::abs(amplitudes[kFirstExpressionIndex + b]);
+  });
+  for (int slot = 0; slot < 6; ++slot) {
+    const int32_t amplitude = amplitudes[kFirstExpressionIndex + order[slot]];
+    if (amplitude == 0) continue;
+    if (slot >= 2) {
+      ++not_written.expressions_dropped;
+      continue;
+    }
+    const int32_t intensity = std::clamp(amplitude, 0, kMaxExpressionIntensity);
+    if (intensity != amplitude) ++not_written.intensities_clamped;
+    frame.expression[2 * slot] = order[slot] + 1;
+    frame.expression[2 * slot + 1] = intensity;
+  }
+  return frame;
+}
+
+FapFile FapRecorder::file(const std::string& name, NotWritten* not_written) const {
+  FapFile file;
+  file.header = header(name);
+  const Mask used = mask();
+  NotWritten dropped;
+  file.frames.reserve(frames_.size());
+  for (uint32_t k = 0; k < frames(); ++k) file.frames.push_back(frame(k, used, dropped));
   if (not_written != nullptr) *not_written = dropped;
   return file;
 }

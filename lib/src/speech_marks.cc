@@ -368,6 +368,7 @@ bool MarksWriter::frames_until(int64_t end_ns, const Sink& sink) {
     // Once everything has settled, frames repeat the same face: a rest longer than
     // kMaxRestNs is written for that long, then the frames go on at the next event.
     if (t >= end_ns_ + kMaxRestNs && end_ns > t) {
+      ++cut_rests_;
       next_frame_ = first_frame_from(end_ns);
       t = frame_time(next_frame_);
     }
@@ -646,7 +647,34 @@ MarksResult MarksReader::read_line(std::string_view line, std::vector<TextEvent>
   return viseme(ms, *symbol, object.get("time")->offset, out);
 }
 
-MarksResult MarksReader::read_document(std::string_view document, std::vector<TextEvent>& out) {
+namespace {
+
+struct Cue {
+  int64_t start_ms = 0;
+  int64_t end_ms = 0;
+  uint8_t symbol = 0;
+  size_t start_offset = 0;
+};
+
+MarksResult read_cue(const json::Value& cue, const PhonemeAlphabet& symbols, Cue& out) {
+  if (cue.type != json::Value::Type::kObject) return {MarksStatus::kNotAnObject, cue.offset};
+  if (MarksResult r = time_member(cue, "start", 3, 1, out.start_ms); !r.ok()) return r;
+  if (MarksResult r = time_member(cue, "end", 3, 1, out.end_ms); !r.ok()) return r;
+  if (out.end_ms < out.start_ms) return {MarksStatus::kTimeGoesBack, cue.get("end")->offset};
+  const json::Value* value = cue.get("value");
+  if (value == nullptr) return {MarksStatus::kMissingField, cue.offset};
+  const std::optional<uint8_t> symbol =
+      value->type == json::Value::Type::kString ? find_symbol(symbols, value->text) : std::nullopt;
+  if (!symbol) return {MarksStatus::kBadViseme, value->offset};
+  out.symbol = *symbol;
+  out.start_offset = cue.get("start")->offset;
+  return {};
+}
+
+}  // namespace
+
+MarksResult MarksReader::read_document(std::string_view document, std::vector<TextEvent>& out,
+                                       const BadCue& bad_cue) {
   if (document.size() > kMaxDocumentBytes) return {MarksStatus::kTooLarge, kMaxDocumentBytes};
   json::Value root;
   if (MarksResult result = parse_object(document, root); !result.ok()) return result;
@@ -655,33 +683,31 @@ MarksResult MarksReader::read_document(std::string_view document, std::vector<Te
     return {MarksStatus::kMissingField, root.offset};
   }
   const PhonemeAlphabet& symbols = *find_alphabet(kRhubarbShapeAlphabet);
-  int64_t end_ms = 0;
-  for (const json::Value& cue : cues->items) {
-    if (cue.type != json::Value::Type::kObject) return {MarksStatus::kNotAnObject, cue.offset};
-    int64_t start_ms = 0;
-    if (MarksResult r = time_member(cue, "start", 3, 1, start_ms); !r.ok()) return r;
-    if (MarksResult r = time_member(cue, "end", 3, 1, end_ms); !r.ok()) return r;
-    if (end_ms < start_ms) return {MarksStatus::kTimeGoesBack, cue.get("end")->offset};
-    const json::Value* value = cue.get("value");
-    if (value == nullptr) return {MarksStatus::kMissingField, cue.offset};
-    const std::optional<uint8_t> symbol = value->type == json::Value::Type::kString
-                                              ? find_symbol(symbols, value->text)
-                                              : std::nullopt;
-    if (!symbol) return {MarksStatus::kBadViseme, value->offset};
-    // A gap between one cue's end and the next start is a rest (X).
-    if (has_pending_ && start_ms > pending_end_ms_ && pending_end_ms_ >= last_time_ms_) {
-      if (MarksResult r = viseme(pending_end_ms_, 0, cue.offset, out); !r.ok()) return r;
+  MarksResult stopped;
+  for (const json::Value& item : cues->items) {
+    Cue cue;
+    MarksResult result = read_cue(item, symbols, cue);
+    if (result.ok() && cue.start_ms < last_time_ms_) {
+      result = {MarksStatus::kTimeGoesBack, cue.start_offset};
     }
-    if (MarksResult r = viseme(start_ms, *symbol, cue.get("start")->offset, out); !r.ok()) {
-      return r;
+    if (!result.ok()) {
+      if (bad_cue && bad_cue(result)) continue;
+      stopped = result;
+      break;
     }
-    pending_end_ms_ = end_ms;
+    // A gap between one cue's end and the next start is a rest (X). Neither viseme can go
+    // back in time: the start was checked.
+    if (has_pending_ && cue.start_ms > pending_end_ms_ && pending_end_ms_ >= last_time_ms_) {
+      viseme(pending_end_ms_, 0, item.offset, out);
+    }
+    viseme(cue.start_ms, cue.symbol, cue.start_offset, out);
+    pending_end_ms_ = cue.end_ms;
   }
   if (has_pending_) {
     pending_.event.phoneme.end_of_text = true;
     emit_pending(pending_end_ms_, out);
   }
-  return {};
+  return stopped;
 }
 
 }  // namespace pfap

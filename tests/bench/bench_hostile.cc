@@ -12,14 +12,23 @@
 //    Each case runs its bytes in turn with the others, repeatedly; the median is printed.
 // 2. Memory of one rtppfapdepay fed a long hostile stream: the process's heap in use and its
 //    RSS after a warm-up and along the rest of the run, with every buffer and event released.
+// 3. Readers and writers (issue 27): the peak RSS of a process running one pipeline to EOS
+//    over an input at a reader's or writer's limits, and the bytes the sink got; each in a
+//    child process of its own (this program run again with --peak), so that each peak is its
+//    own. GST_PLUGIN_PATH may name another build's plugins, to compare.
 //
 // Run: meson test -C build --benchmark --verbose hostile
-//  or: build/tests/bench/bench_hostile [scale [memory-packets [case]]]
+//  or: build/tests/bench/bench_hostile [scale [memory-packets [case [readers]]]]
 //      scale 1 takes ~20 s; memory-packets 0 skips part 2; case: only typical speech and the
-//      cases whose name holds it (to profile one: valgrind --tool=callgrind ... 1 0 smallest)
+//      cases whose name holds it (to profile one: valgrind --tool=callgrind ... 1 0 smallest);
+//      readers 0 skips part 3 (about a minute, and 0.5 GB of files in $TMPDIR while it runs)
+//  or: build/tests/bench/bench_hostile readers   (part 3 alone)
+#include <glib/gstdio.h>
 #include <gst/check/gstharness.h>
 #include <gst/gst.h>
 #include <gst/rtp/gstrtpbuffer.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -27,6 +36,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <functional>
 #include <span>
 #include <string>
 #include <utility>
@@ -35,6 +45,7 @@
 #include "clocks.h"
 #include "element_stats.h"
 #include "heap.h"
+#include "pfap/fap_file.h"
 #include "pfap/markup_event.h"
 #include "pfap/payload.h"
 #include "pfap/recovery.h"
@@ -506,6 +517,157 @@ void memory(long packets) {
       heap_after);
 }
 
+// ---------------------------------------------------------------------------------------------
+// Readers and writers
+
+// The child: runs `description` to EOS; prints the bytes its fakesink "out" got.
+int run_peak(const char* description) {
+  GError* error = nullptr;
+  GstElement* pipeline = gst_parse_launch(description, &error);
+  if (pipeline == nullptr) fail(std::string("cannot make the pipeline: ") + error->message);
+  guint64 bytes = 0;
+  GstElement* out = gst_bin_get_by_name(GST_BIN(pipeline), "out");
+  if (out == nullptr) fail("no element named out");
+  g_object_set(out, "signal-handoffs", TRUE, nullptr);
+  g_signal_connect(out, "handoff",
+                   G_CALLBACK(+[](GstElement*, GstBuffer* buffer, GstPad*, gpointer total) {
+                     *static_cast<guint64*>(total) += gst_buffer_get_size(buffer);
+                   }),
+                   &bytes);
+  gst_object_unref(out);
+  gst_element_set_state(pipeline, GST_STATE_PLAYING);
+  GstBus* bus = gst_element_get_bus(pipeline);
+  GstMessage* m = gst_bus_timed_pop_filtered(
+      bus, GST_CLOCK_TIME_NONE, static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR));
+  const bool eos = GST_MESSAGE_TYPE(m) == GST_MESSAGE_EOS;
+  gst_message_unref(m);
+  gst_object_unref(bus);
+  gst_element_set_state(pipeline, GST_STATE_NULL);
+  gst_object_unref(pipeline);
+  std::printf("%" G_GUINT64_FORMAT " %d\n", bytes, eos ? 1 : 0);
+  return 0;
+}
+
+struct Peak {
+  long rss_kib = 0;
+  unsigned long long bytes = 0;
+  bool eos = false;
+  double seconds = 0;
+};
+
+// Runs `description` in a child process (this program with --peak).
+Peak peak_of(const std::string& description) {
+  int fds[2];
+  if (pipe(fds) != 0) fail("pipe");
+  const double start = pfap::testing::wall_seconds();
+  const pid_t pid = fork();
+  if (pid < 0) fail("fork");
+  if (pid == 0) {
+    dup2(fds[1], STDOUT_FILENO);
+    close(fds[0]);
+    close(fds[1]);
+    execl("/proc/self/exe", "bench_hostile", "--peak", description.c_str(), nullptr);
+    _exit(127);
+  }
+  close(fds[1]);
+  std::string text;
+  char buffer[256];
+  for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;) text.append(buffer, n);
+  close(fds[0]);
+  int status = 0;
+  struct rusage usage {};
+  if (wait4(pid, &status, 0, &usage) != pid) fail("wait4");
+  Peak peak;
+  peak.seconds = pfap::testing::wall_seconds() - start;
+  peak.rss_kib = usage.ru_maxrss;
+  int eos = 0;
+  if (std::sscanf(text.c_str(), "%llu %d", &peak.bytes, &eos) != 2) fail("child: " + text);
+  peak.eos = eos == 1;
+  return peak;
+}
+
+void write_text(const std::string& path, const std::function<void(std::string&)>& fill) {
+  std::string text;
+  fill(text);
+  if (!g_file_set_contents(path.c_str(), text.data(), static_cast<gssize>(text.size()), nullptr)) {
+    fail("cannot write " + path);
+  }
+}
+
+size_t file_size(const std::string& path) {
+  GStatBuf st;
+  return g_stat(path.c_str(), &st) == 0 ? static_cast<size_t>(st.st_size) : 0;
+}
+
+void readers_and_writers() {
+  gchar* dir_name = g_dir_make_tmp("bench_hostile-XXXXXX", nullptr);
+  if (dir_name == nullptr) fail("no temporary directory");
+  const std::string dir = dir_name;
+  g_free(dir_name);
+  const std::string fap = dir + "/limit.fap", speech = dir + "/speech.pfap",
+                    late = dir + "/late.pfap", far = dir + "/far.pfap";
+  // The frame limit, every FAP 3..68 changing in every frame by the most digits a value has.
+  write_text(fap, [](std::string& out) {
+    out = "2.1 hostile 25 " + std::to_string(pfap::kMaxFapFileFrames) + "\n";
+    std::string mask = "0 0";
+    for (int fap = 3; fap <= pfap::kFapFileFaps; ++fap) mask += " 1";
+    for (uint32_t k = 0; k < pfap::kMaxFapFileFrames; ++k) {
+      out += mask;
+      out += '\n';
+      out += std::to_string(k);
+      for (int fap = 3; fap <= pfap::kFapFileFaps; ++fap) {
+        out += k % 2 == 0 ? " -2500000" : " 2500000";
+      }
+      out += '\n';
+    }
+  });
+  write_text(speech, [](std::string& out) { out = "0 1 100 100 -\n100 2 100 100 E\n"; });
+  // Every FAP at 0, then one event 4 hours later: pfapfapenc's frame limit at 25 frames/s,
+  // each frame with every FAP.
+  write_text(late, [](std::string& out) {
+    out = "0 state complete";
+    for (int fap = pfap::kMinFapIndex; fap <= pfap::kFapFileFaps; ++fap) {
+      out += " <FAP " + std::to_string(fap) + " 1000 0 1>";
+    }
+    out += "\n14400000 0 100 0 E\n";
+  });
+  // The tester's: 2,000 phonemes, each 11.6 days (10^9 ms) after the last.
+  write_text(far, [](std::string& out) {
+    for (int i = 0; i < 2000; ++i) {
+      out += std::to_string(int64_t{i} * 1'000'000'000) + " 1 100 100 -\n";
+    }
+  });
+  const struct {
+    const char* what;
+    std::string input;
+    std::string pipeline;
+  } cases[] = {
+      {"nothing read (the process's own)", "", "fakesrc num-buffers=1 ! fakesink name=out"},
+      {"fapparse, a FAP file at the frame limit", fap,
+       "filesrc location=" + fap + " ! fapparse ! fakesink name=out"},
+      {"fapparse with the speech pad, the same file", fap,
+       "filesrc location=" + fap + " ! fapparse name=p ! fakesink name=out filesrc location=" +
+           speech + " ! pfapparse ! p.speech"},
+      {"pfapfapenc at its frame limit (66 FAPs, an event 4 h late)", late,
+       "filesrc location=" + late + " ! pfapparse ! pfapfapenc ! fakesink name=out"},
+      {"pfapmarksenc arkit-json 240 frames/s, 2,000 phonemes 11.6 days apart", far,
+       "filesrc location=" + far +
+           " ! pfapparse alphabet=x-pfap-arpabet ! pfapmarksenc format=arkit-json frame-rate=240 "
+           "! fakesink name=out"},
+  };
+  std::printf("\nReaders and writers: peak RSS of a process running one pipeline to EOS\n");
+  std::printf("%-70s %12s %10s %14s %8s\n", "case", "input bytes", "peak RSS", "output bytes",
+              "seconds");
+  for (const auto& c : cases) {
+    const Peak peak = peak_of(c.pipeline);
+    std::printf("%-70s %12zu %6ld MiB %14llu %8.1f%s\n", c.what,
+                c.input.empty() ? 0 : file_size(c.input), peak.rss_kib >> 10, peak.bytes,
+                peak.seconds, peak.eos ? "" : " (no EOS: an error)");
+  }
+  for (const std::string& path : {fap, speech, late, far}) g_remove(path.c_str());
+  g_rmdir(dir.c_str());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -521,6 +683,11 @@ int main(int argc, char** argv) {
     fail("cannot run again with G_SLICE=always-malloc");
   }
   gst_init(&argc, &argv);
+  if (argc == 3 && std::string(argv[1]) == "--peak") return run_peak(argv[2]);
+  if (argc == 2 && std::string(argv[1]) == "readers") {
+    readers_and_writers();
+    return 0;
+  }
   const int scale = argc > 1 ? std::atoi(argv[1]) : 1;
   const long packets = argc > 2 ? std::atol(argv[2]) : 200000;
   if (scale <= 0 || (packets != 0 && packets < 10)) {
@@ -531,5 +698,6 @@ int main(int argc, char** argv) {
   gst_object_unref(f);
   cost(scale, argc > 3 ? argv[3] : "");
   if (packets > 0) memory(packets);
+  if (argc <= 4 || std::atoi(argv[4]) != 0) readers_and_writers();
   return 0;
 }

@@ -449,7 +449,7 @@ TEST(Loopback, ReportsErrors) {
   {
     const ProcessResult r = run({PFAP_LOOPBACK});
     EXPECT_EQ(r.status, 2);
-    EXPECT_NE(r.err.find("usage:"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("pfap-loopback: wants one FILE.pfap"), std::string::npos) << r.err;
   }
   {
     const std::string bad = dir.file("bad.pfap");

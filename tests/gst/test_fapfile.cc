@@ -163,6 +163,19 @@ TEST(FapParse, BadFilesAreErrorsNamingFileLineAndField) {
   }
 }
 
+// Issue 27: a UTF-8 byte order mark before a FAP file was "unsupported version".
+TEST(FapParse, ByteOrderMarkAtTheStartIsSkipped) {
+  ASSERT_TRUE(plugin_available(kElements));
+  TempDir dir;
+  std::string mask = "0 0 1";
+  for (int i = 4; i <= 68; ++i) mask += " 0";
+  const std::string bom = "\xEF\xBB\xBF";
+  EXPECT_EQ(error_of(bom + "2.1 t 25 1\n" + mask + "\n0 5\n", dir), "");
+  // Only at the start: later, it is a bad field.
+  EXPECT_NE(error_of("2.1 t 25 1\n" + bom + mask + "\n0 5\n", dir).find("line 2, field 1"),
+            std::string::npos);
+}
+
 TEST(FapParse, VisemesAreReportedNotSilentlyLost) {
   ASSERT_TRUE(plugin_available(kElements));
   TempDir dir;
@@ -264,6 +277,75 @@ TEST(FapParse, MergedWithASpeechStreamKeepsTheFileValuesAndTheSpeechPhonemes) {
     EXPECT_TRUE(events.back().phoneme.end_of_text);
     gst_harness_teardown(speech);
     gst_harness_teardown(h);
+  }
+}
+
+// Runs `text`, a FAP file, through fapparse with `speech` on its speech pad; expects `want`.
+void expect_whole_merge(const std::string& text, const std::vector<pfap::TextEvent>& speech,
+                        const std::vector<pfap::TextEvent>& want) {
+  GstHarness* h = gst_harness_new_with_padnames("fapparse", "sink", "src");
+  GstHarness* speech_pad = gst_harness_new_with_element(h->element, "speech", nullptr);
+  ASSERT_NE(speech_pad, nullptr);
+  gst_harness_set_src_caps_str(speech_pad, "application/x-pfap");
+  for (const pfap::TextEvent& e : speech) {
+    const auto pts = static_cast<GstClockTime>(e.time_ms) * GST_MSECOND;
+    ASSERT_EQ(gst_harness_push(speech_pad, pfap::testing::markup_buffer(e.event, pts)),
+              GST_FLOW_OK);
+  }
+  ASSERT_TRUE(gst_harness_push_event(speech_pad, gst_event_new_eos()));
+  push_file(h, text);
+  std::vector<pfap::TextEvent> got;
+  while (GstBuffer* b = gst_harness_try_pull(h)) {
+    pfap::TextEvent e;
+    e.time_ms = static_cast<int64_t>(GST_BUFFER_PTS(b) / GST_MSECOND);
+    GstMapInfo map;
+    gst_buffer_map(b, &map, GST_MAP_READ);
+    EXPECT_TRUE(pfap::read_markup({map.data, map.size}, e.event));
+    gst_buffer_unmap(b, &map);
+    gst_buffer_unref(b);
+    got.push_back(std::move(e));
+  }
+  gst_harness_teardown(speech_pad);
+  gst_harness_teardown(h);
+  ASSERT_EQ(got.size(), want.size());
+  for (size_t i = 0; i < want.size(); ++i) {
+    ASSERT_EQ(got[i], want[i]) << "event " << i << " at " << want[i].time_ms << " ms";
+  }
+}
+
+// Issue 27: merged, fapparse held the file's events, merge_with_speech's copy of their FAPs
+// and its output at once (760 MB for a 261 MB file); it now merges in windows of at least
+// 4096 file events, which must give what the whole merge gives.
+TEST(FapParse, MergedInWindowsIsTheWholeMerge) {
+  ASSERT_TRUE(plugin_available(kElements));
+  std::string mask = "0 0 1";
+  for (int i = 4; i <= 68; ++i) mask += " 0";
+  // 12,000 frames at 25 a second, FAP 3 changing at every third: three windows and more.
+  constexpr int kFrames = 12000;
+  std::string text = "2.1 t 25 " + std::to_string(kFrames) + "\n";
+  for (int k = 0; k < kFrames; ++k) {
+    text += mask + "\n" + std::to_string(k) + " " + std::to_string(k / 3 * 5 % 1000) + "\n";
+  }
+  pfap::FapFile file;
+  ASSERT_TRUE(pfap::read_fap_file(text, file).ok());
+  for (uint32_t seed = 1; seed <= 8; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    // Speech phonemes of 10 to 400 ms, after gaps of 0 to 300 ms, half of them starting at a
+    // frame; ending a text now and then.
+    std::mt19937 random(seed);
+    std::vector<pfap::TextEvent> speech;
+    for (int64_t at = 0; at < int64_t{kFrames} * 40 + 2000;) {
+      pfap::TextEvent e;
+      e.time_ms = at;
+      e.event.phoneme.symbol = static_cast<uint8_t>(1 + random() % 40);
+      e.event.phoneme.duration_ms = static_cast<uint16_t>(10 + random() % 391);
+      e.event.phoneme.end_of_text = random() % 7 == 0;
+      e.event.sentence_start = speech.empty() || speech.back().event.phoneme.end_of_text;
+      speech.push_back(e);
+      at += e.event.phoneme.duration_ms;
+      if (random() % 2 == 0) at = (at + random() % 301 + 39) / 40 * 40;
+    }
+    expect_whole_merge(text, speech, pfap::merge_with_speech(speech, pfap::markup_of(file)));
   }
 }
 
@@ -489,6 +571,41 @@ TEST(PfapFapEnc, EarlierEventIsWrittenAtThePreviousTimeWithAWarning) {
   ASSERT_EQ(file.frames.size(), 2u);
   EXPECT_EQ(file.frames[0].value[3], 0);    // before the first event
   EXPECT_EQ(file.frames[1].value[3], -20);  // the earlier event, after the first at 100 ms
+}
+
+// Issue 27: pfapfapenc took 345 MB at its frame limit, where docs/fap-files.md said 108 MB:
+// the frames' amplitudes, then the whole FapFile, its text and a copy of it. The text now goes
+// out in pieces of about 64 KiB as it is written, from the amplitudes.
+TEST(PfapFapEnc, TheFileGoesOutInPiecesAsItIsWritten) {
+  ASSERT_TRUE(plugin_available(kElements));
+  std::vector<pfap::Fap> every;
+  for (uint8_t fap = pfap::kMinFapIndex; fap <= pfap::kFapFileFaps; ++fap) {
+    every.push_back({fap, 1000, 0, pfap::Curve::kLinear});
+  }
+  // Every FAP set, then 100 s of frames at 25 a second: about 1.3 MB of text.
+  GstHarness* h = gst_harness_new("pfapfapenc");
+  gst_harness_set_src_caps_str(h, "application/x-pfap");
+  ASSERT_EQ(gst_harness_push(h, phoneme_at(0, 100, every)), GST_FLOW_OK);
+  ASSERT_EQ(gst_harness_push(h, phoneme_at(100 * GST_SECOND, 0, {})), GST_FLOW_OK);
+  ASSERT_TRUE(gst_harness_push_event(h, gst_event_new_eos()));
+  std::string text;
+  size_t buffers = 0, largest = 0;
+  while (GstBuffer* b = gst_harness_try_pull(h)) {
+    GstMapInfo map;
+    gst_buffer_map(b, &map, GST_MAP_READ);
+    text.append(reinterpret_cast<const char*>(map.data), map.size);
+    largest = std::max(largest, map.size);
+    ++buffers;
+    gst_buffer_unmap(b, &map);
+    gst_buffer_unref(b);
+  }
+  gst_harness_teardown(h);
+  pfap::FapFile file;
+  ASSERT_TRUE(pfap::read_fap_file(text, file).ok());
+  ASSERT_GE(file.frames.size(), 2500u);
+  EXPECT_EQ(file.frames.back().value[68], 1000);
+  EXPECT_GT(buffers, text.size() / (65 * 1024));
+  EXPECT_LT(largest, size_t{66 * 1024});  // 64 KiB and the last frame's lines
 }
 
 TEST(PfapFapEnc, NoEventsNoFileAndAWarning) {

@@ -4,6 +4,7 @@
 #include <gst/check/gstharness.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <sstream>
@@ -160,6 +161,27 @@ TEST_F(MarksEnc, ArkitFramesAtTheFrameRateEndAfterTheLastTransition) {
   EXPECT_EQ(std::count(rows[2].begin(), rows[2].end(), ','), 55);
 }
 
+// Issue 27: 2,000 phonemes 11.6 days apart made 4.5 MB of arkit-json each at 240 frames/s.
+TEST_F(MarksEnc, ArkitLongRestIsCutWithAWarning) {
+  make("pfapmarksenc format=arkit-csv frame-rate=240");
+  gst_harness_set_src_caps_str(h_, PFAP_MARKUP_CAPS ",alphabet=x-pfap-arpabet");
+  constexpr GstClockTime kDay = 24 * 3600 * GST_SECOND;
+  for (int i = 0; i < 4; ++i) {
+    ASSERT_EQ(gst_harness_push(
+                  h_, pfap::testing::phoneme_buffer(phoneme(22, 100), {}, i * 12 * kDay, i == 0)),
+              GST_FLOW_OK);
+  }
+  gst_harness_push_event(h_, gst_event_new_eos());
+  const std::string csv = pull_text(h_);
+  // Header; 284 frames (0 to 1.18 s) after each of the first 3, 44 after the last.
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 3 * 284 + 44);
+  const std::vector<std::string> warnings = messages(bus_, GST_MESSAGE_WARNING);
+  ASSERT_EQ(warnings.size(), 2u);  // at the 1st and 2nd of 3
+  EXPECT_EQ(warnings[0],
+            "A rest longer than 1000 ms: its frames after that are left out, and the next "
+            "frame's time jumps.");
+}
+
 using MarksParse = HarnessTest;
 
 // Every buffer the harness holds, as events.
@@ -253,6 +275,109 @@ TEST_F(MarksParse, RhubarbJsonIsReadWholeAtEos) {
   EXPECT_EQ(events[1].pts, 100 * kMs);
   EXPECT_EQ(events[1].duration, 200 * kMs);
   EXPECT_EQ(events[1].phoneme.symbol, 6);  // F
+}
+
+// Issue 27: 10 cues with the 6th bad gave 4, even with skip-bad-lines.
+TEST_F(MarksParse, RhubarbJsonBadCueIsSkippedAndEveryGoodOneKept) {
+  make("pfapmarksparse format=rhubarb skip-bad-lines=true");
+  std::string doc = "{\"mouthCues\":[";
+  for (int i = 0; i < 10; ++i) {
+    if (i > 0) doc += ",\n";
+    doc += "{\"start\":" + std::to_string(i) + ".0,\"end\":" + std::to_string(i + 1) +
+           ".0,\"value\":\"" + (i == 5 ? "Z" : "B") + "\"}";
+  }
+  doc += "]}";
+  ASSERT_EQ(gst_harness_push(h_, gst_buffer_new_memdup(doc.data(), doc.size())), GST_FLOW_OK);
+  gst_harness_push_event(h_, gst_event_new_eos());
+  const std::vector<pfap::testing::Event> events = pull_events(h_);
+  std::vector<GstClockTime> times;
+  for (const pfap::testing::Event& e : events) times.push_back(e.pts);
+  // Cue 6's second is a rest, from cue 5's end.
+  EXPECT_EQ(times, (std::vector<GstClockTime>{0, 1000 * kMs, 2000 * kMs, 3000 * kMs, 4000 * kMs,
+                                              5000 * kMs, 6000 * kMs, 7000 * kMs, 8000 * kMs,
+                                              9000 * kMs}));
+  ASSERT_EQ(events.size(), 10u);
+  EXPECT_EQ(events[4].phoneme.symbol, 2);  // B
+  EXPECT_EQ(events[4].duration, 1000 * kMs);
+  EXPECT_EQ(events[5].phoneme.symbol, 0);  // X
+  EXPECT_EQ(events[6].phoneme.symbol, 2);
+  const std::vector<std::string> warnings = messages(bus_, GST_MESSAGE_WARNING);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_TRUE(warnings[0].starts_with("Skipped cue of Rhubarb JSON document 1, column "))
+      << warnings[0];
+  EXPECT_TRUE(warnings[0].ends_with(": not a viseme of this format (1 bad so far)")) << warnings[0];
+  EXPECT_TRUE(messages(bus_, GST_MESSAGE_ERROR).empty());
+}
+
+// Issue 27: every 4 KiB chunk past 16 MiB was counted as one more bad item.
+TEST_F(MarksParse, OversizedRhubarbJsonIsOneBadItem) {
+  make("pfapmarksparse format=rhubarb skip-bad-lines=true");
+  const std::string cue = "{\"start\":0.0,\"end\":0.1,\"value\":\"A\"},";
+  std::string chunk = "{\"mouthCues\":[";
+  while (chunk.size() + cue.size() <= 4096) chunk += cue;
+  chunk.resize(4096, ' ');
+  const size_t chunks = 17 * 1024 / 4;  // 17 MiB
+  for (size_t i = 0; i < chunks; ++i) {
+    ASSERT_EQ(gst_harness_push(h_, gst_buffer_new_memdup(chunk.data(), chunk.size())), GST_FLOW_OK);
+  }
+  gst_harness_push_event(h_, gst_event_new_eos());
+  EXPECT_EQ(gst_harness_buffers_in_queue(h_), 0u);
+  const std::vector<std::string> warnings = messages(bus_, GST_MESSAGE_WARNING);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0],
+            "Skipped Rhubarb JSON document 1, column 16777217: larger than 16 MiB (1 bad so far)");
+  EXPECT_TRUE(messages(bus_, GST_MESSAGE_ERROR).empty());
+}
+
+// Issue 27: a UTF-8 byte order mark before Rhubarb JSON was read as TSV, before Polly and
+// Azure lines was "not a JSON value". Here it comes split over one-byte buffers, as appsrc
+// may give it.
+TEST_F(MarksParse, ByteOrderMarkAtTheStartIsSkippedInEveryFormat) {
+  const struct {
+    const char* format;
+    const char* text;
+    uint8_t symbol;
+  } rows[] = {
+      {"polly", "{\"time\":0,\"type\":\"viseme\",\"value\":\"p\"}\n", 1},
+      {"azure", "{\"audioOffset\":0,\"visemeId\":21}\n", 21},
+      {"rhubarb", "0.00\tF\n", 6},
+      {"rhubarb", "{\"mouthCues\":[{\"start\":0.00,\"end\":0.10,\"value\":\"F\"}]}", 6},
+  };
+  for (const auto& row : rows) {
+    SCOPED_TRACE(std::string(row.format) + ": " + row.text);
+    make((std::string("pfapmarksparse format=") + row.format).c_str());
+    const std::string text = std::string("\xEF\xBB\xBF") + row.text;
+    GstFlowReturn flow = GST_FLOW_OK;
+    for (size_t i = 0; i < text.size() && flow == GST_FLOW_OK; ++i) {
+      flow = gst_harness_push(h_, gst_buffer_new_memdup(&text[i], 1));
+    }
+    EXPECT_EQ(flow, GST_FLOW_OK);
+    gst_harness_push_event(h_, gst_event_new_eos());
+    const std::vector<pfap::testing::Event> events = pull_events(h_);
+    EXPECT_EQ(events.size(), 1u);
+    if (!events.empty()) {
+      EXPECT_EQ(events[0].pts, 0u);
+      EXPECT_EQ(events[0].phoneme.symbol, row.symbol);
+    }
+    EXPECT_EQ(messages(bus_, GST_MESSAGE_ERROR), std::vector<std::string>{});
+    EXPECT_TRUE(messages(bus_, GST_MESSAGE_WARNING).empty());
+    gst_harness_teardown(h_);
+    h_ = nullptr;
+  }
+}
+
+// A byte order mark only where the text starts, and bytes that begin like one are text.
+TEST_F(MarksParse, ByteOrderMarkLaterOrIncompleteIsText) {
+  make("pfapmarksparse format=rhubarb");
+  const std::string text =
+      "\xEF\xBB"
+      "0.00\tF\n";
+  ASSERT_EQ(gst_harness_push(h_, gst_buffer_new_memdup(text.data(), text.size())), GST_FLOW_ERROR);
+  const std::vector<std::string> errors = messages(bus_, GST_MESSAGE_ERROR);
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_EQ(errors[0],
+            "Bad line 1, column 1: bad time (a number >= 0 in the format's unit, "
+            "under about 292 years)");
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -215,4 +215,16 @@ TEST(RegistryReference, CoversEveryElementAndTheTypefinder) {
   EXPECT_EQ(registry.find("example.invalid"), std::string::npos);
 }
 
+// gst-inspect's "Binary package" and "Origin URL" are what the build was configured with
+// (-Dpackage-name, -Dpackage-origin; debian/rules sets its own), on every plugin.
+TEST(RegistryReference, PluginsCarryThePackageOptions) {
+  for (const char* name : kPlugins) {
+    GstPlugin* plugin = gst_registry_find_plugin(gst_registry_get(), name);
+    ASSERT_NE(plugin, nullptr) << "no plugin " << name << "; GST_PLUGIN_PATH?";
+    EXPECT_STREQ(gst_plugin_get_package(plugin), PFAP_PACKAGE_NAME) << name;
+    EXPECT_STREQ(gst_plugin_get_origin(plugin), PFAP_PACKAGE_ORIGIN) << name;
+    gst_object_unref(plugin);
+  }
+}
+
 }  // namespace

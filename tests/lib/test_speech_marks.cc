@@ -3,6 +3,7 @@
 // each format back to x-pfap keeping every viseme's time to the ms, and readers' errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -245,12 +246,37 @@ TEST(SpeechMarks, ArkitFramesOfALongRestAreLeftOut) {
   std::string line;
   std::vector<std::string> rows;
   while (std::getline(lines, line)) rows.push_back(line);
-  // Header; 0 up to 10 s after the mouth has closed at 0.18 s (102 frames), then 60 to
+  // Header; 0 up to 1 s after the mouth has closed at 0.18 s (12 frames), then 60 to
   // 60.18 s.
-  ASSERT_EQ(rows.size(), 1u + 102 + 2);
-  EXPECT_TRUE(rows[102].starts_with("10100.000,"));
-  EXPECT_TRUE(rows[103].starts_with("60000.000,"));
-  EXPECT_TRUE(rows[104].starts_with("60100.000,"));
+  ASSERT_EQ(rows.size(), 1u + 12 + 2);
+  EXPECT_TRUE(rows[12].starts_with("1100.000,"));
+  EXPECT_TRUE(rows[13].starts_with("60000.000,"));
+  EXPECT_TRUE(rows[14].starts_with("60100.000,"));
+}
+
+// Issue 27: 2,000 phonemes 11.6 days apart made 8.9 GB of arkit-json at 240 frames/s, 10 s of
+// rest frames for each. An event makes the frames of what it moves, then at most
+// kMaxRestNs of rest.
+TEST(SpeechMarks, ArkitFramesPerEventAreBoundedWhateverTheGaps) {
+  constexpr int kFps = 240;
+  constexpr int64_t kEvents = 200;
+  constexpr int64_t kGapMs = 1'000'000'000;  // 11.6 days
+  std::vector<TextEvent> events;
+  for (int64_t i = 0; i < kEvents; ++i) events.push_back(event(i * kGapMs, phoneme(1, 100)));
+  MarksWriter writer(MarksFormat::kArkitJson, kFps);
+  writer.set_alphabet(&arpabet());
+  size_t frames = 0, bytes = 0;
+  const MarksWriter::Sink sink = [&](std::string_view text) {
+    frames += static_cast<size_t>(std::count(text.begin(), text.end(), '\n'));
+    bytes += text.size();
+    return true;
+  };
+  for (const TextEvent& e : events) ASSERT_TRUE(writer.add(e.event, e.time_ms * kNsPerMs, sink));
+  ASSERT_TRUE(writer.finish(sink));
+  // The phoneme, its 80 ms closing and 1 s of rest: frames from 0 to 1.18 s, 284 of them;
+  // the last event's end at 0.18 s, 44.
+  EXPECT_EQ(frames, (kEvents - 1) * 284 + 44) << bytes << " bytes";
+  EXPECT_EQ(writer.cut_rests(), static_cast<uint64_t>(kEvents - 1));
 }
 
 TEST(SpeechMarks, BadLinesSayWhatAndWhere) {
@@ -329,6 +355,54 @@ TEST(SpeechMarks, RhubarbJsonDocument) {
   const MarksResult too_many = bad.read_document(wide, out);
   EXPECT_EQ(too_many.status, MarksStatus::kBadJson);
   EXPECT_STREQ(too_many.what, "more than 400000 values");
+}
+
+// Issue 27: the good cue before a bad one was lost, and every cue after it.
+TEST(SpeechMarks, RhubarbJsonBadCueLosesNoGoodOne) {
+  std::string doc = R"({"mouthCues":[)";
+  for (int i = 0; i < 10; ++i) {
+    if (i > 0) doc += ',';
+    // Cue 6 (i == 5) has an unknown shape; each cue is 100 ms, the shapes A..H in turn.
+    doc += R"({"start":)" + std::to_string(i) + R"(.0,"end":)" + std::to_string(i) +
+           R"(.1,"value":")" + (i == 5 ? std::string("Z") : std::string(1, char('A' + i % 8))) +
+           R"("})";
+  }
+  doc += "]}";
+
+  // Stopping at the bad cue: the five before it, each followed by its rest.
+  MarksReader stops(MarksInput::kRhubarb);
+  std::vector<TextEvent> out;
+  const MarksResult result = stops.read_document(doc, out);
+  EXPECT_EQ(result.status, MarksStatus::kBadViseme);
+  EXPECT_EQ(doc.substr(result.column, 3), "\"Z\"");
+  ASSERT_EQ(out.size(), 9u);  // 5 cues and the 4 rests between them
+  EXPECT_EQ(out[8].time_ms, 4000);
+  EXPECT_EQ(out[8].event.phoneme.symbol, 5);  // E
+  EXPECT_EQ(out[8].event.phoneme.duration_ms, 100);
+  EXPECT_TRUE(out[8].event.phoneme.end_of_text);
+
+  // Skipping it: the nine good cues.
+  MarksReader skips(MarksInput::kRhubarb);
+  out.clear();
+  std::vector<MarksResult> bad;
+  ASSERT_TRUE(skips
+                  .read_document(doc, out,
+                                 [&](const MarksResult& r) {
+                                   bad.push_back(r);
+                                   return true;
+                                 })
+                  .ok());
+  ASSERT_EQ(bad.size(), 1u);
+  EXPECT_EQ(bad[0].status, MarksStatus::kBadViseme);
+  std::vector<int64_t> cue_times;
+  for (const TextEvent& e : out) {
+    if (e.event.phoneme.symbol != 0) cue_times.push_back(e.time_ms);
+  }
+  EXPECT_EQ(cue_times, (std::vector<int64_t>{0, 1000, 2000, 3000, 4000, 6000, 7000, 8000, 9000}));
+  EXPECT_EQ(out[9].time_ms, 4100);  // the rest from cue 5's end to cue 7
+  EXPECT_EQ(out[9].event.phoneme.symbol, 0);
+  EXPECT_EQ(out[9].event.phoneme.duration_ms, 1900);
+  EXPECT_TRUE(out.back().event.phoneme.end_of_text);
 }
 
 TEST(SpeechMarks, ArkitFramesAtTheFrameRate) {

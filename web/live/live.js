@@ -56,10 +56,24 @@ export function lipSyncErrors(envelope, frames, { silenceMs = 30, windowMs = 150
 
 export function start({ canvas, audio, form, input, status, saying }) {
   const stats = {
-    phonemes: 0, packets: 0, lost: 0, recovered: 0, complete: 0, uncertain: 0, late: 0,
-    lipSyncErrorsMs: [], fapStateMatchesSender: false,
-    sender: null, texts: 0, done: 0, connected: false, streamNs: 0, endNs: 0,
-    envelope: [], frames: [],
+    phonemes: 0,
+    packets: 0,
+    lost: 0,
+    recovered: 0,
+    complete: 0,
+    uncertain: 0,
+    late: 0,
+    lipSyncErrorsMs: [],
+    fapStateMatchesSender: false,
+    sender: null,
+    texts: 0,
+    done: 0,
+    connected: false,
+    problem: null,
+    streamNs: 0,
+    endNs: 0,
+    envelope: [],
+    frames: [],
   };
   window.pfapStats = stats;
   const ws = new WebSocket(`ws://${location.host}/ws`);
@@ -150,15 +164,31 @@ export function start({ canvas, audio, form, input, status, saying }) {
   pc.onicecandidate = (e) => {
     if (e.candidate) send({ type: 'ice', candidate: e.candidate.candidate, sdpMLineIndex: e.candidate.sdpMLineIndex });
   };
+  // What went wrong stays on the page: the server's reason, or why ICE failed.
+  let problem = null;
+  const fail = (text) => {
+    problem = text;
+    stats.problem = text;
+    status.textContent = text;
+  };
   pc.onconnectionstatechange = () => {
-    status.textContent = pc.connectionState;
     stats.connected = pc.connectionState === 'connected';
+    if (!problem) status.textContent = pc.connectionState;
+  };
+  pc.oniceconnectionstatechange = () => {
+    if (pc.iceConnectionState === 'failed') {
+      fail(
+          'failed: no network path to the server (ICE failed; docs/web.md, "When the page does not connect")');
+    }
   };
 
   ws.onmessage = async (event) => {
     const m = JSON.parse(event.data);
     if (m.type === 'timing') {
       timing = m;
+      // The server's STUN server: a browser that hides its addresses behind mDNS names learns
+      // its loopback address from it (tools/pfap-web-stun.h). Set before the offer comes.
+      if (m.stunPort) pc.setConfiguration({iceServers: [{urls: `stun:127.0.0.1:${m.stunPort}`}]});
       const text = new URLSearchParams(location.search).get('text');
       if (text) send({ type: 'say', text });
     } else if (m.type === 'offer') {
@@ -174,6 +204,8 @@ export function start({ canvas, audio, form, input, status, saying }) {
       ++stats.texts;
       stats.sender = null;
       saying.textContent = `Saying: ${m.text}`;
+    } else if (m.type === 'error') {
+      fail(`closed by the server: ${m.message}`);
     } else if (m.type === 'done' || (m.type === 'state' && stats.sender)) {
       // The sender's state at the end of a text, then after each complete state asked for
       // (one asked for mid-text is compared at the text's end).
@@ -182,7 +214,9 @@ export function start({ canvas, audio, form, input, status, saying }) {
       compare({ repair: true });
     }
   };
-  ws.onclose = () => { status.textContent = 'disconnected'; };
+  ws.onclose = () => {
+    if (!problem) status.textContent = 'disconnected';
+  };
 
   form.onsubmit = (e) => {
     e.preventDefault();

@@ -52,6 +52,11 @@ function ease(u) {
   return u * u * (3 - 2 * u);
 }
 
+/**
+ * pfapface's animator: applies phoneme, recovered and complete events at their times and
+ * gives the FAP values and the face's pose at any time after, with the mouth moving between
+ * visemes (coarticulation) and a generic mouth for symbols it does not know.
+ */
 export class Animator {
   /**
    * @param {import('./index.js').PhonemeAlphabet | null} [alphabet] the phoneme symbols'

@@ -11,6 +11,7 @@ import { FAP_COUNT, FIRST_EXPRESSION_INDEX } from './model.js';
 
 /** The neutral distances, in face units, of which one FAP unit is 1/1024. */
 export const FAP_UNITS = Object.freeze({ mns: 0.14, mw: 0.26, ens: 0.18, es: 0.34, irisd: 0.055 });
+/** The angle unit of the head-rotation FAPs (48..50): 1e-5 rad. */
 export const ANGLE_UNIT = 1e-5; // rad
 
 const U = FAP_UNITS;

@@ -22,6 +22,10 @@ function checkIndex(index) {
   }
 }
 
+/**
+ * The receiver's FAP state, as pfap::FapState: each FAP's transition (start, target, curve)
+ * and the value it has at any time after its start.
+ */
 export class FapState {
   constructor() {
     // Per FAP index, struct-of-arrays: amplitude when the transition started, its target,
@@ -115,7 +119,7 @@ export class FapState {
     }
     const start = this._startNs[index];
     const leftNs = start + this._durationNs[index] - Math.max(timeNs, start);
-    return { index, amplitude: this._target[index], transition: Math.ceil(leftNs / NS_PER_MS), curve: this._curve[index] };
+    return { index, amplitude: this._target[index], transition: Math.ceil(leftNs / NS_PER_MS), curve: /** @type {import('./index.js').Fap['curve']} */ (this._curve[index]) };
   }
 
   /** Every FAP back to 0 with no transition running, as after construction. */

@@ -221,7 +221,7 @@ export declare const NS_PER_MS: 1000000;
 export declare const MIN_FAP_INDEX: 3;
 export declare const MAX_FAP_INDEX: 74;
 export declare const FIRST_EXPRESSION_INDEX: 69;
-export declare const FAP_COUNT: 75;
+export declare const FAP_COUNT: number;
 export declare const MAX_AMPLITUDE: 2529600;
 export declare const MAX_TRANSITION_MS: 16383;
 export declare const MAX_PHONEME_DURATION_MS: 4095;

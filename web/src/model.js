@@ -1,16 +1,23 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // The TtsFAPInterface data as draft-ietf-avt-rtp-pfap-00 carries it (lib/include/pfap/model.h).
 
+/** Nanoseconds in a millisecond: times are ns, durations and transitions ms. */
 export const NS_PER_MS = 1_000_000;
+/** The lowest FAP index a descriptor carries (FAPind 3..74, docs/format.md). */
 export const MIN_FAP_INDEX = 3;
+/** The highest FAP index: 74, expression 6. */
 export const MAX_FAP_INDEX = 74;
 /** FAP indexes 69..74 carry the MPEG-4 expressions 1..6: index = 68 + expression. */
 export const FIRST_EXPRESSION_INDEX = 69;
 /** Arrays indexed by FAP index have this length. */
 export const FAP_COUNT = MAX_FAP_INDEX + 1;
+/** The largest |amplitude| a FAP descriptor carries (22 bits), in the FAP's own units. */
 export const MAX_AMPLITUDE = 2529600;
+/** The longest transition a FAP descriptor carries (14 bits), ms. */
 export const MAX_TRANSITION_MS = 16383;
+/** The longest phoneme a descriptor carries (12 bits), ms. */
 export const MAX_PHONEME_DURATION_MS = 4095;
+/** The highest f0 on the wire (8 bits of 2 Hz), Hz. */
 export const MAX_F0_HZ = 510;
 
 /** Curves (C): 1 linear, 2 triangle, 3 spline. */

@@ -42,6 +42,11 @@ export const DecodeError = Object.freeze({
 // A FAP descriptor or recovery entry at `pos` (48 bits: FAPind 7, s 1, amplitude 22,
 // transition 14, C 2, IB 2): the FAP, or the status of its first bad field. The InfoBits are
 // the caller's.
+/**
+ * @param {Uint8Array} data
+ * @param {number} pos
+ * @returns {import('./index.js').Fap | import('./index.js').DecodeErrorName}
+ */
 function unpackFap(data, pos) {
   const b0 = data[pos];
   const b3 = data[pos + 3];
@@ -56,7 +61,7 @@ function unpackFap(data, pos) {
     index,
     amplitude: b0 & 1 && magnitude !== 0 ? -magnitude : magnitude, // negative zero is 0
     transition: ((b3 & 0b11) << 12) | (data[pos + 4] << 4) | (b5 >> 4),
-    curve,
+    curve: /** @type {import('./index.js').Fap['curve']} */ (curve),
   };
 }
 
@@ -70,6 +75,7 @@ function unpackFap(data, pos) {
 export function decodePayload(payload) {
   const data = payload;
   const size = data.length;
+  /** @type {(error: import('./index.js').DecodeErrorName, offset: number) => import('./index.js').DecodeResult} */
   const fail = (error, offset) => ({ ok: false, error, offset });
 
   if (size === 0) return fail(DecodeError.TRUNCATED, 0);

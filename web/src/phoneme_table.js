@@ -50,22 +50,43 @@ export function findAlphabet(name) {
   return Object.prototype.hasOwnProperty.call(ALPHABETS, name) ? ALPHABETS[name] : null;
 }
 
+// An alphabet object as findAlphabet gives it, or a TypeError that says so: its name (the
+// caps field's and SDP's value, ARPABET_ALPHABET) is the likely mistake.
+/**
+ * @param {import('./index.js').PhonemeAlphabet} alphabet
+ * @param {string} caller
+ * @returns {import('./index.js').PhonemeAlphabet}
+ */
+function checkAlphabet(alphabet, caller) {
+  if (alphabet === null || typeof alphabet !== 'object' || !Array.isArray(alphabet.symbols)) {
+    const given = typeof alphabet === 'string' ? `the name '${alphabet}'` : String(alphabet);
+    throw new TypeError(
+      `${caller}: alphabet must be a PhonemeAlphabet, as findAlphabet(name) returns it, not ${given}`,
+    );
+  }
+  return alphabet;
+}
+
 /**
  * Symbol `symbol` of `alphabet`: its name and viseme, or null if there is no such symbol.
+ * Throws TypeError when `alphabet` is not an alphabet object (its name, for example):
+ * `findPhoneme(findAlphabet(ARPABET_ALPHABET), 16)`.
  * @param {import('./index.js').PhonemeAlphabet} alphabet
  * @param {number} symbol
  * @returns {{name: string, viseme: number} | null}
  */
 export function findPhoneme(alphabet, symbol) {
-  return alphabet.symbols[symbol] ?? null;
+  return checkAlphabet(alphabet, 'findPhoneme').symbols[symbol] ?? null;
 }
 
 /**
- * The symbol of the phoneme called `name` in `alphabet`, or null.
+ * The symbol of the phoneme called `name` in `alphabet`, or null. Throws TypeError when
+ * `alphabet` is not an alphabet object, as findPhoneme.
  * @param {import('./index.js').PhonemeAlphabet} alphabet
  * @param {string} name
+ * @returns {number | null}
  */
 export function findSymbol(alphabet, name) {
-  const i = alphabet.symbols.findIndex((p) => p.name === name);
+  const i = checkAlphabet(alphabet, 'findSymbol').symbols.findIndex((p) => p.name === name);
   return i < 0 ? null : i;
 }

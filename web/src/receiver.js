@@ -32,6 +32,10 @@ function ticksToNs(ticks, clockRate) {
   return seconds * 1e9 + Math.round((rest * 1e9) / clockRate);
 }
 
+/**
+ * The whole receiver: RTP packets in (receive), events with their stream times out (onEvent),
+ * and the talking head at any stream time (faps, pose, draw), as rtppfapdepay ! pfapface.
+ */
 export class PfapReceiver {
   /**
    * @param {import('./index.js').PfapReceiverOptions} [options]
@@ -96,7 +100,7 @@ export class PfapReceiver {
     }
     const decoded = decodePayload(rtp.payload);
     ++this.stats.packets;
-    if (!decoded.ok) {
+    if (decoded.ok === false) {
       this._warn(
         'malformedPayload',
         `dropped malformed payload of packet ${rtp.sequenceNumber}: ${decoded.error} at byte ${decoded.offset}`,

@@ -7,6 +7,10 @@
 import { FapState } from './fap_state.js';
 import { MAX_FAP_INDEX, MIN_FAP_INDEX, NS_PER_MS } from './model.js';
 
+/**
+ * The receiver's side of FAP loss recovery, as pfap::RecoveryReceiver: loss from sequence
+ * numbers, recovery applied when its coverage spans the gap, complete states.
+ */
 export class RecoveryReceiver {
   /**
    * @param {{retryNs?: number}} [options] retryNs: how long after a request for a complete
@@ -36,6 +40,7 @@ export class RecoveryReceiver {
    * @returns {import('./index.js').ReceiveResult}
    */
   receive(packet, sequenceNumber, timeNs) {
+    /** @type {import('./index.js').ReceiveResult} */
     const result = { recovery: 'none', changed: false, stateWhole: true, requestComplete: false, lost: 0 };
     if (this._lastSequenceNumber !== null) {
       const gap = (sequenceNumber - this._lastSequenceNumber - 1) & 0xffff;

@@ -43,10 +43,25 @@ test('index.d.ts type-checks, and a page written against it too (tsc --strict)',
   }
 });
 
-test('npm pack ships the modules and their types', () => {
+test('npm pack ships the modules, their types and the README', () => {
   const [pack] = JSON.parse(execFileSync('npm', ['pack', '--dry-run', '--json'], { cwd: root, encoding: 'utf8', stdio: ['ignore', 'pipe', 'ignore'] }));
   const files = pack.files.map((f) => f.path).sort();
-  assert.deepEqual(files, ['package.json', 'src/index.d.ts', ...sources.map((f) => `src/${f}`)].sort());
+  assert.deepEqual(files, ['README.md', 'package.json', 'src/index.d.ts', ...sources.map((f) => `src/${f}`)].sort());
+});
+
+// The README's "Example" section: its first js block, and the text block it says it prints.
+function readmeExample(readme) {
+  const section = readme.split(/^## /m).find((s) => s.startsWith('Example\n'));
+  assert.ok(section, 'no "## Example" section in README.md');
+  const code = section.match(/```js\n([\s\S]*?)```/);
+  const output = section.match(/```text\n([\s\S]*?)```/);
+  assert.ok(code && output, 'the Example section has no js block, or no text block of its output');
+  return { code: code[1], output: output[1] };
+}
+
+test('the README names every export', () => {
+  const readme = readFileSync(path.join(root, 'README.md'), 'utf8');
+  for (const name of Object.keys(pfap)) assert.match(readme, new RegExp(`\`(new )?${name}\\b`), name);
 });
 
 test('the tarball installs into a project, and import \'pfap\' gives the package', () => {
@@ -62,7 +77,22 @@ test('the tarball installs into a project, and import \'pfap\' gives the package
     const out = JSON.parse(execFileSync(process.execPath, ['use.js'], quiet));
     assert.deepStrictEqual(out, { ok: true, packet: { complete: false, coverage: 0, recovery: [], phonemes: [
       { symbol: 7, duration: 80, f0: 0, stress: false, wordBegin: true, endOfText: false, faps: [] }] } });
+    // The README as installed, and its example run there as it says, printing what it says.
+    const example = readmeExample(readFileSync(path.join(dir, 'node_modules', 'pfap', 'README.md'), 'utf8'));
+    writeFileSync(path.join(dir, 'example.mjs'), example.code);
+    assert.equal(execFileSync(process.execPath, ['example.mjs'], quiet), example.output);
   } finally {
     rmSync(dir, { recursive: true, force: true });
   }
+});
+
+test('findPhoneme and findSymbol take the alphabet object, and say so when given its name', () => {
+  const arpabet = pfap.findAlphabet(pfap.ARPABET_ALPHABET);
+  assert.deepEqual(pfap.findPhoneme(arpabet, 16), { name: 'HH', viseme: pfap.Viseme.KG });
+  assert.equal(pfap.findSymbol(arpabet, 'HH'), 16);
+  for (const [call, name] of [[() => pfap.findPhoneme(pfap.ARPABET_ALPHABET, 16), 'findPhoneme'],
+    [() => pfap.findSymbol(pfap.ARPABET_ALPHABET, 'HH'), 'findSymbol']]) {
+    assert.throws(call, { name: 'TypeError', message: `${name}: alphabet must be a PhonemeAlphabet, as findAlphabet(name) returns it, not the name 'x-pfap-arpabet'` });
+  }
+  assert.throws(() => pfap.findPhoneme(null, 16), { name: 'TypeError', message: /^findPhoneme: alphabet must be a PhonemeAlphabet.* not null$/ });
 });

@@ -173,3 +173,55 @@ test('three browsers at once each get their own whole session; one says somethin
     assert.equal(s.fapStateMatchesSender, true);
   }
 });
+
+// Exactly the README's line, `chromium --allow-loopback-in-peer-connection URL` (headless,
+// and --no-sandbox as root): Chromium hides its host candidates behind mDNS names here, and
+// on a machine with only lo it gathered none the server could reach, so the page said
+// "connecting" for ever. The server's STUN server gives it one (docs/web.md).
+test('the README\'s chromium line connects, and speaks after a click', async () => {
+  const readme = await chromium.launch({
+    executablePath: CHROMIUM,
+    args: ['--no-sandbox', '--allow-loopback-in-peer-connection'],
+  });
+  const server = await startServer(['--text=One, two.']);
+  try {
+    const page = await readme.newPage();
+    await page.goto(server.url);
+    await page
+        .waitForFunction(() => window.pfapStats?.connected, null, {timeout: 20000, polling: 100})
+        .catch(async (e) => {
+          throw new Error(`${e.message}\nstatus: ${await page.textContent('#status')}\nserver: ${
+              server.log()}`);
+        });
+    await page.click('canvas');  // the gesture that lets the page play sound
+    await page.waitForFunction(
+        () => window.pfapStats.done >= 1, null, {timeout: 20000, polling: 100});
+    const s = await page.evaluate(() => window.pfapStats);
+    assert.ok(s.phonemes > 0);
+    assert.equal(s.phonemes, s.sender.phonemes);
+  } finally {
+    await readme.close();
+    assert.equal(await server.stop(), 0, server.log());
+  }
+});
+
+test('a page the server refuses says why', async () => {
+  const server = await startServer(['--max-sessions=1']);
+  const pages = [];
+  try {
+    for (let i = 0; i < 2; ++i) {
+      const page = await browser.newPage();
+      pages.push(page);
+      await page.goto(server.url);
+      await page.waitForFunction(() => window.pfapStats, null, {timeout: 10000});
+    }
+    await pages[1].waitForFunction(
+        () => window.pfapStats.problem, null, {timeout: 10000, polling: 100});
+    assert.match(
+        await pages[1].textContent('#status'),
+        /^closed by the server: the server is full: 1 sessions at once/);
+  } finally {
+    for (const page of pages) await page.close();
+    assert.equal(await server.stop(), 0, server.log());
+  }
+});

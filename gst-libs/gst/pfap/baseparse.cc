@@ -16,7 +16,13 @@ struct GstPfapBaseParsePrivate {
   GstPad* srcpad;
   gboolean need_events;  // stream-start, caps or segment still to send
   gboolean discont;
+  gboolean at_start;  // the bytes read so far may be the start of a byte order mark
+  gsize mark_bytes;   // how many of them there are
 };
+
+// A UTF-8 byte order mark (U+FEFF), which editors on Windows put at the start of a text file,
+// is no part of any format read here: it is dropped before the subclass reads.
+constexpr std::string_view kByteOrderMark = "\xEF\xBB\xBF";
 
 }  // namespace
 
@@ -35,6 +41,8 @@ GstPad* gst_pfap_base_parse_srcpad(GstPfapBaseParse* parse) { return priv(parse)
 static void reset(GstPfapBaseParse* parse) {
   priv(parse)->need_events = TRUE;
   priv(parse)->discont = TRUE;
+  priv(parse)->at_start = TRUE;
+  priv(parse)->mark_bytes = 0;
   GstPfapBaseParseClass* klass = GST_PFAP_BASE_PARSE_GET_CLASS(parse);
   if (klass->reset != nullptr) klass->reset(parse);
 }
@@ -86,6 +94,33 @@ GstFlowReturn gst_pfap_base_parse_push(GstPfapBaseParse* parse, const pfap::Text
   return gst_pad_push(p.srcpad, buffer);
 }
 
+// Hands `data` to the subclass without a byte order mark at the start of the text, even one
+// split across buffers. `end`: the input has ended (`data` empty).
+static GstFlowReturn read_text(GstPfapBaseParse* parse, std::string_view data, bool end) {
+  GstPfapBaseParsePrivate& p = *priv(parse);
+  GstPfapBaseParseClass* klass = GST_PFAP_BASE_PARSE_GET_CLASS(parse);
+  if (p.at_start) {
+    while (!data.empty() && p.mark_bytes < kByteOrderMark.size() &&
+           data[0] == kByteOrderMark[p.mark_bytes]) {
+      data.remove_prefix(1);
+      ++p.mark_bytes;
+    }
+    if (p.mark_bytes == kByteOrderMark.size()) {
+      p.at_start = FALSE;
+    } else if (data.empty() && !end) {
+      return GST_FLOW_OK;  // the rest of a mark may come with the next buffer
+    } else {
+      // Not a mark: the bytes held back are text.
+      p.at_start = FALSE;
+      if (p.mark_bytes > 0) {
+        const GstFlowReturn ret = klass->read_chunk(parse, kByteOrderMark.substr(0, p.mark_bytes));
+        if (ret != GST_FLOW_OK) return ret;
+      }
+    }
+  }
+  return data.empty() ? GST_FLOW_OK : klass->read_chunk(parse, data);
+}
+
 static GstFlowReturn gst_pfap_base_parse_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
   GstPfapBaseParse* parse = GST_PFAP_BASE_PARSE(parent);
   GstMapInfo map;
@@ -94,8 +129,8 @@ static GstFlowReturn gst_pfap_base_parse_chain(GstPad*, GstObject* parent, GstBu
     GST_ELEMENT_ERROR(parse, RESOURCE, READ, (nullptr), ("cannot map the input buffer"));
     return GST_FLOW_ERROR;
   }
-  const GstFlowReturn ret = GST_PFAP_BASE_PARSE_GET_CLASS(parse)->read_chunk(
-      parse, {reinterpret_cast<const char*>(map.data), map.size});
+  const GstFlowReturn ret =
+      read_text(parse, {reinterpret_cast<const char*>(map.data), map.size}, false);
   gst_buffer_unmap(buffer, &map);
   gst_buffer_unref(buffer);
   return ret;
@@ -115,7 +150,8 @@ static gboolean gst_pfap_base_parse_sink_event(GstPad* pad, GstObject* parent, G
       gst_event_unref(event);
       return TRUE;
     case GST_EVENT_EOS: {
-      const GstFlowReturn ret = klass->finish != nullptr ? klass->finish(parse) : GST_FLOW_OK;
+      GstFlowReturn ret = read_text(parse, {}, true);
+      if (ret == GST_FLOW_OK && klass->finish != nullptr) ret = klass->finish(parse);
       // The error is posted; the stream did not end well.
       if (ret == GST_FLOW_ERROR) {
         gst_event_unref(event);
@@ -159,4 +195,5 @@ static void gst_pfap_base_parse_class_init(GstPfapBaseParseClass* klass) {
 static void gst_pfap_base_parse_init(GstPfapBaseParse* parse) {
   priv(parse)->need_events = TRUE;
   priv(parse)->discont = TRUE;
+  priv(parse)->at_start = TRUE;
 }

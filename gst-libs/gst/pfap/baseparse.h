@@ -3,11 +3,11 @@
 // pfapmarksparse), which read text from any chunks and output application/x-pfap events in a
 // TIME segment from 0, the times coming from the text. As GstBaseParse does for its
 // parsers, it holds the pads and the stream's frame: each buffer is mapped and handed to
-// read_chunk; the upstream stream-start goes on sparse (sparse.h); upstream caps, segments
-// and gaps are dropped; at EOS finish reads what is left, then the output's first events go
-// if no buffer sent them, then EOS; a flush or READY to PAUSED calls reset. The output
-// cannot seek (noseek.h). A subclass adds pad templates "sink" and "src" and keeps only its
-// reader and properties.
+// read_chunk, a UTF-8 byte order mark at the start of the text left out; the upstream
+// stream-start goes on sparse (sparse.h); upstream caps, segments and gaps are dropped; at EOS
+// finish reads what is left, then the output's first events go if no buffer sent them, then
+// EOS; a flush or READY to PAUSED calls reset. The output cannot seek (noseek.h). A subclass
+// adds pad templates "sink" and "src" and keeps only its reader and properties.
 #pragma once
 
 #include <gst/gst.h>

@@ -104,6 +104,12 @@ class FapRecorder {
   // The FAP file: every FAP that is ever non-zero is set in every frame, so that readers that
   // hold a FAP the mask leaves out and readers that take it for 0 read the same values.
   FapFile file(const std::string& name, NotWritten* not_written = nullptr) const;
+  // The same file a frame at a time, for a writer that keeps no more than the amplitudes:
+  // its header, the mask of every frame, and frame `number` (< frames()) with that mask.
+  using Mask = std::array<bool, kFapFileFaps + 1>;
+  FapFileHeader header(const std::string& name) const;
+  Mask mask() const;
+  FapFrame frame(uint32_t number, const Mask& mask, NotWritten& not_written) const;
   void reset();
 
  private:

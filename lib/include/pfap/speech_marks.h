@@ -48,8 +48,10 @@ class MarksWriter {
   // phoneme), and to close after the last: pfapface's animator's kMouthEaseNs.
   static constexpr int64_t kMouthEaseNs = 80'000'000;
   // ARKit frames of a rest (every phoneme, transition and closing mouth over) longer than
-  // this are left out: the frames after it keep their times, so a reader sees the jump.
-  static constexpr int64_t kMaxRestNs = 10'000'000'000;
+  // this are left out: the frames after it keep their times, so a reader sees the jump. It
+  // bounds the frames an event can make: what it keeps moving (a phoneme and its 80 ms ease,
+  // up to 4.2 s; a transition, up to 16.4 s), then this rest.
+  static constexpr int64_t kMaxRestNs = 1'000'000'000;
   // A phoneme whose viseme is unknown (no alphabet, or a symbol not in it) is written as
   // this half-open mouth, the nearest to pfapface's generic mouth.
   static constexpr VisemeSet kUnknownVisemes{Viseme::kE, OculusViseme::kE, 4, 14, 3};
@@ -70,6 +72,8 @@ class MarksWriter {
 
   // Phonemes written as kUnknownVisemes since the start.
   uint64_t unknown_phonemes() const { return unknown_phonemes_; }
+  // Rests cut at kMaxRestNs since the start.
+  uint64_t cut_rests() const { return cut_rests_; }
   bool overflow() const { return overflow_; }
 
   struct Spoken {
@@ -93,6 +97,7 @@ class MarksWriter {
   const PhonemeAlphabet* alphabet_ = nullptr;
   std::vector<Spoken> utterance_;
   uint64_t unknown_phonemes_ = 0;
+  uint64_t cut_rests_ = 0;
   bool overflow_ = false;
   bool wrote_header_ = false;
   // ARKit frames.
@@ -156,9 +161,15 @@ class MarksReader {
   // One line (without its end) of Polly, Azure or Rhubarb TSV. Blank lines give nothing. On
   // error nothing is kept from the line.
   MarksResult read_line(std::string_view line, std::vector<TextEvent>& out);
-  // A whole Rhubarb JSON document; its last cue ends at its end. On error, the events of the
-  // cues before the bad one have been given.
-  MarksResult read_document(std::string_view document, std::vector<TextEvent>& out);
+  // Told of a bad cue of a Rhubarb JSON document; returns true to leave it out and go on.
+  using BadCue = std::function<bool(const MarksResult&)>;
+  // A whole Rhubarb JSON document; its last cue ends at its end. A bad cue is given to
+  // `bad_cue`: left out when it returns true (a gap it leaves is a rest, like any gap between
+  // cues), else reading stops there and returns it, every cue before given, the last one
+  // ending at its end. Without `bad_cue`, the first bad cue stops. A document that is not
+  // JSON, or has no mouthCues array, gives nothing.
+  MarksResult read_document(std::string_view document, std::vector<TextEvent>& out,
+                            const BadCue& bad_cue = {});
   // The last viseme, at the end of the input.
   void finish(std::vector<TextEvent>& out);
   void reset();

@@ -1,0 +1,213 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""A load generator for tools/pfap-web (issue 28, "Sessions per server"): N sessions, each a
+real WebRTC peer (Debian's python3-aiortc) but not a browser, opened at once. Each answers
+the offer, says it plays, and checks that the Opus track brings audio and the data channel
+every PFAP packet the server sent for its text (the count and the last sequence number of the
+server's "done" message; nothing is dropped; the audio is counted in Opus RTP packets). Prints one line per session and a summary;
+exits 1 if a session is not whole.
+
+    pfap_web_load.py [N] [TEXT]        (PFAP_WEB names the server; as root)
+
+It runs in a network namespace of its own (unshare -n): aiortc leaves loopback addresses
+out of its ICE candidates, so the namespace gets a veth pair, both ends inside it with
+addresses that exist only there (10.99.0.1 and .2); aiortc offers those and reaches the
+server's 127.0.0.1 from them. No packet leaves the namespace."""
+import asyncio
+import base64
+import json
+import os
+import re
+import shutil
+import struct
+import subprocess
+import sys
+import time
+
+
+def enter_network_namespace():
+    if os.environ.get('PFAP_WEB_NETNS') == '1':
+        return
+    try:
+        import aiortc  # noqa: F401
+    except ImportError:
+        print('SKIP: no aiortc (scripts/install-deps installs python3-aiortc)')
+        sys.exit(77)
+    if os.geteuid() != 0 or shutil.which('unshare') is None or shutil.which('ip') is None:
+        print('SKIP: needs root, unshare and ip (a network namespace with lo and a veth pair)')
+        sys.exit(77)
+    os.environ['PFAP_WEB_NETNS'] = '1'
+    setup = ('ip link set lo up && ip link add pfap0 type veth peer name pfap1 && '
+             'ip addr add 10.99.0.1/24 dev pfap0 && ip addr add 10.99.0.2/24 dev pfap1 && '
+             'ip link set pfap0 up && ip link set pfap1 up && exec "$0" "$@"')
+    os.execvp('unshare', ['unshare', '-n', 'sh', '-c', setup, sys.executable, *sys.argv])
+
+
+class WebSocket:
+    """Just enough of a WebSocket client on asyncio streams: text messages."""
+
+    @classmethod
+    async def connect(cls, port):
+        self = cls()
+        self.reader, self.writer = await asyncio.open_connection('127.0.0.1', port)
+        key = base64.b64encode(os.urandom(16)).decode()
+        self.writer.write((f'GET /ws HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nUpgrade: websocket\r\n'
+                           f'Connection: Upgrade\r\nSec-WebSocket-Key: {key}\r\n'
+                           'Sec-WebSocket-Version: 13\r\n\r\n').encode())
+        head = await self.reader.readuntil(b'\r\n\r\n')
+        if b' 101 ' not in head.split(b'\r\n')[0]:
+            raise RuntimeError(head.split(b'\r\n')[0].decode())
+        return self
+
+    def send(self, message):
+        data = json.dumps(message).encode()
+        mask = os.urandom(4)
+        size = len(data)
+        header = bytes([0x81]) + (bytes([0x80 | size]) if size < 126 else
+                                  bytes([0x80 | 126]) + struct.pack('!H', size) if size < 65536
+                                  else bytes([0x80 | 127]) + struct.pack('!Q', size))
+        self.writer.write(header + mask + bytes(b ^ mask[i % 4] for i, b in enumerate(data)))
+
+    async def receive(self):
+        while True:
+            first, second = await self.reader.readexactly(2)
+            size = second & 0x7f
+            if size == 126:
+                size = struct.unpack('!H', await self.reader.readexactly(2))[0]
+            elif size == 127:
+                size = struct.unpack('!Q', await self.reader.readexactly(8))[0]
+            payload = await self.reader.readexactly(size)
+            if first & 0x0f == 8:
+                raise ConnectionError(f'closed by the server {payload[2:].decode(errors="replace")}')
+            if first & 0x0f == 1:
+                return json.loads(payload)
+
+
+async def session(port, number, deadline_s):
+    from aiortc import RTCPeerConnection, RTCSessionDescription
+    from aiortc.sdp import candidate_from_sdp
+
+    result = {'session': number, 'audio_packets': 0, 'packets': 0, 'last_seq': None,
+              'sender': None, 'error': None}
+    pc = RTCPeerConnection()
+    ws = await WebSocket.connect(port)
+    channel_open = asyncio.Event()
+
+    @pc.on('datachannel')
+    def on_datachannel(channel):
+        channel_open.set()
+
+        @channel.on('message')
+        def on_message(message):
+            result['packets'] += 1
+            result['last_seq'] = struct.unpack('!H', message[2:4])[0]
+
+    try:
+        async with asyncio.timeout(deadline_s):
+            while True:
+                m = await ws.receive()
+                if m['type'] == 'offer':
+                    await pc.setRemoteDescription(RTCSessionDescription(m['sdp'], 'offer'))
+                    await pc.setLocalDescription(await pc.createAnswer())
+                    ws.send({'type': 'answer', 'sdp': pc.localDescription.sdp})
+                    # The server starts the audio and the text once the page plays.
+                    asyncio.ensure_future(say_playing_when_open(ws, channel_open))
+                elif m['type'] == 'ice' and m['candidate']:
+                    c = candidate_from_sdp(m['candidate'].split(':', 1)[1])
+                    c.sdpMLineIndex = m['sdpMLineIndex']
+                    c.sdpMid = str(m['sdpMLineIndex'])
+                    await pc.addIceCandidate(c)
+                elif m['type'] == 'error':
+                    raise ConnectionError(m['message'])
+                elif m['type'] == 'done':
+                    result['sender'] = m
+                    break
+            # The last packets may come after the message: a moment for them.
+            end = time.monotonic() + 2
+            while result['last_seq'] != m['lastSequenceNumber'] and time.monotonic() < end:
+                await asyncio.sleep(0.05)
+            for receiver in pc.getReceivers():
+                for stats in (await receiver.getStats()).values():
+                    if stats.type == 'inbound-rtp' and stats.kind == 'audio':
+                        result['audio_packets'] = stats.packetsReceived
+    except Exception as e:  # noqa: BLE001 (reported per session)
+        result['error'] = f'{type(e).__name__}: {e}'
+    finally:
+        await pc.close()
+        ws.writer.close()
+    return result
+
+
+async def say_playing_when_open(ws, channel_open):
+    await channel_open.wait()
+    ws.send({'type': 'playing'})
+
+
+def whole(r):
+    s = r['sender']
+    return (r['error'] is None and s is not None and r['audio_packets'] > 0 and s['dropped'] == 0
+            and r['packets'] == s['packets'] and r['last_seq'] == s['lastSequenceNumber'])
+
+
+async def main():
+    sessions = int(sys.argv[1]) if len(sys.argv) > 1 else 4
+    text = sys.argv[2] if len(sys.argv) > 2 else 'One, two, three.'
+    server = subprocess.Popen([os.environ['PFAP_WEB'], '--port=0', f'--text={text}'],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    line = ''
+    while 'open http' not in line:
+        line = server.stdout.readline()
+        if not line:
+            raise SystemExit(f'pfap-web did not start: {server.stderr.read()}')
+    port = int(re.search(r'127\.0\.0\.1:(\d+)/', line).group(1))
+    base = (len(os.listdir(f'/proc/{server.pid}/fd')), len(os.listdir(f'/proc/{server.pid}/task')))
+    peak = list(base)
+
+    async def sample():
+        while True:
+            peak[0] = max(peak[0], len(os.listdir(f'/proc/{server.pid}/fd')))
+            peak[1] = max(peak[1], len(os.listdir(f'/proc/{server.pid}/task')))
+            await asyncio.sleep(0.05)
+
+    def cpu_s():
+        fields = open(f'/proc/{server.pid}/stat').read().rsplit(')', 1)[1].split()
+        return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
+    sampler = asyncio.ensure_future(sample())
+    start = time.monotonic()
+    cpu_start = cpu_s()
+    results = await asyncio.gather(*(session(port, i + 1, 60) for i in range(sessions)))
+    took = time.monotonic() - start
+    cpu = cpu_s() - cpu_start
+    rss_peak = open(f'/proc/{server.pid}/status').read().split('VmHWM:')[1].split('\n')[0].strip()
+    sampler.cancel()
+    server.terminate()
+    out, err = server.communicate(timeout=30)
+    for r in results:
+        s = r['sender'] or {}
+        print(f"session {r['session']}: {'whole' if whole(r) else 'NOT WHOLE'}: "
+              f"{r['audio_packets']} Opus packets, {r['packets']} of {s.get('packets')} PFAP "
+              f"packets, last sequence number {r['last_seq']} of {s.get('lastSequenceNumber')}"
+              + (f", {r['error']}" if r['error'] else ''))
+    good = sum(whole(r) for r in results)
+    print(f'pfap-web: {base[0]} file descriptors and {base[1]} threads alone, at most {peak[0]} '
+          f'and {peak[1]} with the sessions ({(peak[0] - base[0]) / sessions:.1f} and '
+          f'{(peak[1] - base[1]) / sessions:.1f} per session); CPU {cpu:.2f} s in {took:.1f} s '
+          f'({cpu / took / sessions * 100:.1f} % of a core per session); peak RSS {rss_peak}')
+    print(f'{good} of {sessions} sessions whole in {took:.1f} s; pfap-web exited {server.returncode}')
+    if good != sessions or server.returncode != 0:
+        print(err[-2000:], file=sys.stderr)
+        sys.exit(1)
+
+
+def skip_opus_decoding():
+    """aiortc 1.4's Opus decoder takes only 20 ms frames and fails on pfap-web's 10 ms ones:
+    the audio is counted in RTP packets (the receiver's stats), not decoded."""
+    from aiortc.codecs import opus
+    opus.OpusDecoder.decode = lambda self, frame: []
+
+
+if __name__ == '__main__':
+    enter_network_namespace()
+    skip_opus_decoding()
+    asyncio.run(main())
