@@ -54,6 +54,7 @@
 #include "pfap/payload.h"
 #include "pfap/recovery.h"
 #include "ratelimit.h"
+#include "speech_level.h"
 
 namespace {
 
@@ -387,22 +388,17 @@ GstPadProbeReturn on_sink_gap(GstPad*, GstPadProbeInfo* info, gpointer data) {
 struct Envelope {
   std::weak_ptr<Session> session;
   GstClockTime offset = 0;  // the speaker's pad offset: its running time in the pipeline's
-  GstClockTime start = GST_CLOCK_TIME_NONE;  // running time of levels[0]
-  std::vector<int64_t> levels;               // RMS of each ms, S16 units
-  double sum = 0.0;
-  int count = 0;
+  GstClockTime start = GST_CLOCK_TIME_NONE;  // running time of the first level waiting
+  SpeechLevel level;
 };
 
-constexpr int kSamplesPerLevel = 48;  // 1 ms of the speaker's S16 mono at 48 kHz
-constexpr size_t kLevelsPerMessage = 50;
-
 void send_envelope(Envelope& e) {
-  if (e.levels.empty()) return;
-  const bool silent =
-      std::all_of(e.levels.begin(), e.levels.end(), [](int64_t v) { return v == 0; });
+  if (e.level.empty()) return;
+  const std::vector<int64_t> levels = e.level.take();
+  const bool silent = std::all_of(levels.begin(), levels.end(), [](int64_t v) { return v == 0; });
   std::shared_ptr<Session> session = e.session.lock();
   if (!silent && session != nullptr) {
-    post(session, [start = e.start, levels = e.levels](Session& s) {
+    post(session, [start = e.start, levels](Session& s) {
       JsonBuilder* b = message("envelope");
       member(b, "runningTimeNs", static_cast<int64_t>(start));
       json_builder_set_member_name(b, "rms");
@@ -412,8 +408,7 @@ void send_envelope(Envelope& e) {
       finish(s, b);
     });
   }
-  e.start += e.levels.size() * GST_MSECOND;
-  e.levels.clear();
+  e.start += levels.size() * GST_MSECOND;
 }
 
 GstPadProbeReturn on_speech(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
@@ -439,16 +434,8 @@ GstPadProbeReturn on_speech(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
   }
   GstMapInfo map;
   if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) return GST_PAD_PROBE_OK;
-  const auto* samples = reinterpret_cast<const int16_t*>(map.data);
-  for (size_t i = 0; i < map.size / 2; ++i) {
-    e.sum += static_cast<double>(samples[i]) * samples[i];
-    if (++e.count == kSamplesPerLevel) {
-      e.levels.push_back(std::lround(std::sqrt(e.sum / kSamplesPerLevel)));
-      e.sum = 0.0;
-      e.count = 0;
-      if (e.levels.size() == kLevelsPerMessage) send_envelope(e);
-    }
-  }
+  e.level.add({reinterpret_cast<const int16_t*>(map.data), map.size / 2},
+              [&] { send_envelope(e); });
   gst_buffer_unmap(buffer, &map);
   return GST_PAD_PROBE_OK;
 }

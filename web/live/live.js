@@ -13,7 +13,7 @@
 //
 // window.pfapStats holds the figures the browser test reads.
 import { PfapReceiver, Viseme, parseRtp } from '../src/index.js';
-import { SentLevel, matchLevels } from './clock.js';
+import { DrawnPhonemes, PlayoutClock, drawInTime, showCounts } from './playout.js';
 
 /**
  * Lip sync measured against the sound: each speech onset (the level passing 3 % of the
@@ -79,28 +79,23 @@ export function start({ canvas, audio, form, input, status, saying }) {
   const ws = new WebSocket(`ws://${location.host}/ws`);
   const send = (m) => ws.readyState === WebSocket.OPEN && ws.send(JSON.stringify(m));
   const pc = new RTCPeerConnection({ iceServers: [] });
-  const ctx = canvas.getContext('2d');
   let timing = null;
   let firstPfapTimestamp = null;
   let lastSequenceNumber = null;
   let audioReceiver = null;
   let audioContext = null;
-  // The running time (ms) heard at performance time t is t + mappingAt(t): from the
-  // synchronization source's readings until the played audio's level has been found in the
-  // sender's, then from that match and the jitter buffer's stretching since (docs/web.md).
-  const sent = new SentLevel();
-  const readings = [];  // [heard from, running time less heard time]
-  const stretches = [];  // [heard from, samples removed less inserted]
-  let matched = null;  // {m: running time less heard time, stretch: the stretch then}
-  const phonemes = [];  // {timeNs, pressed}: which phoneme is drawn when (lip-sync measurement)
-  let drawn = 0;  // the phoneme drawn last
+  // The running time heard: from the synchronization source's readings until the played
+  // audio's level has been found in the sender's, then from that match and the jitter
+  // buffer's stretching since (playout.js, docs/web.md).
+  const clock = new PlayoutClock({ envelope: stats.envelope });
+  const drawnPhonemes = new DrawnPhonemes(stats.frames);
 
   const receiver = new PfapReceiver({
     clockRate: 44100,
     onEvent: (e) => {
       if (e.kind === 'phoneme') {
         ++stats.phonemes;
-        phonemes.push({ timeNs: e.timeNs, pressed: e.phoneme.viseme === Viseme.PBM });
+        drawnPhonemes.add(e.timeNs, e.phoneme.viseme === Viseme.PBM);
       }
       if (e.uncertain) ++stats.uncertain;
     },
@@ -108,14 +103,7 @@ export function start({ canvas, audio, form, input, status, saying }) {
     onWarning: (w) => console.warn(w),
   });
 
-  const show = () => {
-    const s = receiver.stats;
-    Object.assign(stats, { packets: s.packets, lost: s.lost, recovered: s.recovered, complete: s.completeStates, late: s.late });
-    for (const key of ['phonemes', 'packets', 'lost', 'late', 'recovered', 'complete', 'uncertain']) {
-      document.getElementById(key).textContent = String(stats[key]);
-    }
-    document.getElementById('matches').textContent = stats.sender ? (stats.fapStateMatchesSender ? 'yes' : 'no') : '-';
-  };
+  const show = () => showCounts(receiver, stats);
 
   // The sender's FAP state after a text: equal to ours once every packet, or the recovery
   // of those lost, has come. Packets lost at the end have nothing after them to recover
@@ -144,7 +132,8 @@ export function start({ canvas, audio, form, input, status, saying }) {
     // Chromium feeds a remote track to Web Audio only while a media element plays it; the
     // element is muted, the speech heard through the AudioContext, whose tap sees it too.
     audio.srcObject = stream;
-    playThroughWebAudio(stream);
+    audioContext = clock.play(stream);
+    clock.followStretching(audioReceiver);
     // The server starts the audio when it is played (tools/pfap-web.cc, start_when_ready).
     // Browsers start an AudioContext only after a gesture on the page, unless allowed to.
     const running = new Promise((resolve) => {
@@ -210,7 +199,7 @@ export function start({ canvas, audio, form, input, status, saying }) {
     } else if (m.type === 'ice') {
       await pc.addIceCandidate({ candidate: m.candidate, sdpMLineIndex: m.sdpMLineIndex });
     } else if (m.type === 'envelope') {
-      sent.add(m.runningTimeNs, m.rms);
+      clock.sent.add(m.runningTimeNs, m.rms);
     } else if (m.type === 'saying') {
       ++stats.texts;
       stats.sender = null;
@@ -234,57 +223,6 @@ export function start({ canvas, audio, form, input, status, saying }) {
     if (input.value.trim()) send({ type: 'say', text: input.value });
   };
 
-  function playThroughWebAudio(stream) {
-    audioContext = new AudioContext({ latencyHint: 'interactive', sampleRate: 48000 });
-    const source = audioContext.createMediaStreamSource(stream);
-    source.connect(audioContext.destination);
-    audioContext.audioWorklet.addModule(new URL('./tap.js', import.meta.url)).then(() => {
-      const tap = new AudioWorkletNode(audioContext, 'pfap-tap');
-      source.connect(tap);
-      tap.port.onmessage = (m) => {
-        // AudioContext time to performance time, at the output (what is heard when).
-        const { contextTime, performanceTime } = audioContext.getOutputTimestamp();
-        const data = m.data;
-        for (let i = 0; i < data.length; i += 2) {
-          stats.envelope.push({ t: performanceTime + (data[i] - contextTime) * 1000, rms: data[i + 1] });
-        }
-        matchHeard();
-      };
-    });
-    audioContext.resume();
-  }
-
-  // The output's latency, which the synchronization source's timestamp is before the sound.
-  const latencyMs = () => (audioContext.baseLatency + (audioContext.outputLatency || 0)) * 1000;
-
-  // The value of `history` ([from, value], in order) at heard time t.
-  const valueAt = (history, t, otherwise) => {
-    for (let i = history.length - 1; i >= 0; --i) if (history[i][0] <= t) return history[i][1];
-    return history.length > 0 ? history[0][1] : otherwise;
-  };
-  const remember = (history, from, value) => {
-    if (history.length === 0 || history.at(-1)[1] !== value) history.push([from, value]);
-    if (history.length > 1000) history.splice(0, 500);
-  };
-
-  function mappingAt(t) {
-    if (!matched) return valueAt(readings, t, null);
-    return matched.m + (valueAt(stretches, t, 0) - matched.stretch) / (timing.audioClockRate / 1000);
-  }
-
-  // The last 150 ms of the audio played, found in the sender's level (clock.js).
-  function matchHeard() {
-    const env = stats.envelope;
-    if (env.length === 0 || readings.length === 0) return;
-    const newest = env.at(-1).t;
-    const heard = [];
-    for (let i = env.length - 1; i >= 0 && env[i].t >= newest - 150; --i) {
-      heard.push({ x: env[i].t + mappingAt(env[i].t), rms: env[i].rms });
-    }
-    const lag = matchLevels(heard.reverse(), (ms) => sent.at(ms));
-    if (lag !== null) matched = { m: mappingAt(newest) + lag, stretch: valueAt(stretches, newest, 0) };
-  }
-
   // The PFAP stream time of the audio heard at performance time `now`, or null before the
   // audio and the PFAP stream have both begun.
   function streamNs(now) {
@@ -293,40 +231,14 @@ export function start({ canvas, audio, form, input, status, saying }) {
     if (!source) return null;
     // The chunk it names is heard from its timestamp plus the latency on; until then the
     // readings before hold (they differ when the jitter buffer stretches the audio).
-    const heardFrom = source.timestamp - performance.timeOrigin + latencyMs();
+    const heardFrom = source.timestamp - performance.timeOrigin + clock.latencyMs();
     const rtpMs = ((source.rtpTimestamp - timing.audioTimestampOffset) >>> 0) / timing.audioClockRate * 1000;
-    remember(readings, heardFrom, rtpMs - heardFrom);
-    const running = (now + mappingAt(now)) / 1000;
+    clock.reading(heardFrom, rtpMs);
+    const running = clock.runningMs(now) / 1000;
     const first = ((firstPfapTimestamp - timing.pfapTimestampOffset) >>> 0) / timing.pfapClockRate;
     return Math.round((running - first) * 1e9);
   }
 
-  // The jitter buffer's stretching (getStats), from when it is heard: a poll sees a change
-  // some time in the 25 ms before it, which is heard the output's latency later.
-  setInterval(async () => {
-    if (!audioReceiver || !audioContext) return;
-    const polled = performance.now();
-    (await audioReceiver.getStats()).forEach((v) => {
-      if (v.type !== 'inbound-rtp') return;
-      const net = (v.removedSamplesForAcceleration ?? 0) - (v.insertedSamplesForDeceleration ?? 0);
-      remember(stretches, polled - 12.5 + latencyMs(), net);
-    });
-  }, 25);
-
-  const frame = (now) => {
-    const ns = streamNs(now);
-    if (ns !== null) {
-      stats.streamNs = ns;
-      stats.endNs = receiver.animator.endNs;
-      receiver.draw(ctx, ns, { style: 'cartoon' });
-      while (drawn + 1 < phonemes.length && phonemes[drawn + 1].timeNs <= ns) ++drawn;
-      const pressed = drawn < phonemes.length && phonemes[drawn].timeNs <= ns && phonemes[drawn].pressed;
-      stats.frames.push({ t: now, pressed });
-      if (stats.frames.length > 20000) stats.frames.splice(0, 10000);
-      if (stats.envelope.length > 200000) stats.envelope.splice(0, 100000);
-    }
-    requestAnimationFrame(frame);
-  };
-  requestAnimationFrame(frame);
+  drawInTime({ receiver, canvas, stats, streamNs, drawn: drawnPhonemes });
   stats.measureLipSync = () => (stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames));
 }

@@ -1,0 +1,137 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// The talking head broadcast through Janus (docs/web.md): Debian's janus with the project's
+// configuration (scripts/janus-config), tools/pfap-broadcast as the sender, and Debian's
+// chromium, headless, driven by playwright-core, as the viewers; their window.pfapStats say
+// what arrived.
+//
+// Run by tests/web/janus-broadcast.sh inside a network namespace of its own (lo and a veth
+// pair for Janus's ICE, PFAP_JANUS_ICE_ADDRESS), with PFAP_BROADCAST (the sender),
+// PFAP_SOURCE_ROOT and GST_PLUGIN_PATH set. PFAP_BROADCAST_OUT=FILE writes every page's
+// figures there.
+import assert from 'node:assert/strict';
+import dgram from 'node:dgram';
+import { writeFileSync } from 'node:fs';
+import { after, before, test } from 'node:test';
+
+import {
+  COMPLETE_INTERVAL_MS, DATA_PORT, exited, figures, launchChromium, openViewer, servePages, startJanus, startSender, stop,
+} from './janus.js';
+
+// Sharp onsets after silence for the lip-sync measurement (each "pa" sounds as its closed
+// lips open; nothing else in the text presses the lips, so no onset pairs with another
+// word's), five bookmarks for the FAP state to repair, and long enough (about 8 s) for the
+// late joiner.
+const TEXT = 'pa. pa. <FAP 2 1 40 0 0 800 3> pa. pa. <FAP 48 6000 400 2> pa. pa. pa. ' +
+  '<FAP 2 6 50 0 0 300 2> pa. pa. pa. <FAP 2 1 50 0 0 800 3> pa. pa. pa. <FAP 48 -4000 400 2> pa. pa. pa. ' +
+  'pa. pa. pa. pa. pa. pa. pa. pa.';
+
+let browser;
+let janus;
+let pageServer;
+
+before(async () => {
+  janus = await startJanus();
+  pageServer = await servePages();
+  browser = await launchChromium();
+});
+
+after(async () => {
+  await browser?.close();
+  pageServer?.close();
+  if (janus) {
+    // Janus stops cleanly on SIGTERM, as on Ctrl-C.
+    const status = await stop(janus);
+    janus.cleanup();
+    assert.equal(status, 0, `janus stopped by SIGTERM:\n${janus.log}`);
+  }
+});
+
+test('three viewers through Janus, a tenth of the PFAP datagrams dropped before it: each whole and in lip sync; a late joiner whole within a complete-state interval', async () => {
+  const open = () => openViewer(browser, pageServer, janus);
+  const viewers = await Promise.all([open(), open(), open()]);
+  const sender = startSender(TEXT, ['--drop=0.1', '--seed=3']);
+  // Bad input on the data port, as from a confused or hostile sender: each page drops both
+  // messages whole, counts them, and goes on.
+  await new Promise((r) => setTimeout(r, 1000));
+  const socket = dgram.createSocket('udp4');
+  for (const bad of ['{not json', '{"type": "level", "rms": [1, 2, 3]}']) {
+    await new Promise((r) => socket.send(bad, DATA_PORT, '127.0.0.1', r));
+  }
+  socket.close();
+  // A fourth joins 1.5 s into the speech.
+  await new Promise((r) => setTimeout(r, 500));
+  const late = await open();
+  const all = await Promise.all([...viewers, late].map((page) => figures(page)));
+  assert.equal(await exited(sender), 0, sender.log);
+  const sent = JSON.parse(sender.out.trim().split('\n').at(-1));
+  if (process.env.PFAP_BROADCAST_OUT) writeFileSync(process.env.PFAP_BROADCAST_OUT, JSON.stringify({ sent, pages: all }));
+
+  assert.ok(sent.dropped > 0, 'some PFAP datagrams dropped');
+  for (const [i, s] of all.entries()) {
+    const which = `page ${i + 1}: ${JSON.stringify(s)}`;
+    assert.deepEqual(s.sender.settled, sent.settled, which);
+    assert.equal(s.fapStateMatchesSender, true, which);
+    assert.equal(s.streams, 1, which);
+    assert.ok(s.matched, `the played level found in the sender's: ${which}`);
+    if (i === 3) continue;
+    assert.equal(s.malformed, 2, which);
+    // Every phoneme Janus had to relay: all but those of the datagrams dropped before it.
+    assert.equal(s.phonemes, sent.phonemes - sent.phonemesDropped, which);
+    assert.equal(s.packets, sent.packets - sent.dropped, which);
+    assert.ok(s.lost > 0, which);
+    // Whole from the stream's first complete state that arrives (with this seed the opening
+    // one is among those dropped: the pages wait for a later one).
+    assert.ok(s.wholeAfterMs !== null, which);
+  }
+  // Lip sync, sanity only (the figures go to docs/web.md), over the three pages together: a
+  // share of the onsets paired (under load a page's audio glitches and its onsets go
+  // unpaired), and their median a few frames from the sound at most.
+  const errors = all.slice(0, 3).flatMap((s) => s.lipSyncErrorsMs);
+  assert.ok(errors.length >= 12, `onsets paired (of 3 x 24): ${JSON.stringify(errors)}`);
+  const median = [...errors].sort((a, b) => a - b)[Math.floor(errors.length / 2)];
+  assert.ok(median >= -20 && median <= 40, `median lip sync error ${median} ms: ${JSON.stringify(errors)}`);
+  // The late joiner: joined mid-stream, whole from the first complete state, which comes
+  // within an interval of stream time (and the packet it goes before) of its first packet.
+  const s = all[3];
+  assert.ok(s.phonemes > 0 && s.phonemes < sent.phonemes - sent.phonemesDropped, JSON.stringify(s));
+  assert.ok(s.wholeAfterMs !== null && s.wholeAfterMs <= COMPLETE_INTERVAL_MS + 500, `whole after ${s.wholeAfterMs} ms`);
+});
+
+test('the sender restarts mid-sentence: each viewer takes the new stream and ends whole with it', async () => {
+  const open = () => openViewer(browser, pageServer, janus);
+  const viewers = await Promise.all([open(), open()]);
+  const first = startSender(TEXT);
+  await new Promise((r) => setTimeout(r, 2500));
+  assert.equal(await stop(first), 0, first.log);  // SIGTERM mid-sentence: it stops cleanly
+  const second = startSender('Hello again. <FAP 2 1 40 0 0 500 1> I am back, pa. pa.', ['--drop=0.1', '--seed=5']);
+  const all = await Promise.all(viewers.map((page) => figures(page)));
+  assert.equal(await exited(second), 0, second.log);
+  const sent = JSON.parse(second.out.trim().split('\n').at(-1));
+  for (const [i, s] of all.entries()) {
+    const which = `page ${i + 1}: ${JSON.stringify(s)}`;
+    assert.equal(s.streams, 2, which);
+    assert.equal(s.sender.ssrc, sent.ssrc, which);
+    assert.equal(s.fapStateMatchesSender, true, which);
+    assert.ok(s.matched, which);
+  }
+});
+
+test('Janus restarts mid-sentence: each viewer watches again and ends whole with the stream', async () => {
+  const open = () => openViewer(browser, pageServer, janus);
+  const viewers = await Promise.all([open(), open()]);
+  const sender = startSender(TEXT);
+  await new Promise((r) => setTimeout(r, 2000));
+  assert.equal(await stop(janus), 0, janus.log);
+  janus.cleanup();
+  janus = await startJanus();
+  const all = await Promise.all(viewers.map((page) => figures(page)));
+  assert.equal(await exited(sender), 0, sender.log);
+  const sent = JSON.parse(sender.out.trim().split('\n').at(-1));
+  for (const [i, s] of all.entries()) {
+    const which = `page ${i + 1}: ${JSON.stringify(s)}`;
+    assert.equal(s.reconnects, 1, which);
+    assert.equal(s.sender.ssrc, sent.ssrc, which);
+    assert.equal(s.fapStateMatchesSender, true, which);
+    assert.ok(s.matched, which);
+  }
+});

@@ -1,0 +1,165 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// What the broadcast's browser test (janus-broadcast.browser.js) and its benchmark
+// (../bench/janus-viewers.browser.js) share: Janus with the project's configuration
+// (scripts/janus-config), the viewer page served as scripts/broadcast serves it, the sender,
+// Debian's chromium and the viewers. All run inside the network namespace that
+// tests/web/janus-broadcast.sh makes (its ports are the namespace's own).
+import { execFileSync, spawn } from 'node:child_process';
+import { createReadStream, existsSync, mkdtempSync, readFileSync, rmSync, statSync } from 'node:fs';
+import http from 'node:http';
+import os from 'node:os';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+import { chromium } from 'playwright-core';
+
+const webDir = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
+const sourceRoot = process.env.PFAP_SOURCE_ROOT ?? path.resolve(webDir, '..');
+export const JANUS_PORT = 8088;
+export const AUDIO_PORT = 5002;
+export const DATA_PORT = 5004;
+// rtppfappay's complete-recovery-interval (its default): a late joiner is whole within it.
+export const COMPLETE_INTERVAL_MS = 1000;
+
+// Stops a child with SIGTERM (as Ctrl-C would); resolves to its exit status, or to the signal
+// that ended it (SIGKILL after 10 s if SIGTERM did not).
+export function stop(child) {
+  return new Promise((resolve) => {
+    if (child.exitCode !== null || child.signalCode !== null) {
+      resolve(child.exitCode ?? child.signalCode);
+      return;
+    }
+    const kill = setTimeout(() => child.kill('SIGKILL'), 10000);
+    child.once('exit', (code, signal) => {
+      clearTimeout(kill);
+      resolve(code ?? signal);
+    });
+    child.kill('SIGTERM');
+  });
+}
+
+/** Runs `file`; its stdout collects in `.out`, its stderr in `.log`. */
+export function run(file, args) {
+  const child = spawn(file, args, { stdio: ['ignore', 'pipe', 'pipe'] });
+  child.out = '';
+  child.log = '';
+  child.stdout.on('data', (d) => { child.out += d; });
+  child.stderr.on('data', (d) => { child.log += d; });
+  return child;
+}
+
+/** Resolves to the exit status of `child` once it has ended. */
+export function exited(child) {
+  return new Promise((resolve) => (child.exitCode !== null ? resolve(child.exitCode) : child.once('exit', resolve)));
+}
+
+/** CPU time (user and system, s) that process `pid` has used. */
+export function cpuSeconds(pid) {
+  const fields = readFileSync(`/proc/${pid}/stat`, 'utf8').split(') ')[1].split(' ');
+  return (Number(fields[11]) + Number(fields[12])) / 100;  // utime, stime in clock ticks (USER_HZ 100)
+}
+
+/** Starts Janus in a temporary directory; resolves once its API answers. */
+export async function startJanus() {
+  const tmp = mkdtempSync(path.join(os.tmpdir(), 'pfap-janus-'));
+  execFileSync(path.join(sourceRoot, 'scripts', 'janus-config'), [path.join(tmp, 'janus'), String(JANUS_PORT),
+    String(AUDIO_PORT), String(DATA_PORT), process.env.PFAP_JANUS_ICE_ADDRESS]);
+  const janus = run('janus', ['-F', path.join(tmp, 'janus'), '-C', path.join(tmp, 'janus', 'janus.jcfg')]);
+  janus.cleanup = () => rmSync(tmp, { recursive: true, force: true });
+  for (let i = 0; i < 100; ++i) {
+    try {
+      if ((await fetch(`http://127.0.0.1:${JANUS_PORT}/janus/info`)).ok) return janus;
+    } catch {
+      // not yet
+    }
+    await new Promise((r) => setTimeout(r, 100));
+  }
+  throw new Error(`Janus does not answer:\n${janus.out}${janus.log}`);
+}
+
+/** The sender, saying `text` with `args` (--drop=P, --seed=S). */
+export function startSender(text, args = []) {
+  return run(process.env.PFAP_BROADCAST, [`--audio-port=${AUDIO_PORT}`, `--data-port=${DATA_PORT}`, `--text=${text}`, ...args]);
+}
+
+// The viewer page and what it imports, as scripts/broadcast serves them.
+const served = {
+  '/src/': path.join(webDir, 'src'),
+  '/live/': path.join(webDir, 'live'),
+  '/broadcast/': path.join(webDir, 'broadcast'),
+  '/janus-gateway/': '/usr/share/javascript/janus-gateway',
+  '/webrtc-adapter/': '/usr/share/javascript/webrtc-adapter',
+};
+const types = { '.html': 'text/html', '.js': 'text/javascript' };
+
+/** Serves the viewer page on a free port of 127.0.0.1. */
+export function servePages() {
+  const server = http.createServer((req, res) => {
+    const url = new URL(req.url, 'http://127.0.0.1');
+    const prefix = Object.keys(served).find((p) => url.pathname.startsWith(p));
+    let file = prefix && path.join(served[prefix], path.normalize(url.pathname.slice(prefix.length)));
+    if (file && existsSync(file) && statSync(file).isDirectory()) file = path.join(file, 'index.html');
+    if (!file || !file.startsWith(served[prefix]) || !existsSync(file)) {
+      res.writeHead(404).end();
+      return;
+    }
+    res.writeHead(200, { 'Content-Type': types[path.extname(file)] ?? 'application/octet-stream' });
+    createReadStream(file).pipe(res);
+  });
+  return new Promise((resolve) => server.listen(0, '127.0.0.1', () => resolve(server)));
+}
+
+/** Debian's chromium, headless, allowed to play sound unasked. */
+export function launchChromium() {
+  return chromium.launch({
+    executablePath: process.env.PFAP_CHROMIUM ?? '/usr/bin/chromium',
+    args: [
+      '--no-sandbox',  // as root (the namespace needs it)
+      '--autoplay-policy=no-user-gesture-required',
+      '--allow-loopback-in-peer-connection',  // pfap-web's ICE is on 127.0.0.1
+      '--disable-features=WebRtcHideLocalIpsWithMdns',
+    ],
+  });
+}
+
+/** Opens `url` in a new page of `browser`, its console and failed loads kept in `.messages`. */
+export async function newPage(browser, url) {
+  const page = await browser.newPage({ viewport: { width: 640, height: 720 } });
+  const messages = [];
+  page.on('console', (m) => messages.push(m.text()));
+  page.on('response', (r) => r.status() >= 400 && messages.push(`${r.status()} ${r.url()}`));
+  page.messages = messages;
+  await page.goto(url);
+  return page;
+}
+
+/** Opens a viewer page; resolves once it receives the mountpoint's data stream. */
+export async function openViewer(browser, pageServer, janus) {
+  const { port } = pageServer.address();
+  const page = await newPage(browser, `http://127.0.0.1:${port}/broadcast/?janus=http://127.0.0.1:${JANUS_PORT}/janus`);
+  await page.waitForFunction(() => window.pfapStats?.dataOpen, null, { timeout: 30000, polling: 100 })
+    .catch((e) => { throw new Error(`${e.message}\npage: ${page.messages.join('\n')}\njanus: ${janus.out}${janus.log}`); });
+  return page;
+}
+
+/**
+ * Waits until the page has the sender's state at the end and has played the audio past the
+ * last phoneme (pfap-web's page and the viewer page alike); its figures (lip sync measured).
+ */
+export async function figures(page, { timeout = 30000 } = {}) {
+  const read = () => page.evaluate(() => {
+    const s = window.pfapStats;
+    s.measureLipSync();
+    const { envelope, frames, ...rest } = s;
+    return rest;
+  });
+  try {
+    await page.waitForFunction(() => window.pfapStats.done >= 1 && window.pfapStats.streamNs > window.pfapStats.endNs + 3e8,
+      null, { timeout, polling: 100 });
+    return await read();
+  } catch (e) {
+    throw new Error(`${e.message}\n${JSON.stringify(await read())}\npage: ${page.messages.join('\n')}`);
+  } finally {
+    await page.close();
+  }
+}
