@@ -38,6 +38,7 @@
 #include "pfap/phoneme_table.h"
 #include "viseme_detector.h"
 #include "viseme_frames.h"
+#include "wav_file.h"
 
 namespace {
 
@@ -45,35 +46,10 @@ using pfap::align::TimedSymbol;
 
 const pfap::PhonemeAlphabet& arpabet() { return *pfap::find_alphabet(pfap::kArpabetAlphabet); }
 
-bool read_wav(const std::string& path, std::vector<int16_t>& samples, unsigned& rate) {
-  std::ifstream in(path, std::ios::binary);
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (bytes.size() < 12 || bytes.compare(0, 4, "RIFF") != 0) return false;
-  auto u32 = [&](size_t at) {
-    uint32_t v;
-    std::memcpy(&v, bytes.data() + at, 4);
-    return v;
-  };
-  auto u16 = [&](size_t at) {
-    uint16_t v;
-    std::memcpy(&v, bytes.data() + at, 2);
-    return v;
-  };
-  bool format_ok = false;
-  for (size_t at = 12; at + 8 <= bytes.size();) {
-    const std::string id = bytes.substr(at, 4);
-    const uint32_t size = u32(at + 4);
-    if (id == "fmt ") {
-      format_ok = u16(at + 8) == 1 && u16(at + 10) == 1 && u16(at + 22) == 16;
-      rate = u32(at + 12);
-    } else if (id == "data" && format_ok) {
-      const size_t n = std::min<size_t>(size, bytes.size() - at - 8) / 2;
-      samples.resize(n);
-      std::memcpy(samples.data(), bytes.data() + at + 8, n * 2);
-      return true;
-    }
-    at += 8 + size + (size & 1);
-  }
+// `path` as 16-bit mono PCM, or false with a message.
+bool load(const std::string& path, std::vector<int16_t>& samples, unsigned& rate) {
+  if (pfap::tools::read_wav(path, samples, rate)) return true;
+  std::fprintf(stderr, "%s: not 16-bit mono PCM\n", path.c_str());
   return false;
 }
 
@@ -169,10 +145,7 @@ int label(int argc, char** argv) {
   if (argc != 5) return 2;
   std::vector<int16_t> samples;
   unsigned rate = 0;
-  if (!read_wav(argv[2], samples, rate)) {
-    std::fprintf(stderr, "%s: not 16-bit mono PCM\n", argv[2]);
-    return 1;
-  }
+  if (!load(argv[2], samples, rate)) return 1;
   std::ifstream text_in(argv[3]);
   std::stringstream text;
   text << text_in.rdbuf();
@@ -194,10 +167,7 @@ int features(int argc, char** argv) {
     const std::string base = std::string(argv[2]) + "/" + argv[a];
     std::vector<int16_t> samples;
     unsigned rate = 0;
-    if (!read_wav(base + ".wav", samples, rate)) {
-      std::fprintf(stderr, "%s.wav: not 16-bit mono PCM\n", base.c_str());
-      return 1;
-    }
+    if (!load(base + ".wav", samples, rate)) return 1;
     const std::vector<float> f = pfap::align::viseme_features(samples, rate);
     const size_t frames = f.size() / pfap::align::kVisemeMfccs;
     std::vector<pfap::Viseme> truth = pfap::align::viseme_frames(
@@ -246,10 +216,7 @@ int eval(int argc, char** argv) {
     const std::string base = std::string(argv[2]) + "/" + argv[a];
     std::vector<int16_t> samples;
     unsigned rate = 0;
-    if (!read_wav(base + ".wav", samples, rate)) {
-      std::fprintf(stderr, "%s.wav: not 16-bit mono PCM\n", base.c_str());
-      return 1;
-    }
+    if (!load(base + ".wav", samples, rate)) return 1;
     const double duration = static_cast<double>(samples.size()) / rate;
     seconds += duration;
     const std::clock_t c0 = std::clock();
@@ -299,10 +266,7 @@ int trace(int argc, char** argv) {
   if (argc != 4) return 2;
   std::vector<int16_t> samples;
   unsigned rate = 0;
-  if (!read_wav(argv[2], samples, rate)) {
-    std::fprintf(stderr, "%s: not 16-bit mono PCM\n", argv[2]);
-    return 1;
-  }
+  if (!load(argv[2], samples, rate)) return 1;
   std::vector<float> probabilities;
   const std::vector<pfap::align::VisemeRun> runs = detect(samples, rate, &probabilities);
   std::ofstream out(argv[3]);
