@@ -37,6 +37,7 @@
 #include "pfap/phoneme_table.h"
 #include "recognizer.h"
 #include "streaming.h"
+#include "viseme_detector.h"
 #include "viseme_frames.h"
 
 namespace {
@@ -245,6 +246,21 @@ bool recognize_live(const std::vector<int16_t>& samples, unsigned rate,
   return true;
 }
 
+// The frame-level viseme detector (align/viseme_detector.h) over the recording in 20 ms
+// blocks: each 10 ms frame's viseme.
+std::vector<pfap::Viseme> detect_visemes(const std::vector<int16_t>& samples, unsigned rate) {
+  pfap::align::VisemeDetector detector(rate);
+  std::vector<pfap::align::VisemeRun> runs;
+  const size_t block = std::max(1u, rate / 50);
+  for (size_t i = 0; i < samples.size(); i += block) {
+    detector.push(std::span(samples).subspan(i, std::min(block, samples.size() - i)), runs);
+  }
+  detector.finish(runs);
+  std::vector<pfap::Viseme> out;
+  for (const pfap::align::VisemeRun& r : runs) out.insert(out.end(), r.frames, r.viseme);
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -279,6 +295,8 @@ int main(int argc, char** argv) {
   double live_seconds = 0, live_cpu_seconds = 0;
   size_t live_lag = 0;                     // samples, at 16 kHz or the corpus's rate
   std::vector<pfap::Viseme> truth_frames;  // every sentence's, for the baseline
+  Agreement detector_agreement;            // the frame-level viseme detector's
+  double detector_cpu_seconds = 0;
   for (int a = 2; a < argc; ++a) {
     const std::string base = dir + "/" + argv[a];
     std::vector<int16_t> samples;
@@ -354,6 +372,9 @@ int main(int argc, char** argv) {
     truth_frames.insert(truth_frames.end(), truth_visemes.begin(), truth_visemes.end());
     aligned_agreement.add(pfap::align::viseme_frames(timed(alignment.phonemes, rate), duration),
                           truth_visemes);
+    const std::clock_t d0 = std::clock();
+    detector_agreement.add(detect_visemes(samples, rate), truth_visemes);
+    detector_cpu_seconds += static_cast<double>(std::clock() - d0) / CLOCKS_PER_SEC;
     double recognized_share = 0;
     if (recognize) {
       pfap::align::Recognition recognition;
@@ -446,6 +467,7 @@ int main(int argc, char** argv) {
     live_offline_agreement.print("live against offline (not Festival)");
   }
   aligned_agreement.print("with text (pfapalign)");
+  detector_agreement.print("frame-level viseme detector, live");
   const auto commonest = std::max_element(count.begin(), count.end());
   const auto commonest_speech = std::max_element(speech_count.begin(), speech_count.end());
   std::printf("%-36s %5.1f %% of frames (viseme %zu), %5.1f %% of speech frames (viseme %zu)\n",
@@ -454,6 +476,8 @@ int main(int argc, char** argv) {
               static_cast<size_t>(commonest - count.begin()),
               100.0 * static_cast<double>(*commonest_speech) / std::max<size_t>(speech_total, 1),
               static_cast<size_t>(commonest_speech - speech_count.begin()));
+  std::printf("viseme detector: %.2f s of processor time for %.1f s, %.2f %% of a core\n",
+              detector_cpu_seconds, audio_seconds, 100 * detector_cpu_seconds / audio_seconds);
   if (recognize) {
     // The processor time too: on a shared machine the wall clock measures the others' load.
     std::printf(

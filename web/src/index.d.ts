@@ -229,3 +229,18 @@ export declare const MAX_F0_HZ: 510;
 export declare function f0Code(hz: number): number;
 export declare function isValidFap(fap: Fap): boolean;
 export declare function isValidPhoneme(phoneme: Phoneme): boolean;
+
+/** The viseme detector (viseme_detector.js; align/viseme_detector.h in C++). */
+export declare const OCULUS_VISEME_ALPHABET: 'x-pfap-oculus-viseme';
+export declare const OCULUS_VISEMES: readonly string[];
+export declare const OCULUS_VISEME_TABLE: PhonemeAlphabet;
+export declare const VISEME_LOOKAHEAD_MS: number;
+export interface VisemeModel { hidden1: number; hidden2: number; params: Float32Array }
+export interface VisemeRun { start: number; frames: number; viseme: number }
+export declare function parseVisemeModel(text: string): VisemeModel;
+export declare class VisemeDetector {
+  constructor(rate: number, options: { model: VisemeModel; maxRunFrames?: number; switchMargin?: number; minRunFrames?: number; trace?: number[] | null });
+  readonly frames: number;
+  push(samples: Float32Array | number[]): VisemeRun[];
+  finish(): VisemeRun[];
+}

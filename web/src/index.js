@@ -10,6 +10,7 @@ export { ANGLE_UNIT, FAP_UNITS, addExpressions, expressionWeight, fapValues, pos
 export { Animator, MOUTH_EASE_NS, visemeShape } from './animator.js';
 export { Style, renderFace } from './renderer.js';
 export { DEFAULT_CLOCK_RATE, PfapReceiver } from './receiver.js';
+export { OCULUS_VISEMES, OCULUS_VISEME_ALPHABET, OCULUS_VISEME_TABLE, VISEME_LOOKAHEAD_MS, VisemeDetector, parseVisemeModel } from './viseme_detector.js';
 export {
   COVERAGE_STEPS, Curve, FAP_COUNT, FIRST_EXPRESSION_INDEX, MAX_AMPLITUDE, MAX_F0_HZ, MAX_FAP_INDEX,
   MAX_PHONEME_DURATION_MS, MAX_TRANSITION_MS, MIN_FAP_INDEX, NS_PER_MS, f0Code, isValidFap,

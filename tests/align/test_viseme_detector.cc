@@ -1,0 +1,228 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// The frame-level viseme detector (align/viseme_detector.h): agreement with espeak-ng's own
+// phoneme times on sentences in a voice it was not trained on, the runs tiling the audio
+// whatever the blocks, the lookahead it declares, and bad input (silence, noise, clipping,
+// other rates, a broken model) giving a clear result in bounded work.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "boundaries.h"
+#include "speech_fixtures.h"
+#include "viseme_detector.h"
+#include "viseme_frames.h"
+
+namespace pfap::align {
+namespace {
+
+// Three Harvard sentences (tools/align-sentences.txt, the held-out texts) in espeak-ng's
+// en-us+f2, a variant held out of the training (tools/viseme-corpus).
+const char* const kSentences[] = {
+    "The birch canoe slid on the smooth planks.",
+    "Glue the sheet to the dark blue background.",
+    "It's easy to tell the depth of a well.",
+};
+
+struct Spoken {
+  std::vector<int16_t> samples;
+  unsigned rate = 0;
+  std::vector<Viseme> truth;  // each 10 ms frame's, from the phonemes in phonetic convention
+};
+
+Spoken spoken(const char* text) {
+  tts::VoiceSettings voice;
+  voice.voice = "en-us+f2";
+  voice.rate = 165;
+  voice.pitch = 55;
+  tts::Speech speech = testing::say(text, voice);
+  to_phonetic_boundaries(speech);
+  std::vector<TimedSymbol> phonemes;
+  for (const tts::SpokenPhoneme& p : speech.phonemes) {
+    phonemes.push_back({static_cast<double>(p.start) / speech.sample_rate, p.event.phoneme.symbol});
+  }
+  const double seconds = static_cast<double>(speech.samples.size()) / speech.sample_rate;
+  return {speech.samples, speech.sample_rate, viseme_frames(phonemes, seconds)};
+}
+
+std::vector<VisemeRun> detect(std::span<const int16_t> samples, unsigned rate, size_t block,
+                              size_t max_run_frames = 0) {
+  VisemeDetector detector(rate, max_run_frames);
+  std::vector<VisemeRun> runs;
+  for (size_t i = 0; i < samples.size(); i += block) {
+    detector.push(samples.subspan(i, std::min(block, samples.size() - i)), runs);
+  }
+  detector.finish(runs);
+  return runs;
+}
+
+std::vector<Viseme> frames_of(const std::vector<VisemeRun>& runs) {
+  std::vector<Viseme> out;
+  for (const VisemeRun& r : runs) out.insert(out.end(), r.frames, r.viseme);
+  return out;
+}
+
+// The runs are contiguous from frame 0 and cover every 10 ms frame of `seconds` (the last
+// partly), none empty.
+void expect_tiles(const std::vector<VisemeRun>& runs, double seconds) {
+  uint64_t next = 0;
+  for (const VisemeRun& r : runs) {
+    EXPECT_EQ(r.start, next);
+    EXPECT_GT(r.frames, 0u);
+    next = r.start + r.frames;
+  }
+  EXPECT_EQ(next, static_cast<uint64_t>(std::ceil(seconds * 100 - 1e-9)));
+}
+
+TEST(VisemeDetector, HeldOutVoiceAgreesWithItsPhonemesWellAboveTheBaseline) {
+  size_t same = 0, frames = 0, pauses = 0, runs_total = 0;
+  double seconds = 0;
+  for (const char* text : kSentences) {
+    const Spoken s = spoken(text);
+    const std::vector<VisemeRun> runs = detect(s.samples, s.rate, s.rate / 50);
+    expect_tiles(runs, static_cast<double>(s.samples.size()) / s.rate);
+    const std::vector<Viseme> got = frames_of(runs);
+    for (size_t f = 0; f < std::min(got.size(), s.truth.size()); ++f) {
+      same += got[f] == s.truth[f];
+      pauses += s.truth[f] == Viseme::kNone;
+      ++frames;
+    }
+    runs_total += runs.size();
+    seconds += static_cast<double>(s.samples.size()) / s.rate;
+  }
+  const double agreement = static_cast<double>(same) / static_cast<double>(frames);
+  std::printf("agreement %.1f %% of %zu frames (pauses %.1f %%), %.1f runs a second\n",
+              100 * agreement, frames, 100.0 * static_cast<double>(pauses) / frames,
+              static_cast<double>(runs_total) / seconds);
+  // Measured 70 to 80 % on these (docs/align.md); the baseline of one viseme is under 20 %.
+  EXPECT_GT(agreement, 0.50);
+  // Smoothed: about 10 runs a second, not a flicker every frame or two.
+  EXPECT_LT(static_cast<double>(runs_total) / seconds, 20);
+}
+
+TEST(VisemeDetector, BlocksOfAnySizeGiveTheSameRuns) {
+  const Spoken s = spoken(kSentences[0]);
+  const std::vector<VisemeRun> whole = detect(s.samples, s.rate, s.samples.size());
+  for (size_t block : {size_t{1}, size_t{7}, size_t{441}, size_t{4096}}) {
+    const std::vector<VisemeRun> runs = detect(s.samples, s.rate, block);
+    ASSERT_EQ(runs.size(), whole.size()) << block;
+    for (size_t k = 0; k < runs.size(); ++k) {
+      EXPECT_EQ(runs[k].start, whole[k].start);
+      EXPECT_EQ(runs[k].frames, whole[k].frames);
+      EXPECT_EQ(runs[k].viseme, whole[k].viseme);
+    }
+  }
+}
+
+TEST(VisemeDetector, SettlesEachFrameWithinTheDeclaredLookahead) {
+  EXPECT_LE(kVisemeLookaheadMs, 60);
+  for (unsigned rate : {8000u, 16000u, 22050u, 44100u, 48000u}) {
+    const Spoken s = spoken(kSentences[1]);
+    const std::vector<int16_t> audio = testing::resample(s.samples, s.rate, rate);
+    VisemeDetector detector(rate);
+    std::vector<VisemeRun> runs;
+    const size_t block = rate / 100;  // 10 ms
+    for (size_t i = 0; i < audio.size(); i += block) {
+      detector.push(std::span(audio).subspan(i, std::min(block, audio.size() - i)), runs);
+      const double ms = static_cast<double>(std::min(i + block, audio.size())) * 1000 / rate;
+      // Every frame ending kVisemeLookaheadMs or more before the newest sample is settled.
+      const auto due = static_cast<uint64_t>(std::max(0.0, (ms - kVisemeLookaheadMs) / 10));
+      ASSERT_GE(detector.frames(), due) << rate << " Hz at " << ms << " ms";
+    }
+  }
+}
+
+TEST(VisemeDetector, PiecesKeepEveryRunWithinTheLimit) {
+  std::vector<int16_t> audio(16000 * 2, 0);  // two seconds of silence, then speech
+  const Spoken s = spoken(kSentences[2]);
+  const std::vector<int16_t> speech = testing::resample(s.samples, s.rate, 16000);
+  audio.insert(audio.end(), speech.begin(), speech.end());
+  const std::vector<VisemeRun> whole = detect(audio, 16000, 320);
+  const std::vector<VisemeRun> pieces = detect(audio, 16000, 320, 5);
+  EXPECT_TRUE(std::all_of(pieces.begin(), pieces.end(),
+                          [](const VisemeRun& r) { return r.frames <= 5; }));
+  EXPECT_EQ(frames_of(pieces), frames_of(whole));
+  EXPECT_GT(pieces.size(), whole.size());
+}
+
+TEST(VisemeDetector, SilenceIsOnePause) {
+  for (unsigned rate : {16000u, 48000u}) {
+    const std::vector<int16_t> silence(rate * 3, 0);
+    const std::vector<VisemeRun> runs = detect(silence, rate, rate / 50);
+    ASSERT_EQ(runs.size(), 1u);
+    EXPECT_EQ(runs[0].viseme, Viseme::kNone);
+    expect_tiles(runs, 3);
+  }
+  EXPECT_TRUE(detect(std::vector<int16_t>{}, 16000, 320).empty());
+}
+
+TEST(VisemeDetector, NoiseTilesTheAudioInFewRuns) {
+  // White noise at about -20 dBFS and a low hiss at about -60 dBFS: no speech to follow, so
+  // the runs must be few (no flicker), whatever visemes they show.
+  std::mt19937 rng(30);
+  for (double level : {3000.0, 30.0}) {
+    std::normal_distribution<double> noise(0, level);
+    std::vector<int16_t> audio(16000 * 3);
+    for (int16_t& x : audio) x = static_cast<int16_t>(std::clamp(noise(rng), -32768.0, 32767.0));
+    const std::vector<VisemeRun> runs = detect(audio, 16000, 320);
+    expect_tiles(runs, 3);
+    std::printf("noise of sd %.0f: %zu runs in 3 s, first viseme %d\n", level, runs.size(),
+                static_cast<int>(runs[0].viseme));
+    EXPECT_LT(runs.size(), 30u) << level;
+  }
+}
+
+TEST(VisemeDetector, ClippedAndResampledSpeechStillAgrees) {
+  const Spoken s = spoken(kSentences[0]);
+  auto agreement = [&](const std::vector<VisemeRun>& runs) {
+    return viseme_agreement(frames_of(runs), s.truth);
+  };
+  const double plain = agreement(detect(s.samples, s.rate, 441));
+  // Clipped: 12 dB louder, the peaks cut at full scale.
+  std::vector<int16_t> clipped(s.samples.size());
+  std::transform(s.samples.begin(), s.samples.end(), clipped.begin(), [](int16_t x) {
+    return static_cast<int16_t>(std::clamp(x * 4, -32768, 32767));
+  });
+  const double clip = agreement(detect(clipped, s.rate, 441));
+  std::printf("agreement: as spoken (%u Hz) %.2f, clipped %.2f", s.rate, plain, clip);
+  EXPECT_GT(clip, plain - 0.2);
+  for (unsigned rate : {8000u, 16000u, 44100u, 48000u}) {
+    const std::vector<int16_t> audio = testing::resample(s.samples, s.rate, rate);
+    const std::vector<VisemeRun> runs = detect(audio, rate, rate / 50);
+    expect_tiles(runs, static_cast<double>(audio.size()) / rate);
+    const double a = agreement(runs);
+    std::printf(", %u Hz %.2f", rate, a);
+    // 8 kHz audio has nothing above 4 kHz, where the mel bands up to 7.6 kHz look and the
+    // training never saw such speech: a clear result, not a good one (docs/align.md).
+    if (rate != 8000) {
+      EXPECT_GT(a, plain - 0.15) << rate;
+    }
+  }
+  std::printf("\n");
+}
+
+TEST(VisemeDetector, RatesOutsideTheRangeAreTakenAsTheNearest) {
+  // 4 kHz is read as 8 kHz and 400 kHz as 192 kHz: a clear (if wrong-speed) result, no crash.
+  for (unsigned rate : {4000u, 400000u, 0u}) {
+    const std::vector<int16_t> audio(8000, 1000);
+    const std::vector<VisemeRun> runs = detect(audio, rate, 100);
+    EXPECT_FALSE(runs.empty()) << rate;
+  }
+}
+
+TEST(VisemeDetector, ModelNumbersAreChecked) {
+  EXPECT_GT(VisemeModel::builtin().weights(), 10000u);
+  EXPECT_LT(VisemeModel::builtin().weights(), 40000u);
+  EXPECT_EQ(VisemeModel::from_numbers(std::vector<float>{}), nullptr);
+  EXPECT_EQ(VisemeModel::from_numbers(std::vector<float>{1, 13, 8, 4, 2, 2, 15}), nullptr);
+  std::vector<float> wrong_shape{1, 13, 8, 5, 2, 2, 15};
+  wrong_shape.resize(7 + 26 + 2 * 170 + 2 * 3 + 15 * 3);
+  EXPECT_EQ(VisemeModel::from_numbers(wrong_shape), nullptr);
+  std::vector<float> right{1, 13, 8, 4, 2, 2, 15};
+  right.resize(7 + 26 + 2 * 170 + 2 * 3 + 15 * 3);
+  EXPECT_NE(VisemeModel::from_numbers(right), nullptr);
+}
+
+}  // namespace
+}  // namespace pfap::align
