@@ -18,9 +18,11 @@ import * as receiver from '../src/receiver.js';
 import * as recovery from '../src/recovery.js';
 import * as renderer from '../src/renderer.js';
 import * as rtp from '../src/rtp.js';
+import * as visemeDetector from '../src/viseme_detector.js';
 
 type Code = typeof animator & typeof faceModel & typeof fapState & typeof model & typeof payload &
-  typeof phonemeTable & typeof receiver & typeof recovery & typeof renderer & typeof rtp;
+  typeof phonemeTable & typeof receiver & typeof recovery & typeof renderer & typeof rtp &
+  typeof visemeDetector;
 type Declarations = typeof Declared;
 
 type IsAny<T> = 0 extends 1 & T ? true : false;
