@@ -263,8 +263,10 @@ async def main():
     cpu = cpu_s() - cpu_start
     rss_peak = rss_kib(server.pid, 'VmHWM')
     sampler.cancel()
+    stopping = time.monotonic()
     server.terminate()
-    out, err = server.communicate(timeout=30)
+    out, err = server.communicate(timeout=120)
+    stopped_in = time.monotonic() - stopping
     decode_states(results)
     audio_worst, audio_late = late_summary(results, 'audio_times', AUDIO_CLOCK_RATE)
     pfap_worst, pfap_late = late_summary(results, 'pfap_times', PFAP_CLOCK_RATE)
@@ -299,7 +301,7 @@ async def main():
               f'{LATE_S * 1000:.0f} ms; PFAP worst {pfap_worst * 1000:.0f} ms, '
               f'{pfap_late * 100:.1f} % over {LATE_S * 1000:.0f} ms')
         print(f'{good} of {sessions} sessions whole in {took:.1f} s; pfap-web exited '
-              f'{server.returncode}')
+              f'{server.returncode}, {stopped_in:.1f} s after SIGTERM')
     if good != sessions or server.returncode != 0:
         print(err[-2000:], file=sys.stderr)
         sys.exit(1)
