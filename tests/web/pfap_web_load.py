@@ -12,7 +12,11 @@ against the stream's most punctual packet) and the share later than LATE_S say w
 server keeps real time. Prints one line per session and a summary (with --row, one Markdown
 table row for scripts/bench); exits 1 if a session is not whole.
 
-    pfap_web_load.py [--row] [N] [TEXT]   (PFAP_WEB names the server, NODE node; as root)
+    pfap_web_load.py [--row] [--threads] [N] [TEXT]   (PFAP_WEB names the server, NODE node;
+                                                       as root)
+
+--threads adds where the server's CPU time went, by thread name (GStreamer names a streaming
+thread after its element and pad), sampled every 0.5 s.
 
 It runs in a network namespace of its own (unshare -n): aiortc leaves loopback addresses
 out of its ICE candidates, so the namespace gets a veth pair, both ends inside it with
@@ -230,7 +234,8 @@ def late_summary(results, key, clock_rate):
 async def main():
     args = sys.argv[1:]
     row = '--row' in args
-    args = [a for a in args if a != '--row']
+    by_thread = '--threads' in args
+    args = [a for a in args if a not in ('--row', '--threads')]
     sessions = int(args[0]) if args else 4
     text = args[1] if len(args) > 1 else 'One, two, three.'
     server = subprocess.Popen([os.environ['PFAP_WEB'], '--port=0', f'--text={text}'],
@@ -244,11 +249,21 @@ async def main():
     base = (len(os.listdir(f'/proc/{server.pid}/fd')), len(os.listdir(f'/proc/{server.pid}/task')))
     peak = list(base)
     rss_base = rss_kib(server.pid, 'VmRSS')
+    thread_cpu = {}  # thread id: (name, CPU ticks), its last reading
 
     async def sample():
-        while True:
+        for tick in range(1 << 62):
             peak[0] = max(peak[0], len(os.listdir(f'/proc/{server.pid}/fd')))
             peak[1] = max(peak[1], len(os.listdir(f'/proc/{server.pid}/task')))
+            if by_thread and tick % 10 == 0:
+                for tid in os.listdir(f'/proc/{server.pid}/task'):
+                    try:
+                        stat = open(f'/proc/{server.pid}/task/{tid}/stat').read()
+                    except OSError:
+                        continue  # gone
+                    name = stat[stat.index('(') + 1:stat.rindex(')')]
+                    fields = stat.rsplit(')', 1)[1].split()
+                    thread_cpu[tid] = (name, int(fields[11]) + int(fields[12]))
             await asyncio.sleep(0.05)
 
     def cpu_s():
@@ -271,6 +286,15 @@ async def main():
     audio_worst, audio_late = late_summary(results, 'audio_times', AUDIO_CLOCK_RATE)
     pfap_worst, pfap_late = late_summary(results, 'pfap_times', PFAP_CLOCK_RATE)
     good = sum(whole(r) for r in results)
+    if by_thread:
+        groups = {}
+        for name, ticks in thread_cpu.values():
+            key = re.sub(r'\d+', 'N', name)
+            groups[key] = groups.get(key, 0) + ticks
+        total = sum(groups.values()) or 1
+        print('CPU by thread name (N: any number), sampled every 0.5 s:')
+        for key, ticks in sorted(groups.items(), key=lambda kv: -kv[1]):
+            print(f'  {key:18} {ticks / os.sysconf("SC_CLK_TCK"):6.2f} s  {ticks / total * 100:5.1f} %')
     if row:
         print(f'| {sessions} | {good} | {cpu / took / sessions * 100:.2f} % | '
               f'{(rss_peak - rss_base) / 1024 / sessions:.1f} MiB | '
