@@ -21,12 +21,12 @@ In a network namespace with lo and a veth pair, as tests/web/pfap_web_load.py.""
 import asyncio
 import os
 import re
-import subprocess
 import sys
 import threading
 import time
 
-from pfap_web_load import (WebSocket, enter_network_namespace, rss_kib, skip_opus_decoding)
+from pfap_web_load import (WebSocket, enter_network_namespace, rss_kib, skip_opus_decoding,
+                           start_server)
 
 WARM_UP = 9
 # Alive at exit whatever the sessions did: dtlsdec keeps one agent for its generated
@@ -102,17 +102,9 @@ async def main():
     kinds = sys.argv[3] if len(sys.argv) > 3 else 'nme'
     if not kinds or set(kinds) - set('nme'):
         raise SystemExit(f'KINDS is some of n, m and e: {kinds}')
-    server = subprocess.Popen([os.environ['PFAP_WEB'], '--port=0', f'--text={TEXT}',
-                               '--connect-timeout=1'],
-                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                              env=dict(os.environ, GST_TRACERS='leaks', GST_DEBUG_NO_COLOR='1',
-                                       GST_DEBUG='*:1,GST_TRACER:7'))
-    line = ''
-    while 'open http' not in line:
-        line = server.stdout.readline()
-        if not line:
-            raise SystemExit(f'pfap-web did not start: {server.stderr.read()}')
-    port = int(re.search(r'127\.0\.0\.1:(\d+)/', line).group(1))
+    server, port = start_server([f'--text={TEXT}', '--connect-timeout=1'],
+                                env=dict(os.environ, GST_TRACERS='leaks', GST_DEBUG_NO_COLOR='1',
+                                         GST_DEBUG='*:1,GST_TRACER:7'))
     opened, closed = set(), set()
     alive, err = {}, []
 

@@ -238,14 +238,7 @@ async def main():
     args = [a for a in args if a not in ('--row', '--threads')]
     sessions = int(args[0]) if args else 4
     text = args[1] if len(args) > 1 else 'One, two, three.'
-    server = subprocess.Popen([os.environ['PFAP_WEB'], '--port=0', f'--text={text}'],
-                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    line = ''
-    while 'open http' not in line:
-        line = server.stdout.readline()
-        if not line:
-            raise SystemExit(f'pfap-web did not start: {server.stderr.read()}')
-    port = int(re.search(r'127\.0\.0\.1:(\d+)/', line).group(1))
+    server, port = start_server([f'--text={text}'])
     base = (len(os.listdir(f'/proc/{server.pid}/fd')), len(os.listdir(f'/proc/{server.pid}/task')))
     peak = list(base)
     rss_base = rss_kib(server.pid, 'VmRSS')
@@ -329,6 +322,19 @@ async def main():
     if good != sessions or server.returncode != 0:
         print(err[-2000:], file=sys.stderr)
         sys.exit(1)
+
+
+def start_server(options, env=None):
+    """pfap-web (PFAP_WEB) on a free port with these options; returns it and its port once it
+    listens."""
+    server = subprocess.Popen([os.environ['PFAP_WEB'], '--port=0', *options],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    line = ''
+    while 'open http' not in line:
+        line = server.stdout.readline()
+        if not line:
+            raise SystemExit(f'pfap-web did not start: {server.stderr.read()}')
+    return server, int(re.search(r'127\.0\.0\.1:(\d+)/', line).group(1))
 
 
 def rss_kib(pid, field):
