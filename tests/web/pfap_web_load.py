@@ -4,10 +4,19 @@
 real WebRTC peer (Debian's python3-aiortc) but not a browser, opened at once. Each answers
 the offer, says it plays, and checks that the Opus track brings audio and the data channel
 every PFAP packet the server sent for its text (the count and the last sequence number of the
-server's "done" message; nothing is dropped; the audio is counted in Opus RTP packets). Prints one line per session and a summary;
-exits 1 if a session is not whole.
+server's "done" message; nothing is dropped; the audio is counted in Opus RTP packets), and
+that the FAP state those packets leave equals the sender's (the "done" message's settled
+values; the packets decoded by web/src/ in node, tests/web/pfap_web_state.mjs). Each also
+times every packet's arrival against its RTP timestamp: the worst lateness (lateness():
+against the stream's most punctual packet) and the share later than LATE_S say whether the
+server keeps real time. Prints one line per session and a summary (with --row, one Markdown
+table row for scripts/bench); exits 1 if a session is not whole.
 
-    pfap_web_load.py [N] [TEXT]        (PFAP_WEB names the server; as root)
+    pfap_web_load.py [--row] [--threads] [N] [TEXT]   (PFAP_WEB names the server, NODE node;
+                                                       as root)
+
+--threads adds where the server's CPU time went, by thread name (GStreamer names a streaming
+thread after its element and pad), sampled every 0.5 s.
 
 It runs in a network namespace of its own (unshare -n): aiortc leaves loopback addresses
 out of its ICE candidates, so the namespace gets a veth pair, both ends inside it with
@@ -23,6 +32,13 @@ import struct
 import subprocess
 import sys
 import time
+
+# A packet later than this after its time (lateness()) is late:
+# beyond what a WebRTC jitter buffer absorbs for audio. PFAP packets leave the server 400 ms
+# ahead of their audio (kPfapLead in tools/pfap-web.cc), so theirs is the stricter reading.
+LATE_S = 0.1
+AUDIO_CLOCK_RATE = 48000
+PFAP_CLOCK_RATE = 44100
 
 
 def enter_network_namespace():
@@ -88,7 +104,8 @@ async def session(port, number, deadline_s):
     from aiortc.sdp import candidate_from_sdp
 
     result = {'session': number, 'audio_packets': 0, 'packets': 0, 'last_seq': None,
-              'sender': None, 'error': None}
+              'sender': None, 'error': None, 'messages': [], 'pfap_times': [],
+              'audio_times': []}
     pc = RTCPeerConnection()
     ws = await WebSocket.connect(port)
     channel_open = asyncio.Event()
@@ -101,6 +118,9 @@ async def session(port, number, deadline_s):
         def on_message(message):
             result['packets'] += 1
             result['last_seq'] = struct.unpack('!H', message[2:4])[0]
+            result['messages'].append(message)
+            result['pfap_times'].append((time.monotonic(),
+                                         struct.unpack('!I', message[4:8])[0]))
 
     try:
         async with asyncio.timeout(deadline_s):
@@ -108,6 +128,8 @@ async def session(port, number, deadline_s):
                 m = await ws.receive()
                 if m['type'] == 'offer':
                     await pc.setRemoteDescription(RTCSessionDescription(m['sdp'], 'offer'))
+                    for receiver in pc.getReceivers():
+                        receiver.pfap_arrivals = result['audio_times']
                     await pc.setLocalDescription(await pc.createAnswer())
                     ws.send({'type': 'answer', 'sdp': pc.localDescription.sdp})
                     # The server starts the audio and the text once the page plays.
@@ -146,27 +168,95 @@ async def say_playing_when_open(ws, channel_open):
 def whole(r):
     s = r['sender']
     return (r['error'] is None and s is not None and r['audio_packets'] > 0 and s['dropped'] == 0
-            and r['packets'] == s['packets'] and r['last_seq'] == s['lastSequenceNumber'])
+            and r['packets'] == s['packets'] and r['last_seq'] == s['lastSequenceNumber']
+            and r['state_equal'])
+
+
+def decode_states(results):
+    """Each session's FAP state from its packets, by web/src/'s receiver in node, compared with
+    the settled values of the server's "done" message."""
+    node = os.environ.get('NODE') or shutil.which('node')
+    if node is None:
+        raise SystemExit('no node: it decodes the PFAP packets (scripts/install-deps)')
+    script = os.path.join(os.path.dirname(os.path.abspath(__file__)), 'pfap_web_state.mjs')
+    sessions = [[base64.b64encode(m).decode() for m in r['messages']] for r in results]
+    decoded = subprocess.run([node, script], input=json.dumps(sessions), capture_output=True,
+                             text=True, check=True)
+    sys.stderr.write(decoded.stderr)
+    for r, state in zip(results, json.loads(decoded.stdout)):
+        s = r['sender']
+        r['state_whole'] = state['stateWhole']
+        r['state_equal'] = (s is not None and state['stateWhole']
+                            and state['settled'] == s['settled'])
+        r['state_differs'] = [i + 3 for i, (a, b) in enumerate(zip(state['settled'],
+                                                                   (s or {}).get('settled', [])))
+                              if a != b]
+
+
+def lateness(times, clock_rate):
+    """Each packet's arrival less its RTP time (in s; timestamps unwrapped), less the least of
+    those: how much later than the stream's most punctual packet each came. A server that
+    falls behind real time shows as lateness that grows."""
+    if not times:
+        return []
+    offsets, ticks, last = [], 0, times[0][1]
+    for arrival, ts in times:
+        ticks += (ts - last + 2**31) % 2**32 - 2**31
+        last = ts
+        offsets.append(arrival - ticks / clock_rate)
+    least = min(offsets)
+    return [x - least for x in offsets]
+
+
+def record_audio_arrivals():
+    """Notes each Opus RTP packet's arrival and timestamp on its receiver's list (set by the
+    session once it has the offer)."""
+    from aiortc.rtcrtpreceiver import RTCRtpReceiver
+    handle = RTCRtpReceiver._handle_rtp_packet
+
+    async def noted(self, packet, arrival_time_ms):
+        arrivals = getattr(self, 'pfap_arrivals', None)
+        if arrivals is not None:
+            arrivals.append((time.monotonic(), packet.timestamp))
+        await handle(self, packet, arrival_time_ms)
+
+    RTCRtpReceiver._handle_rtp_packet = noted
+
+
+def late_summary(results, key, clock_rate):
+    """The worst lateness over every session's packets, and the share of them late."""
+    late = [x for r in results for x in lateness(r[key], clock_rate)]
+    if not late:
+        return 0.0, 0.0
+    return max(late), sum(x > LATE_S for x in late) / len(late)
 
 
 async def main():
-    sessions = int(sys.argv[1]) if len(sys.argv) > 1 else 4
-    text = sys.argv[2] if len(sys.argv) > 2 else 'One, two, three.'
-    server = subprocess.Popen([os.environ['PFAP_WEB'], '--port=0', f'--text={text}'],
-                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    line = ''
-    while 'open http' not in line:
-        line = server.stdout.readline()
-        if not line:
-            raise SystemExit(f'pfap-web did not start: {server.stderr.read()}')
-    port = int(re.search(r'127\.0\.0\.1:(\d+)/', line).group(1))
+    args = sys.argv[1:]
+    row = '--row' in args
+    by_thread = '--threads' in args
+    args = [a for a in args if a not in ('--row', '--threads')]
+    sessions = int(args[0]) if args else 4
+    text = args[1] if len(args) > 1 else 'One, two, three.'
+    server, port = start_server([f'--text={text}'])
     base = (len(os.listdir(f'/proc/{server.pid}/fd')), len(os.listdir(f'/proc/{server.pid}/task')))
     peak = list(base)
+    rss_base = rss_kib(server.pid, 'VmRSS')
+    thread_cpu = {}  # thread id: (name, CPU ticks), its last reading
 
     async def sample():
-        while True:
+        for tick in range(1 << 62):
             peak[0] = max(peak[0], len(os.listdir(f'/proc/{server.pid}/fd')))
             peak[1] = max(peak[1], len(os.listdir(f'/proc/{server.pid}/task')))
+            if by_thread and tick % 10 == 0:
+                for tid in os.listdir(f'/proc/{server.pid}/task'):
+                    try:
+                        stat = open(f'/proc/{server.pid}/task/{tid}/stat').read()
+                    except OSError:
+                        continue  # gone
+                    name = stat[stat.index('(') + 1:stat.rindex(')')]
+                    fields = stat.rsplit(')', 1)[1].split()
+                    thread_cpu[tid] = (name, int(fields[11]) + int(fields[12]))
             await asyncio.sleep(0.05)
 
     def cpu_s():
@@ -179,25 +269,77 @@ async def main():
     results = await asyncio.gather(*(session(port, i + 1, 60) for i in range(sessions)))
     took = time.monotonic() - start
     cpu = cpu_s() - cpu_start
-    rss_peak = open(f'/proc/{server.pid}/status').read().split('VmHWM:')[1].split('\n')[0].strip()
+    rss_peak = rss_kib(server.pid, 'VmHWM')
     sampler.cancel()
+    stopping = time.monotonic()
     server.terminate()
-    out, err = server.communicate(timeout=30)
+    out, err = server.communicate(timeout=120)
+    stopped_in = time.monotonic() - stopping
+    decode_states(results)
+    audio_worst, audio_late = late_summary(results, 'audio_times', AUDIO_CLOCK_RATE)
+    pfap_worst, pfap_late = late_summary(results, 'pfap_times', PFAP_CLOCK_RATE)
+    good = sum(whole(r) for r in results)
+    if by_thread:
+        groups = {}
+        for name, ticks in thread_cpu.values():
+            key = re.sub(r'\d+', 'N', name)
+            groups[key] = groups.get(key, 0) + ticks
+        total = sum(groups.values()) or 1
+        print('CPU by thread name (N: any number), sampled every 0.5 s:')
+        for key, ticks in sorted(groups.items(), key=lambda kv: -kv[1]):
+            print(f'  {key:18} {ticks / os.sysconf("SC_CLK_TCK"):6.2f} s  {ticks / total * 100:5.1f} %')
+    if row:
+        print(f'| {sessions} | {good} | {cpu / took / sessions * 100:.2f} % | '
+              f'{(rss_peak - rss_base) / 1024 / sessions:.1f} MiB | '
+              f'{(peak[0] - base[0]) / sessions:.1f} | {(peak[1] - base[1]) / sessions:.1f} | '
+              f'{audio_worst * 1000:.0f} ms, {audio_late * 100:.1f} % | '
+              f'{pfap_worst * 1000:.0f} ms, {pfap_late * 100:.1f} % |')
     for r in results:
         s = r['sender'] or {}
+        if row and whole(r):
+            continue
         print(f"session {r['session']}: {'whole' if whole(r) else 'NOT WHOLE'}: "
               f"{r['audio_packets']} Opus packets, {r['packets']} of {s.get('packets')} PFAP "
-              f"packets, last sequence number {r['last_seq']} of {s.get('lastSequenceNumber')}"
+              f"packets, last sequence number {r['last_seq']} of {s.get('lastSequenceNumber')}, "
+              + (f"FAP state equal to the sender's ({sum(v != 0 for v in s['settled'])} FAPs "
+                 'not at rest)' if r['state_equal'] else
+                 f"FAP state {'whole' if r['state_whole'] else 'not whole'}, differs from the "
+                 f"sender's at FAPs {r['state_differs']}")
               + (f", {r['error']}" if r['error'] else ''))
-    good = sum(whole(r) for r in results)
-    print(f'pfap-web: {base[0]} file descriptors and {base[1]} threads alone, at most {peak[0]} '
-          f'and {peak[1]} with the sessions ({(peak[0] - base[0]) / sessions:.1f} and '
-          f'{(peak[1] - base[1]) / sessions:.1f} per session); CPU {cpu:.2f} s in {took:.1f} s '
-          f'({cpu / took / sessions * 100:.1f} % of a core per session); peak RSS {rss_peak}')
-    print(f'{good} of {sessions} sessions whole in {took:.1f} s; pfap-web exited {server.returncode}')
+    if not row:
+        print(f'pfap-web: {base[0]} file descriptors and {base[1]} threads alone, at most '
+              f'{peak[0]} and {peak[1]} with the sessions ({(peak[0] - base[0]) / sessions:.1f} '
+              f'and {(peak[1] - base[1]) / sessions:.1f} per session); CPU {cpu:.2f} s in '
+              f'{took:.1f} s ({cpu / took / sessions * 100:.1f} % of a core per session); RSS '
+              f'{rss_base} KiB alone, peak {rss_peak} KiB '
+              f'({(rss_peak - rss_base) / 1024 / sessions:.1f} MiB per session)')
+        print(f'lateness against RTP time (lateness()): audio worst '
+              f'{audio_worst * 1000:.0f} ms, {audio_late * 100:.1f} % of packets over '
+              f'{LATE_S * 1000:.0f} ms; PFAP worst {pfap_worst * 1000:.0f} ms, '
+              f'{pfap_late * 100:.1f} % over {LATE_S * 1000:.0f} ms')
+        print(f'{good} of {sessions} sessions whole in {took:.1f} s; pfap-web exited '
+              f'{server.returncode}, {stopped_in:.1f} s after SIGTERM')
     if good != sessions or server.returncode != 0:
         print(err[-2000:], file=sys.stderr)
         sys.exit(1)
+
+
+def start_server(options, env=None):
+    """pfap-web (PFAP_WEB) on a free port with these options; returns it and its port once it
+    listens."""
+    server = subprocess.Popen([os.environ['PFAP_WEB'], '--port=0', *options],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    line = ''
+    while 'open http' not in line:
+        line = server.stdout.readline()
+        if not line:
+            raise SystemExit(f'pfap-web did not start: {server.stderr.read()}')
+    return server, int(re.search(r'127\.0\.0\.1:(\d+)/', line).group(1))
+
+
+def rss_kib(pid, field):
+    """VmRSS (now) or VmHWM (peak) of a process, in KiB."""
+    return int(open(f'/proc/{pid}/status').read().split(f'{field}:')[1].split()[0])
 
 
 def skip_opus_decoding():
@@ -210,4 +352,5 @@ def skip_opus_decoding():
 if __name__ == '__main__':
     enter_network_namespace()
     skip_opus_decoding()
+    record_audio_arrivals()
     asyncio.run(main())
