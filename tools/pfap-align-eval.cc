@@ -39,6 +39,7 @@
 #include "streaming.h"
 #include "viseme_detector.h"
 #include "viseme_frames.h"
+#include "wav_file.h"
 
 namespace {
 
@@ -46,38 +47,6 @@ struct Phone {
   std::string name;
   double start;  // seconds
 };
-
-bool read_wav(const std::string& path, std::vector<int16_t>& samples, unsigned& rate) {
-  std::ifstream in(path, std::ios::binary);
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (bytes.size() < 12 || bytes.compare(0, 4, "RIFF") != 0) return false;
-  auto u32 = [&](size_t at) {
-    uint32_t v;
-    std::memcpy(&v, bytes.data() + at, 4);
-    return v;
-  };
-  auto u16 = [&](size_t at) {
-    uint16_t v;
-    std::memcpy(&v, bytes.data() + at, 2);
-    return v;
-  };
-  bool format_ok = false;
-  for (size_t at = 12; at + 8 <= bytes.size();) {
-    const std::string id = bytes.substr(at, 4);
-    const uint32_t size = u32(at + 4);
-    if (id == "fmt ") {
-      format_ok = u16(at + 8) == 1 && u16(at + 10) == 1 && u16(at + 22) == 16;
-      rate = u32(at + 12);
-    } else if (id == "data" && format_ok) {
-      const size_t n = std::min<size_t>(size, bytes.size() - at - 8) / 2;
-      samples.resize(n);
-      std::memcpy(samples.data(), bytes.data() + at + 8, n * 2);
-      return true;
-    }
-    at += 8 + size + (size & 1);
-  }
-  return false;
-}
 
 std::vector<Phone> read_segs(const std::string& path) {
   std::ifstream in(path);
@@ -301,7 +270,7 @@ int main(int argc, char** argv) {
     const std::string base = dir + "/" + argv[a];
     std::vector<int16_t> samples;
     unsigned rate = 0;
-    if (!read_wav(base + ".wav", samples, rate)) {
+    if (!pfap::tools::read_wav(base + ".wav", samples, rate)) {
       std::fprintf(stderr, "%s.wav: not 16-bit mono PCM\n", base.c_str());
       return 1;
     }

@@ -1,6 +1,5 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// A WAV file's samples, for the measurement tools (tools/pfap-viseme-data; pfap-align-eval
-// has the same reader of its own, to be replaced by this one).
+// A WAV file's samples, for the measurement tools (tools/pfap-viseme-data, pfap-align-eval).
 #pragma once
 
 #include <algorithm>
