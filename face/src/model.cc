@@ -173,7 +173,7 @@ class Head {
 }  // namespace
 
 double expression_weight(const FapValues& faps, int e) {
-  return std::clamp(faps[pfap::kFirstExpressionIndex - 1 + e] / 63.0, 0.0, 1.0);
+  return pfap::expression_weight(faps[pfap::kFirstExpressionIndex - 1 + e]);
 }
 
 void add_expressions(FapValues& faps) {
