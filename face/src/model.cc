@@ -163,6 +163,8 @@ class Head {
     const double x2 = p.x * std::cos(yaw_) + z1 * std::sin(yaw_);
     return rotated({x2, y1}, roll_);
   }
+  // The head turns around the neck, which shifts it a little sideways with yaw.
+  double neck_shift() const { return 0.25 * kHeadRx * std::sin(yaw_); }
   double roll() const { return roll_; }
   double yaw() const { return yaw_; }
 
@@ -170,10 +172,131 @@ class Head {
   double pitch_, yaw_, roll_;
 };
 
+// The jaw, in face units: FAP 3 down, 14 forward, 15 to the face's right (-x).
+struct Jaw {
+  double open;  // never up
+  double shift;
+  double thrust;
+};
+
+Jaw jaw_from_faps(const FapValues& f) {
+  return {.open = std::max(0.0, f[3] * kMns), .shift = -f[15] * kMw, .thrust = f[14] * kMns};
+}
+
+// Inner lips. Upper points move down with 4, 8, 9; lower points with the jaw and up with 5,
+// 10, 11; corners out with 6, 7 and up with 12, 13, and half with the jaw.
+LipContour inner_lip_contour(const FapValues& f, const Jaw& jaw) {
+  LipContour inner = kNeutralInner;
+  const double stretch_left = f[6] * kMw, stretch_right = f[7] * kMw;
+  // Pushed lips pucker: the corners come in.
+  const double pucker = 0.3 * (f[16] + f[17]) / 2 * kMns;
+  inner[0].x += -stretch_right + pucker + jaw.shift / 2;
+  inner[0].y += jaw.open / 2 - f[13] * kMns;
+  inner[4].x += stretch_left - pucker + jaw.shift / 2;
+  inner[4].y += jaw.open / 2 - f[12] * kMns;
+  inner[1].x += (-stretch_right + pucker) / 2;
+  inner[3].x += (stretch_left - pucker) / 2;
+  inner[5].x += (stretch_left - pucker) / 2 + jaw.shift;
+  inner[7].x += (-stretch_right + pucker) / 2 + jaw.shift;
+  inner[6].x += jaw.shift;
+  inner[1].y += f[9] * kMns;
+  inner[2].y += f[4] * kMns;
+  inner[3].y += f[8] * kMns;
+  inner[5].y += jaw.open - f[10] * kMns;
+  inner[6].y += jaw.open - f[5] * kMns;
+  inner[7].y += jaw.open - f[11] * kMns;
+  // A lower lip raised past the upper one presses against it.
+  for (int i = 5; i <= 7; ++i) inner[i].y = std::max(inner[i].y, inner[8 - i].y);
+  return inner;
+}
+
+// Outer lips: where the inner ones went, then their own FAPs 51..60, lips thickened by
+// pushing (16, 17) and the jaw's thrust (14), the lower lip lifted by the chin (18).
+LipContour outer_lip_contour(const FapValues& f, const Jaw& jaw, const LipContour& inner) {
+  LipContour outer = kNeutralOuter;
+  for (size_t i = 0; i < outer.size(); ++i) {
+    outer[i].x += inner[i].x - kNeutralInner[i].x;
+    outer[i].y += inner[i].y - kNeutralInner[i].y;
+  }
+  outer[0].x -= f[54] * kMw;
+  outer[0].y -= f[60] * kMns;
+  outer[4].x += f[53] * kMw;
+  outer[4].y -= f[59] * kMns;
+  outer[1].y += f[56] * kMns - 0.25 * f[17] * kMns;
+  outer[2].y += f[51] * kMns - 0.25 * f[17] * kMns;
+  outer[3].y += f[55] * kMns - 0.25 * f[17] * kMns;
+  const double lower_out = 0.25 * f[16] * kMns + 0.3 * jaw.thrust - 0.5 * f[18] * kMns;
+  outer[5].y += -f[57] * kMns + lower_out;
+  outer[6].y += -f[52] * kMns + lower_out;
+  outer[7].y += -f[58] * kMns + lower_out;
+  for (int i = 1; i <= 3; ++i) outer[i].y = std::min(outer[i].y, inner[i].y - kMinLipThickness);
+  for (int i = 5; i <= 7; ++i) outer[i].y = std::max(outer[i].y, inner[i].y + kMinLipThickness);
+  return outer;
+}
+
+// An eye: the upper lid down with 19, 20, the lower lid up with 21, 22 and with the cheek's
+// lift (41, 42); the eyeball turns with 23..26.
+Eye eye_from_faps(const FapValues& f, int side, double cheek_lift, const Head& head) {
+  const double x = side == kLeft ? kUnits.es / 2 : -kUnits.es / 2;
+  Eye eye;
+  eye.center = head.project({x, kEyeY});
+  // Foreshortened as the surface under it turns away.
+  const double facing = std::atan2(x, kHeadRz);
+  eye.half_width = kEyeHalfWidth * std::max(0.2, std::cos(facing + head.yaw()) / std::cos(facing));
+  double upper = -kUnits.irisd / 2 + f[19 + side] * kIrisd;
+  double lower = kUnits.irisd / 2 - f[21 + side] * kIrisd - 0.3 * cheek_lift;
+  upper = std::max(upper, -kUnits.irisd);
+  lower = std::min(lower, kUnits.irisd);
+  if (lower < upper) upper = lower = (upper + lower) / 2;
+  eye.upper_lid = upper;
+  eye.lower_lid = lower;
+  eye.pupil = {kEyeballRadius * std::sin(f[23 + side] * kAngleUnit),
+               kEyeballRadius * std::sin(f[25 + side] * kAngleUnit)};
+  eye.iris_radius = kUnits.irisd / 2;
+  return eye;
+}
+
+// A brow: 31..36 up, 37, 38 towards the middle.
+Brow brow_from_faps(const FapValues& f, int side, const Head& head) {
+  const double sign = side == kLeft ? 1 : -1;
+  const double squeeze = f[37 + side] * kEs;
+  const std::array<Point, 3> brow{{{sign * 0.08, kBrowY - f[31 + side] * kEns},
+                                   {sign * 0.16, kBrowY - 0.012 - f[33 + side] * kEns},
+                                   {sign * 0.235, kBrowY + 0.004 - f[35 + side] * kEns}}};
+  Brow projected;
+  for (size_t i = 0; i < brow.size(); ++i) {
+    projected.points[i] = head.project({brow[i].x - sign * squeeze, brow[i].y});
+  }
+  return projected;
+}
+
+// The silhouette: an ellipse, with the cheeks bulging, the jaw's lower part moved, and the
+// whole shifted with the neck.
+std::array<Point, 12> silhouette(const FapValues& f, const Jaw& jaw,
+                                 const std::array<double, 2>& cheek_puff, const Head& head) {
+  std::array<Point, 12> outline;
+  for (size_t k = 0; k < outline.size(); ++k) {
+    const double angle = (-90.0 + 30.0 * static_cast<double>(k)) * std::numbers::pi / 180;
+    Point p{kHeadRx * std::cos(angle), kHeadRy * std::sin(angle)};
+    if (k == 3 || k == 4) p.x += (k == 4 ? 1.0 : 0.5) * cheek_puff[kLeft];
+    if (k == 8 || k == 9) p.x -= (k == 8 ? 1.0 : 0.5) * cheek_puff[kRight];
+    if (k >= 4 && k <= 8) {
+      const double share = (k == 4 || k == 8) ? 0.5 : 1.0;
+      p.y += share * jaw.open;
+      p.x += share * jaw.shift;
+    }
+    if (k == 6) p.y -= 0.5 * f[18] * kMns;
+    outline[k] = rotated(p, head.roll());
+  }
+  const double shift = head.neck_shift();
+  for (Point& p : outline) p.x += shift;
+  return outline;
+}
+
 }  // namespace
 
 double expression_weight(const FapValues& faps, int e) {
-  return std::clamp(faps[pfap::kFirstExpressionIndex - 1 + e] / 63.0, 0.0, 1.0);
+  return pfap::expression_weight(faps[pfap::kFirstExpressionIndex - 1 + e]);
 }
 
 void add_expressions(FapValues& faps) {
@@ -190,122 +313,31 @@ FacePose pose_from_faps(const FapValues& f) {
   const Head head(f[48] * kAngleUnit, f[49] * kAngleUnit, f[50] * kAngleUnit);
   pose.roll = head.roll();
   for (int e = 1; e <= 6; ++e) pose.expressions[e - 1] = expression_weight(f, e);
+  const Jaw jaw = jaw_from_faps(f);
+  pose.jaw_open = jaw.open;
 
-  // Jaw: FAP 3 down, 14 forward, 15 to the face's right (-x), 18 the chin up.
-  const double jaw = std::max(0.0, f[3] * kMns);
-  const double jaw_shift = -f[15] * kMw;
-  const double jaw_thrust = f[14] * kMns;
-  pose.jaw_open = jaw;
-
-  // Inner lips. Upper points move down with 4, 8, 9; lower points with the jaw and up with
-  // 5, 10, 11; corners out with 6, 7 and up with 12, 13, and half with the jaw.
-  LipContour inner = kNeutralInner;
-  const double stretch_left = f[6] * kMw, stretch_right = f[7] * kMw;
-  // Pushed lips pucker: the corners come in.
-  const double pucker = 0.3 * (f[16] + f[17]) / 2 * kMns;
-  inner[0].x += -stretch_right + pucker + jaw_shift / 2;
-  inner[0].y += jaw / 2 - f[13] * kMns;
-  inner[4].x += stretch_left - pucker + jaw_shift / 2;
-  inner[4].y += jaw / 2 - f[12] * kMns;
-  inner[1].x += (-stretch_right + pucker) / 2;
-  inner[3].x += (stretch_left - pucker) / 2;
-  inner[5].x += (stretch_left - pucker) / 2 + jaw_shift;
-  inner[7].x += (-stretch_right + pucker) / 2 + jaw_shift;
-  inner[6].x += jaw_shift;
-  inner[1].y += f[9] * kMns;
-  inner[2].y += f[4] * kMns;
-  inner[3].y += f[8] * kMns;
-  inner[5].y += jaw - f[10] * kMns;
-  inner[6].y += jaw - f[5] * kMns;
-  inner[7].y += jaw - f[11] * kMns;
-  // A lower lip raised past the upper one presses against it.
-  for (int i = 5; i <= 7; ++i) inner[i].y = std::max(inner[i].y, inner[8 - i].y);
-
-  // Outer lips: where the inner ones went, then their own FAPs 51..60, lips thickened by
-  // pushing (16, 17) and the jaw's thrust (14), the lower lip lifted by the chin (18).
-  LipContour outer = kNeutralOuter;
-  for (size_t i = 0; i < outer.size(); ++i) {
-    outer[i].x += inner[i].x - kNeutralInner[i].x;
-    outer[i].y += inner[i].y - kNeutralInner[i].y;
-  }
-  outer[0].x -= f[54] * kMw;
-  outer[0].y -= f[60] * kMns;
-  outer[4].x += f[53] * kMw;
-  outer[4].y -= f[59] * kMns;
-  outer[1].y += f[56] * kMns - 0.25 * f[17] * kMns;
-  outer[2].y += f[51] * kMns - 0.25 * f[17] * kMns;
-  outer[3].y += f[55] * kMns - 0.25 * f[17] * kMns;
-  const double lower_out = 0.25 * f[16] * kMns + 0.3 * jaw_thrust - 0.5 * f[18] * kMns;
-  outer[5].y += -f[57] * kMns + lower_out;
-  outer[6].y += -f[52] * kMns + lower_out;
-  outer[7].y += -f[58] * kMns + lower_out;
-  for (int i = 1; i <= 3; ++i) outer[i].y = std::min(outer[i].y, inner[i].y - kMinLipThickness);
-  for (int i = 5; i <= 7; ++i) outer[i].y = std::max(outer[i].y, inner[i].y + kMinLipThickness);
-
+  const LipContour inner = inner_lip_contour(f, jaw);
+  const LipContour outer = outer_lip_contour(f, jaw, inner);
   const double lip_depth = 0.02 + 0.5 * (f[16] + f[17]) / 2 * kMns;
   for (size_t i = 0; i < outer.size(); ++i) {
-    const double depth = i >= 5 ? lip_depth + jaw_thrust : lip_depth;
+    const double depth = i >= 5 ? lip_depth + jaw.thrust : lip_depth;
     pose.outer_lips[i] = head.project(outer[i], depth);
     pose.inner_lips[i] = head.project(inner[i], depth);
   }
 
-  // Eyes: upper lids down with 19, 20, lower lids up with 21, 22 and with the cheeks (41,
-  // 42); eyeballs turn with 23..26.
   const double cheek_lift[2] = {f[41] * kEns, f[42] * kEns};
   for (int side : {kLeft, kRight}) {
-    const double x = side == kLeft ? kUnits.es / 2 : -kUnits.es / 2;
-    Eye& eye = pose.eyes[side];
-    eye.center = head.project({x, kEyeY});
-    // Foreshortened as the surface under it turns away.
-    const double facing = std::atan2(x, kHeadRz);
-    eye.half_width =
-        kEyeHalfWidth * std::max(0.2, std::cos(facing + head.yaw()) / std::cos(facing));
-    double upper = -kUnits.irisd / 2 + f[19 + side] * kIrisd;
-    double lower = kUnits.irisd / 2 - f[21 + side] * kIrisd - 0.3 * cheek_lift[side];
-    upper = std::max(upper, -kUnits.irisd);
-    lower = std::min(lower, kUnits.irisd);
-    if (lower < upper) upper = lower = (upper + lower) / 2;
-    eye.upper_lid = upper;
-    eye.lower_lid = lower;
-    eye.pupil = {kEyeballRadius * std::sin(f[23 + side] * kAngleUnit),
-                 kEyeballRadius * std::sin(f[25 + side] * kAngleUnit)};
-    eye.iris_radius = kUnits.irisd / 2;
-
-    // Brows: 31..36 up, 37, 38 towards the middle.
-    const double sign = side == kLeft ? 1 : -1;
-    const double squeeze = f[37 + side] * kEs;
-    const std::array<Point, 3> brow{{{sign * 0.08, kBrowY - f[31 + side] * kEns},
-                                     {sign * 0.16, kBrowY - 0.012 - f[33 + side] * kEns},
-                                     {sign * 0.235, kBrowY + 0.004 - f[35 + side] * kEns}}};
-    for (size_t i = 0; i < brow.size(); ++i) {
-      pose.brows[side].points[i] = head.project({brow[i].x - sign * squeeze, brow[i].y});
-    }
-
+    pose.eyes[side] = eye_from_faps(f, side, cheek_lift[side], head);
+    pose.brows[side] = brow_from_faps(f, side, head);
     // Cheeks: 39, 40 puff outwards, 41, 42 lift.
+    const double sign = side == kLeft ? 1 : -1;
     pose.cheek_puff[side] = std::max(0.0, f[39 + side] * kEs);
     pose.cheeks[side] =
         head.project({sign * (kCheekX + pose.cheek_puff[side] / 2), kCheekY - cheek_lift[side]});
   }
   pose.nose = head.project({0, kNoseY}, kNoseDepth);
-
-  // The silhouette: an ellipse, with the cheeks bulging and the jaw's lower part moved.
-  for (size_t k = 0; k < pose.outline.size(); ++k) {
-    const double angle = (-90.0 + 30.0 * static_cast<double>(k)) * std::numbers::pi / 180;
-    Point p{kHeadRx * std::cos(angle), kHeadRy * std::sin(angle)};
-    if (k == 3 || k == 4) p.x += (k == 4 ? 1.0 : 0.5) * pose.cheek_puff[kLeft];
-    if (k == 8 || k == 9) p.x -= (k == 8 ? 1.0 : 0.5) * pose.cheek_puff[kRight];
-    if (k >= 4 && k <= 8) {
-      const double share = (k == 4 || k == 8) ? 0.5 : 1.0;
-      p.y += share * jaw;
-      p.x += share * jaw_shift;
-    }
-    if (k == 6) p.y -= 0.5 * f[18] * kMns;
-    pose.outline[k] = rotated(p, head.roll());
-  }
-  // The head turns around the neck, which shifts the silhouette a little with yaw.
-  const double shift = 0.25 * kHeadRx * std::sin(head.yaw());
-  for (Point& p : pose.outline) p.x += shift;
-  pose.head_center = {shift, 0};
+  pose.outline = silhouette(f, jaw, pose.cheek_puff, head);
+  pose.head_center = {head.neck_shift(), 0};
   return pose;
 }
 

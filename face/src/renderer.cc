@@ -91,14 +91,8 @@ Palette palette(Style style, const FacePose& pose) {
           true};
 }
 
-void draw_face(cairo_t* cr, const FacePose& pose, Style style, double unit) {
-  const Palette p = palette(style, pose);
-  const double line = style == Style::kLine ? 0.008 : 0.006;
-  cairo_set_line_width(cr, std::max(line, 1.0 / unit));
-  cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
-  cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
-
-  // Neck, then hair behind the head.
+// The neck, then the hair behind the head.
+void draw_neck_and_hair(cairo_t* cr, const FacePose& pose, const Palette& p) {
   cairo_save(cr);
   cairo_translate(cr, pose.head_center.x, 0);
   cairo_rotate(cr, -pose.roll / 2);
@@ -118,15 +112,17 @@ void draw_face(cairo_t* cr, const FacePose& pose, Style style, double unit) {
     set_color(cr, p.hair);
     cairo_fill(cr);
   }
+}
 
-  // The head.
+// The head, and a fringe over its forehead.
+void draw_head(cairo_t* cr, const FacePose& pose, const Palette& p) {
   spline(cr, pose.outline, true);
   set_color(cr, p.skin);
   cairo_fill_preserve(cr);
   set_color(cr, p.skin_line);
   cairo_stroke(cr);
 
-  // A fringe over the forehead, inside the head.
+  // A fringe over the forehead, inside it.
   cairo_save(cr);
   spline(cr, pose.outline, true);
   cairo_clip(cr);
@@ -147,8 +143,10 @@ void draw_face(cairo_t* cr, const FacePose& pose, Style style, double unit) {
     cairo_stroke(cr);
   }
   cairo_restore(cr);
+}
 
-  // Cheeks: a blush that grows when puffed and rises when lifted.
+// Cheeks: a blush that grows when puffed and rises when lifted.
+void draw_cheeks(cairo_t* cr, const FacePose& pose, const Palette& p) {
   for (int side : {kLeft, kRight}) {
     const Point c = pose.cheeks[side];
     const double r = 0.055 + pose.cheek_puff[side];
@@ -169,8 +167,10 @@ void draw_face(cairo_t* cr, const FacePose& pose, Style style, double unit) {
       cairo_stroke(cr);
     }
   }
+}
 
-  // Eyes: white between the lids, the iris clipped by them, then the lids' lines.
+// Eyes: white between the lids, the iris clipped by them, then the lids' lines.
+void draw_eyes(cairo_t* cr, const FacePose& pose, const Palette& p) {
   for (const Eye& eye : pose.eyes) {
     cairo_save(cr);
     cairo_translate(cr, eye.center.x, eye.center.y);
@@ -203,8 +203,9 @@ void draw_face(cairo_t* cr, const FacePose& pose, Style style, double unit) {
     cairo_stroke(cr);
     cairo_restore(cr);
   }
+}
 
-  // Brows.
+void draw_brows(cairo_t* cr, const FacePose& pose, const Palette& p) {
   for (const Brow& brow : pose.brows) {
     spline(cr, brow.points, false);
     cairo_save(cr);
@@ -213,8 +214,10 @@ void draw_face(cairo_t* cr, const FacePose& pose, Style style, double unit) {
     cairo_stroke(cr);
     cairo_restore(cr);
   }
+}
 
-  // Nose: the line under its tip and one side.
+// Nose: the line under its tip and one side.
+void draw_nose(cairo_t* cr, const FacePose& pose, const Palette& p) {
   const Point n = pose.nose;
   cairo_move_to(cr, n.x - 0.035, n.y - 0.005);
   cairo_curve_to(cr, n.x - 0.02, n.y + 0.02, n.x + 0.02, n.y + 0.02, n.x + 0.035, n.y - 0.005);
@@ -222,8 +225,10 @@ void draw_face(cairo_t* cr, const FacePose& pose, Style style, double unit) {
   cairo_curve_to(cr, n.x + 0.02, n.y - 0.05, n.x + 0.035, n.y - 0.03, n.x + 0.03, n.y - 0.01);
   set_color(cr, p.skin_line);
   cairo_stroke(cr);
+}
 
-  // Mouth: the opening with teeth and tongue, then the lips around it.
+// Mouth: the opening with teeth and tongue, then the lips around it.
+void draw_mouth(cairo_t* cr, const FacePose& pose, const Palette& p) {
   lip_path(cr, pose.inner_lips);
   set_color(cr, p.mouth);
   cairo_fill_preserve(cr);
@@ -256,6 +261,22 @@ void draw_face(cairo_t* cr, const FacePose& pose, Style style, double unit) {
   lip_path(cr, pose.inner_lips);
   set_color(cr, p.line);
   cairo_stroke(cr);
+}
+
+void draw_face(cairo_t* cr, const FacePose& pose, Style style, double unit) {
+  const Palette p = palette(style, pose);
+  const double line = style == Style::kLine ? 0.008 : 0.006;
+  cairo_set_line_width(cr, std::max(line, 1.0 / unit));
+  cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
+  cairo_set_line_cap(cr, CAIRO_LINE_CAP_ROUND);
+
+  draw_neck_and_hair(cr, pose, p);
+  draw_head(cr, pose, p);
+  draw_cheeks(cr, pose, p);
+  draw_eyes(cr, pose, p);
+  draw_brows(cr, pose, p);
+  draw_nose(cr, pose, p);
+  draw_mouth(cr, pose, p);
 }
 
 // Breaks `text` at spaces into lines no wider than `width`.

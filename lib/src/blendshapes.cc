@@ -230,7 +230,7 @@ BlendshapeWeights blendshape_weights(const FapAmplitudes& faps, const VisemeMout
 
   // Expressions: FAP 68 + e carries intensity 0..63.
   for (size_t e = 0; e < kExpressions.size(); ++e) {
-    const double weight = std::clamp(f[kFirstExpressionIndex + e] / 63.0, 0.0, 1.0);
+    const double weight = expression_weight(f[kFirstExpressionIndex + e]);
     if (weight == 0) continue;
     for (const auto& [shape, amount] : kExpressions[e]) {
       w[static_cast<size_t>(shape)] += weight * amount;

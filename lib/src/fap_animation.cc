@@ -9,9 +9,6 @@
 namespace pfap {
 namespace {
 
-// MPEG-4's expression_intensity is 6 bits.
-constexpr int32_t kMaxExpressionIntensity = 63;
-
 // A frame of the file with changes: where a phoneme must start.
 struct Cut {
   int64_t time_ms;

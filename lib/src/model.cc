@@ -5,6 +5,10 @@
 
 namespace pfap {
 
+double expression_weight(double amplitude) {
+  return std::clamp(amplitude / kMaxExpressionIntensity, 0.0, 1.0);
+}
+
 uint8_t f0_code(unsigned hz) { return static_cast<uint8_t>((std::min(hz, kMaxF0Hz) + 1) / 2); }
 
 void split_long_phoneme(const Phoneme& phoneme, uint32_t duration_ms, std::vector<Phoneme>& out) {

@@ -17,6 +17,15 @@ TEST(F0Code, RoundsToTheNearestTwoHzStepAndSaturates) {
   for (const auto& c : cases) EXPECT_EQ(f0_code(c.hz), c.code) << c.hz;
 }
 
+TEST(ExpressionWeight, IntensityOver63ClampedTo0To1) {
+  const struct {
+    double amplitude, weight;
+  } cases[] = {{0, 0},  {63, 1}, {31.5, 0.5},         {21, 1.0 / 3},
+               {-1, 0}, {64, 1}, {-kMaxAmplitude, 0}, {kMaxAmplitude, 1}};
+  for (const auto& c : cases)
+    EXPECT_DOUBLE_EQ(expression_weight(c.amplitude), c.weight) << c.amplitude;
+}
+
 TEST(Validity, FapFieldsAtAndPastTheirLimits) {
   const Fap good{kMinFapIndex, kMaxAmplitude, kMaxTransitionMs, Curve::kSpline};
   EXPECT_TRUE(is_valid(good));

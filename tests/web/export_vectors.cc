@@ -16,11 +16,14 @@
 //                                       at seeded places, and what RecoveryReceiver holds
 //   export_vectors render DIR           face states, their poses, and their frames drawn by
 //                                       pfap::face::render as raw BGRx files in DIR
+//   export_vectors expressions          pfap::expression_weight of amplitudes in, at the edges
+//                                       of and beyond 0..63
 // The JSON shapes are the package's own (web/src/index.d.ts): the tests compare them whole.
 #include <gst/rtp/gstrtpbuffer.h>
 
 #include <algorithm>
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -36,6 +39,7 @@
 #include "face/renderer.h"
 #include "pfap/blendshapes.h"
 #include "pfap/fap_state.h"
+#include "pfap/model.h"
 #include "pfap/packetizer.h"
 #include "pfap/payload.h"
 #include "pfap/phoneme_table.h"
@@ -606,6 +610,32 @@ int export_render(const char* dir) {
   return 0;
 }
 
+// Amplitudes for pfap::expression_weight: every integer from -2 to 66, fractions and the
+// nearest doubles at the ends of 0..63, the ends of the wire's range, and seeded random
+// amplitudes in and around 0..63.
+int export_expressions() {
+  std::vector<double> amplitudes;
+  for (int a = -2; a <= 66; ++a) amplitudes.push_back(a);
+  for (const double a : {0.5, 1.0 / 3, 31.5, 62.5, 63.5}) amplitudes.push_back(a);
+  for (const double end : {0.0, 63.0}) {
+    amplitudes.push_back(std::nextafter(end, -1.0));
+    amplitudes.push_back(std::nextafter(end, 64.0));
+  }
+  amplitudes.push_back(-pfap::kMaxAmplitude);
+  amplitudes.push_back(pfap::kMaxAmplitude);
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<double> around(-20, 90);
+  for (int i = 0; i < 1000; ++i) amplitudes.push_back(around(rng));
+
+  std::cout << "[";
+  for (size_t i = 0; i < amplitudes.size(); ++i) {
+    std::cout << (i ? ",\n" : "") << "{\"amplitude\":" << number(amplitudes[i])
+              << ",\"weight\":" << number(pfap::expression_weight(amplitudes[i])) << "}";
+  }
+  std::cout << "]\n";
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -618,9 +648,10 @@ int main(int argc, char** argv) {
   if (mode == "alphabet" && argc == 2) return export_alphabet();
   if (mode == "recovery" && argc == 2) return export_recovery();
   if (mode == "render" && argc == 3) return export_render(argv[2]);
+  if (mode == "expressions" && argc == 2) return export_expressions();
   std::fprintf(
       stderr,
       "usage: export_vectors payloads CORPUS_DIR | decode | rtp | curves | animator | alphabet | "
-      "recovery | render DIR\n");
+      "recovery | render DIR | expressions\n");
   return 2;
 }

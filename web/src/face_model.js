@@ -89,6 +89,120 @@ function makeHead(pitch, yaw, roll) {
   };
 }
 
+// The head turns around the neck, which shifts it a little sideways with yaw.
+function neckShift(yaw) {
+  return 0.25 * HEAD_RX * Math.sin(yaw);
+}
+
+// The jaw, in face units: FAP 3 down (never up), 14 forward, 15 to the face's right (-x).
+function jawFromFaps(f) {
+  return { open: Math.max(0.0, f[3] * MNS), shift: -f[15] * MW, thrust: f[14] * MNS };
+}
+
+// Inner lips. Upper points move down with 4, 8, 9; lower points with the jaw and up with 5,
+// 10, 11; corners out with 6, 7 and up with 12, 13, and half with the jaw.
+function innerLipContour(f, jaw) {
+  const inner = NEUTRAL_INNER.map(([x, y]) => ({ x, y }));
+  const stretchLeft = f[6] * MW;
+  const stretchRight = f[7] * MW;
+  const pucker = ((0.3 * (f[16] + f[17])) / 2) * MNS;
+  inner[0].x += -stretchRight + pucker + jaw.shift / 2;
+  inner[0].y += jaw.open / 2 - f[13] * MNS;
+  inner[4].x += stretchLeft - pucker + jaw.shift / 2;
+  inner[4].y += jaw.open / 2 - f[12] * MNS;
+  inner[1].x += (-stretchRight + pucker) / 2;
+  inner[3].x += (stretchLeft - pucker) / 2;
+  inner[5].x += (stretchLeft - pucker) / 2 + jaw.shift;
+  inner[7].x += (-stretchRight + pucker) / 2 + jaw.shift;
+  inner[6].x += jaw.shift;
+  inner[1].y += f[9] * MNS;
+  inner[2].y += f[4] * MNS;
+  inner[3].y += f[8] * MNS;
+  inner[5].y += jaw.open - f[10] * MNS;
+  inner[6].y += jaw.open - f[5] * MNS;
+  inner[7].y += jaw.open - f[11] * MNS;
+  for (let i = 5; i <= 7; ++i) inner[i].y = Math.max(inner[i].y, inner[8 - i].y);
+  return inner;
+}
+
+// Outer lips: where the inner ones went, then their own FAPs 51..60, lips thickened by
+// pushing (16, 17) and the jaw's thrust (14), the lower lip lifted by the chin (18).
+function outerLipContour(f, jaw, inner) {
+  const outer = NEUTRAL_OUTER.map(([x, y], i) => ({
+    x: x + (inner[i].x - NEUTRAL_INNER[i][0]),
+    y: y + (inner[i].y - NEUTRAL_INNER[i][1]),
+  }));
+  outer[0].x -= f[54] * MW;
+  outer[0].y -= f[60] * MNS;
+  outer[4].x += f[53] * MW;
+  outer[4].y -= f[59] * MNS;
+  outer[1].y += f[56] * MNS - 0.25 * f[17] * MNS;
+  outer[2].y += f[51] * MNS - 0.25 * f[17] * MNS;
+  outer[3].y += f[55] * MNS - 0.25 * f[17] * MNS;
+  const lowerOut = 0.25 * f[16] * MNS + 0.3 * jaw.thrust - 0.5 * f[18] * MNS;
+  outer[5].y += -f[57] * MNS + lowerOut;
+  outer[6].y += -f[52] * MNS + lowerOut;
+  outer[7].y += -f[58] * MNS + lowerOut;
+  for (let i = 1; i <= 3; ++i) outer[i].y = Math.min(outer[i].y, inner[i].y - MIN_LIP_THICKNESS);
+  for (let i = 5; i <= 7; ++i) outer[i].y = Math.max(outer[i].y, inner[i].y + MIN_LIP_THICKNESS);
+  return outer;
+}
+
+// An eye: the upper lid down with 19, 20, the lower lid up with 21, 22 and with the cheek's
+// lift (41, 42); the eyeball turns with 23..26.
+function eyeFromFaps(f, side, cheekLift, project, yaw) {
+  const x = side === LEFT ? U.es / 2 : -U.es / 2;
+  const facing = Math.atan2(x, HEAD_RZ);
+  let upper = -U.irisd / 2 + f[19 + side] * IRISD;
+  let lower = U.irisd / 2 - f[21 + side] * IRISD - 0.3 * cheekLift;
+  upper = Math.max(upper, -U.irisd);
+  lower = Math.min(lower, U.irisd);
+  if (lower < upper) upper = lower = (upper + lower) / 2;
+  return {
+    center: project(x, EYE_Y),
+    halfWidth: EYE_HALF_WIDTH * Math.max(0.2, Math.cos(facing + yaw) / Math.cos(facing)),
+    upperLid: upper,
+    lowerLid: lower,
+    pupil: { x: EYEBALL_RADIUS * Math.sin(f[23 + side] * ANGLE_UNIT), y: EYEBALL_RADIUS * Math.sin(f[25 + side] * ANGLE_UNIT) },
+    irisRadius: U.irisd / 2,
+  };
+}
+
+// A brow: 31..36 up, 37, 38 towards the middle.
+function browFromFaps(f, side, project) {
+  const sign = side === LEFT ? 1 : -1;
+  const squeeze = f[37 + side] * ES;
+  const brow = [
+    [sign * 0.08, BROW_Y - f[31 + side] * ENS],
+    [sign * 0.16, BROW_Y - 0.012 - f[33 + side] * ENS],
+    [sign * 0.235, BROW_Y + 0.004 - f[35 + side] * ENS],
+  ];
+  return { points: brow.map(([bx, by]) => project(bx - sign * squeeze, by)) };
+}
+
+// The silhouette: an ellipse, with the cheeks bulging, the jaw's lower part moved, and the
+// whole shifted with the neck.
+function silhouette(f, jaw, cheekPuff, roll, yaw) {
+  const outline = [];
+  for (let k = 0; k < 12; ++k) {
+    const angle = ((-90.0 + 30.0 * k) * Math.PI) / 180;
+    let x = HEAD_RX * Math.cos(angle);
+    let y = HEAD_RY * Math.sin(angle);
+    if (k === 3 || k === 4) x += (k === 4 ? 1.0 : 0.5) * cheekPuff[LEFT];
+    if (k === 8 || k === 9) x -= (k === 8 ? 1.0 : 0.5) * cheekPuff[RIGHT];
+    if (k >= 4 && k <= 8) {
+      const share = k === 4 || k === 8 ? 0.5 : 1.0;
+      y += share * jaw.open;
+      x += share * jaw.shift;
+    }
+    if (k === 6) y -= 0.5 * f[18] * MNS;
+    outline.push(rotated(x, y, roll));
+  }
+  const shift = neckShift(yaw);
+  for (const p of outline) p.x += shift;
+  return outline;
+}
+
 /** A FapValues array: amplitudes by FAP index, 0..74 (0..2 unused). */
 export function fapValues() {
   return new Float64Array(FAP_COUNT);
@@ -125,53 +239,13 @@ export function poseFromFaps(f) {
   const roll = f[50] * ANGLE_UNIT;
   const project = makeHead(pitch, yaw, roll);
   const expressions = [1, 2, 3, 4, 5, 6].map((e) => expressionWeight(f, e));
+  const jaw = jawFromFaps(f);
 
-  const jaw = Math.max(0.0, f[3] * MNS);
-  const jawShift = -f[15] * MW;
-  const jawThrust = f[14] * MNS;
-
-  const inner = NEUTRAL_INNER.map(([x, y]) => ({ x, y }));
-  const stretchLeft = f[6] * MW;
-  const stretchRight = f[7] * MW;
-  const pucker = ((0.3 * (f[16] + f[17])) / 2) * MNS;
-  inner[0].x += -stretchRight + pucker + jawShift / 2;
-  inner[0].y += jaw / 2 - f[13] * MNS;
-  inner[4].x += stretchLeft - pucker + jawShift / 2;
-  inner[4].y += jaw / 2 - f[12] * MNS;
-  inner[1].x += (-stretchRight + pucker) / 2;
-  inner[3].x += (stretchLeft - pucker) / 2;
-  inner[5].x += (stretchLeft - pucker) / 2 + jawShift;
-  inner[7].x += (-stretchRight + pucker) / 2 + jawShift;
-  inner[6].x += jawShift;
-  inner[1].y += f[9] * MNS;
-  inner[2].y += f[4] * MNS;
-  inner[3].y += f[8] * MNS;
-  inner[5].y += jaw - f[10] * MNS;
-  inner[6].y += jaw - f[5] * MNS;
-  inner[7].y += jaw - f[11] * MNS;
-  for (let i = 5; i <= 7; ++i) inner[i].y = Math.max(inner[i].y, inner[8 - i].y);
-
-  const outer = NEUTRAL_OUTER.map(([x, y], i) => ({
-    x: x + (inner[i].x - NEUTRAL_INNER[i][0]),
-    y: y + (inner[i].y - NEUTRAL_INNER[i][1]),
-  }));
-  outer[0].x -= f[54] * MW;
-  outer[0].y -= f[60] * MNS;
-  outer[4].x += f[53] * MW;
-  outer[4].y -= f[59] * MNS;
-  outer[1].y += f[56] * MNS - 0.25 * f[17] * MNS;
-  outer[2].y += f[51] * MNS - 0.25 * f[17] * MNS;
-  outer[3].y += f[55] * MNS - 0.25 * f[17] * MNS;
-  const lowerOut = 0.25 * f[16] * MNS + 0.3 * jawThrust - 0.5 * f[18] * MNS;
-  outer[5].y += -f[57] * MNS + lowerOut;
-  outer[6].y += -f[52] * MNS + lowerOut;
-  outer[7].y += -f[58] * MNS + lowerOut;
-  for (let i = 1; i <= 3; ++i) outer[i].y = Math.min(outer[i].y, inner[i].y - MIN_LIP_THICKNESS);
-  for (let i = 5; i <= 7; ++i) outer[i].y = Math.max(outer[i].y, inner[i].y + MIN_LIP_THICKNESS);
-
+  const inner = innerLipContour(f, jaw);
+  const outer = outerLipContour(f, jaw, inner);
   const lipDepth = 0.02 + ((0.5 * (f[16] + f[17])) / 2) * MNS;
-  const outerLips = outer.map((p, i) => project(p.x, p.y, i >= 5 ? lipDepth + jawThrust : lipDepth));
-  const innerLips = inner.map((p, i) => project(p.x, p.y, i >= 5 ? lipDepth + jawThrust : lipDepth));
+  const outerLips = outer.map((p, i) => project(p.x, p.y, i >= 5 ? lipDepth + jaw.thrust : lipDepth));
+  const innerLips = inner.map((p, i) => project(p.x, p.y, i >= 5 ? lipDepth + jaw.thrust : lipDepth));
 
   const cheekLift = [f[41] * ENS, f[42] * ENS];
   const eyes = [];
@@ -179,56 +253,18 @@ export function poseFromFaps(f) {
   const cheeks = [];
   const cheekPuff = [];
   for (const side of [LEFT, RIGHT]) {
-    const x = side === LEFT ? U.es / 2 : -U.es / 2;
-    const facing = Math.atan2(x, HEAD_RZ);
-    let upper = -U.irisd / 2 + f[19 + side] * IRISD;
-    let lower = U.irisd / 2 - f[21 + side] * IRISD - 0.3 * cheekLift[side];
-    upper = Math.max(upper, -U.irisd);
-    lower = Math.min(lower, U.irisd);
-    if (lower < upper) upper = lower = (upper + lower) / 2;
-    eyes.push({
-      center: project(x, EYE_Y),
-      halfWidth: EYE_HALF_WIDTH * Math.max(0.2, Math.cos(facing + yaw) / Math.cos(facing)),
-      upperLid: upper,
-      lowerLid: lower,
-      pupil: { x: EYEBALL_RADIUS * Math.sin(f[23 + side] * ANGLE_UNIT), y: EYEBALL_RADIUS * Math.sin(f[25 + side] * ANGLE_UNIT) },
-      irisRadius: U.irisd / 2,
-    });
-
+    eyes.push(eyeFromFaps(f, side, cheekLift[side], project, yaw));
+    brows.push(browFromFaps(f, side, project));
     const sign = side === LEFT ? 1 : -1;
-    const squeeze = f[37 + side] * ES;
-    const brow = [
-      [sign * 0.08, BROW_Y - f[31 + side] * ENS],
-      [sign * 0.16, BROW_Y - 0.012 - f[33 + side] * ENS],
-      [sign * 0.235, BROW_Y + 0.004 - f[35 + side] * ENS],
-    ];
-    brows.push({ points: brow.map(([bx, by]) => project(bx - sign * squeeze, by)) });
-
     cheekPuff.push(Math.max(0.0, f[39 + side] * ES));
     cheeks.push(project(sign * (CHEEK_X + cheekPuff[side] / 2), CHEEK_Y - cheekLift[side]));
   }
   const nose = project(0, NOSE_Y, NOSE_DEPTH);
 
-  const outline = [];
-  for (let k = 0; k < 12; ++k) {
-    const angle = ((-90.0 + 30.0 * k) * Math.PI) / 180;
-    let x = HEAD_RX * Math.cos(angle);
-    let y = HEAD_RY * Math.sin(angle);
-    if (k === 3 || k === 4) x += (k === 4 ? 1.0 : 0.5) * cheekPuff[LEFT];
-    if (k === 8 || k === 9) x -= (k === 8 ? 1.0 : 0.5) * cheekPuff[RIGHT];
-    if (k >= 4 && k <= 8) {
-      const share = k === 4 || k === 8 ? 0.5 : 1.0;
-      y += share * jaw;
-      x += share * jawShift;
-    }
-    if (k === 6) y -= 0.5 * f[18] * MNS;
-    outline.push(rotated(x, y, roll));
-  }
-  const shift = 0.25 * HEAD_RX * Math.sin(yaw);
-  for (const p of outline) p.x += shift;
+  const outline = silhouette(f, jaw, cheekPuff, roll, yaw);
   return {
     roll,
-    headCenter: { x: shift, y: 0 },
+    headCenter: { x: neckShift(yaw), y: 0 },
     outline,
     eyes,
     brows,
@@ -237,7 +273,7 @@ export function poseFromFaps(f) {
     nose,
     outerLips,
     innerLips,
-    jawOpen: jaw,
+    jawOpen: jaw.open,
     expressions,
   };
 }

@@ -6,6 +6,8 @@
 /** Drawing styles: flat colours, or black lines on white like a sketch. */
 export const Style = Object.freeze({ CARTOON: 'cartoon', LINE: 'line' });
 
+const TAU = 2 * Math.PI;
+
 function mix(a, b, u) {
   return [a[0] + (b[0] - a[0]) * u, a[1] + (b[1] - a[1]) * u, a[2] + (b[2] - a[2]) * u];
 }
@@ -90,15 +92,8 @@ function palette(style, pose) {
   };
 }
 
-function drawFace(ctx, pose, style, unit) {
-  const p = palette(style, pose);
-  const TAU = 2 * Math.PI;
-  ctx.lineWidth = Math.max(style === Style.LINE ? 0.008 : 0.006, 1.0 / unit);
-  ctx.lineJoin = 'round';
-  ctx.lineCap = 'round';
-  ctx.beginPath();
-
-  // Neck, then hair behind the head.
+// The neck, then the hair behind the head.
+function drawNeckAndHair(ctx, pose, p) {
   ctx.save();
   ctx.translate(pose.headCenter.x, 0);
   ctx.rotate(-pose.roll / 2);
@@ -118,15 +113,17 @@ function drawFace(ctx, pose, style, unit) {
     ctx.fillStyle = css(p.hair);
     fill(ctx);
   }
+}
 
-  // The head.
+// The head, and a fringe over its forehead.
+function drawHead(ctx, pose, p) {
   spline(ctx, pose.outline, true);
   ctx.fillStyle = css(p.skin);
   ctx.fill();
   ctx.strokeStyle = css(p.skinLine);
   stroke(ctx);
 
-  // A fringe over the forehead, inside the head.
+  // A fringe over the forehead, inside it.
   ctx.save();
   spline(ctx, pose.outline, true);
   ctx.clip();
@@ -148,8 +145,10 @@ function drawFace(ctx, pose, style, unit) {
     stroke(ctx);
   }
   ctx.restore();
+}
 
-  // Cheeks: a blush that grows when puffed and rises when lifted.
+// Cheeks: a blush that grows when puffed and rises when lifted.
+function drawCheeks(ctx, pose, p) {
   for (const side of [0, 1]) {
     const c = pose.cheeks[side];
     const r = 0.055 + pose.cheekPuff[side];
@@ -167,8 +166,10 @@ function drawFace(ctx, pose, style, unit) {
       stroke(ctx);
     }
   }
+}
 
-  // Eyes: white between the lids, the iris clipped by them, then the lids' lines.
+// Eyes: white between the lids, the iris clipped by them, then the lids' lines.
+function drawEyes(ctx, pose, p) {
   for (const eye of pose.eyes) {
     ctx.save();
     ctx.translate(eye.center.x, eye.center.y);
@@ -201,8 +202,9 @@ function drawFace(ctx, pose, style, unit) {
     stroke(ctx);
     ctx.restore();
   }
+}
 
-  // Brows.
+function drawBrows(ctx, pose, p) {
   for (const brow of pose.brows) {
     spline(ctx, brow.points, false);
     ctx.save();
@@ -211,8 +213,10 @@ function drawFace(ctx, pose, style, unit) {
     stroke(ctx);
     ctx.restore();
   }
+}
 
-  // Nose: the line under its tip and one side.
+// Nose: the line under its tip and one side.
+function drawNose(ctx, pose, p) {
   const n = pose.nose;
   ctx.moveTo(n.x - 0.035, n.y - 0.005);
   ctx.bezierCurveTo(n.x - 0.02, n.y + 0.02, n.x + 0.02, n.y + 0.02, n.x + 0.035, n.y - 0.005);
@@ -220,8 +224,10 @@ function drawFace(ctx, pose, style, unit) {
   ctx.bezierCurveTo(n.x + 0.02, n.y - 0.05, n.x + 0.035, n.y - 0.03, n.x + 0.03, n.y - 0.01);
   ctx.strokeStyle = css(p.skinLine);
   stroke(ctx);
+}
 
-  // Mouth: the opening with teeth and tongue, then the lips around it.
+// Mouth: the opening with teeth and tongue, then the lips around it.
+function drawMouth(ctx, pose, p) {
   lipPath(ctx, pose.innerLips);
   ctx.fillStyle = css(p.mouth);
   ctx.fill();
@@ -254,6 +260,22 @@ function drawFace(ctx, pose, style, unit) {
   lipPath(ctx, pose.innerLips);
   ctx.strokeStyle = css(p.line);
   stroke(ctx);
+}
+
+function drawFace(ctx, pose, style, unit) {
+  const p = palette(style, pose);
+  ctx.lineWidth = Math.max(style === Style.LINE ? 0.008 : 0.006, 1.0 / unit);
+  ctx.lineJoin = 'round';
+  ctx.lineCap = 'round';
+  ctx.beginPath();
+
+  drawNeckAndHair(ctx, pose, p);
+  drawHead(ctx, pose, p);
+  drawCheeks(ctx, pose, p);
+  drawEyes(ctx, pose, p);
+  drawBrows(ctx, pose, p);
+  drawNose(ctx, pose, p);
+  drawMouth(ctx, pose, p);
 }
 
 // Breaks `text` at spaces into lines no wider than `width`.

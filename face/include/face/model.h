@@ -74,8 +74,8 @@ struct FacePose {
   std::array<double, 6> expressions{};  // joy, sadness, anger, fear, disgust, surprise: 0..1
 };
 
-// The weight (0..1) of MPEG-4 expression `e` (1..6) from FAP 68 + e: its amplitude is the
-// expression intensity of FAP 2, 0..63.
+// The weight (0..1) of MPEG-4 expression `e` (1..6) from FAP 68 + e, by
+// pfap::expression_weight: its amplitude is the expression intensity of FAP 2, 0..63.
 double expression_weight(const FapValues& faps, int e);
 
 // Adds to `faps` the FAP displacements that make up the six expressions at their weights

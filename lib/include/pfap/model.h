@@ -18,6 +18,9 @@ inline constexpr int kMaxFapIndex = 74;
 // FAP indexes 69..74 carry the MPEG-4 expressions 1..6 (joy, sadness, anger, fear, disgust,
 // surprise): index = 68 + expression.
 inline constexpr int kFirstExpressionIndex = 69;
+// An expression FAP's amplitude is the expression's intensity: MPEG-4's expression_intensity
+// (FAP 2), 6 bits.
+inline constexpr int32_t kMaxExpressionIntensity = 63;
 inline constexpr int kFapCount = kMaxFapIndex + 1;  // arrays indexed by FAP index
 inline constexpr int32_t kMaxAmplitude = 2529600;
 inline constexpr uint16_t kMaxTransitionMs = 16383;      // 14 bits
@@ -73,6 +76,12 @@ inline bool is_valid(const Phoneme& phoneme) {
 // The f0 code for a frequency in Hz: nearest 2 Hz step, halves rounded up, saturating at
 // 510 Hz (code 255).
 uint8_t f0_code(unsigned hz);
+
+// The weight 0..1 of an expression whose FAP (68 + expression) has `amplitude`: the
+// intensity over 63, clamped, so that a value outside 0..63 saturates. pfapface's face, the
+// blendshapes and pfap.js (web/src/face_model.js, held to this by tests/web) all weigh
+// expressions by it.
+double expression_weight(double amplitude);
 
 // A phoneme longer than 4095 ms as the consecutive pieces the wire can carry: pieces of
 // 4095 ms, then the rest. The first piece keeps stress and word begin, the last keeps end of
