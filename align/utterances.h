@@ -1,0 +1,63 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// Which stretch of a recording each text is the utterance of, for pfapalign (offline and
+// live) without GStreamer: the texts come with the sample they start at (the element turns
+// their running time into it) and the rules below cut the audio into utterances. Also the
+// audio's bytes (S16LE) into samples. docs/align.md, "Timeline and utterances".
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace pfap::align {
+
+// Where a stream's phonemes come from, offline and live: its texts, when it has any; else the
+// audio alone, recognized (recognizer.h); else, in a build without the recognizer, one pause
+// (which the element warns about).
+enum class PhonemeSource { kTexts, kRecognition, kPause };
+PhonemeSource phoneme_source(bool has_text);
+
+// One text: the sample it starts at, counted from the first sample kept (none: it has no
+// time, and continues the text before it offline or starts at the audio so far live), and its
+// bytes (any, UTF-8 is checked later).
+struct TimedText {
+  std::optional<size_t> from;
+  std::string bytes;
+};
+
+// The utterance of `text` over samples [from, to). `is_text`: false for the audio before the
+// first text, a pause whose empty text is no problem.
+struct UtteranceSpan {
+  size_t from = 0;
+  size_t to = 0;
+  std::string text;
+  bool is_text = true;
+};
+
+// Offline: the utterances of the `n` samples kept, in order, tiling [0, n). `whole` is the
+// text of the whole stream (the text property, when no text pad is linked), an utterance from
+// 0 before `texts`. A text without a start continues the one before (the first starts at 0);
+// a text from beyond the audio starts at its end at `end_of_stream`, and else waits: its index
+// in `texts` goes to `later` (in order) and it is left as it is; the bytes of the others are
+// moved out. The audio before the first
+// utterance is one that is not a text. Empty when there is no text at all: the audio is to be
+// recognized.
+std::vector<UtteranceSpan> utterances_of(std::vector<TimedText>& texts,
+                                         const std::optional<std::string>& whole, size_t n,
+                                         bool end_of_stream, std::vector<size_t>& later);
+
+// Live: of `texts`, those that start before sample `end`, as utterance starts in order
+// (UtteranceSpan::to is `end`), none before `now` (the audio so far; a text without a start,
+// or a late one, starts there). The others' indices go to `later`, in order, and they are left
+// as they are; the bytes of those taken are moved out.
+std::vector<UtteranceSpan> live_utterances_before(std::vector<TimedText>& texts, size_t now,
+                                                  size_t end, std::vector<size_t>& later);
+
+// Appends the S16LE samples in `bytes` (an odd last byte left out) to `samples`, at most
+// `max_count` of them; returns how many `bytes` held.
+void append_s16le(std::span<const uint8_t> bytes, size_t max_count, std::vector<int16_t>& samples);
+
+}  // namespace pfap::align
