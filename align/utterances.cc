@@ -4,8 +4,6 @@
 #include <algorithm>
 #include <utility>
 
-#include "recognizer.h"
-
 namespace pfap::align {
 
 namespace {
@@ -74,6 +72,56 @@ void append_s16le(std::span<const uint8_t> bytes, size_t max_count, std::vector<
   for (size_t i = 0; i < taken; ++i) {
     samples.push_back(static_cast<int16_t>(bytes[2 * i] | (bytes[2 * i + 1] << 8)));
   }
+}
+
+void LiveUtterances::reset() {
+  open_ = false;
+  samples_ = 0;
+}
+
+bool LiveUtterances::start_text(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
+                                unsigned rate, std::string& error) {
+  if (!aligner_.start(utterance, voice, rate, error)) return false;
+  open_ = true;
+  recognizing_ = false;
+  from_ = samples_;
+  return true;
+}
+
+bool LiveUtterances::start_recognition(unsigned rate, std::string& error) {
+  if (!recognizer_.start(rate, error)) return false;
+  open_ = true;
+  recognizing_ = true;
+  from_ = samples_;
+  return true;
+}
+
+void LiveUtterances::push(std::span<const int16_t> samples, std::vector<tts::SpokenPhoneme>& out) {
+  const size_t first = out.size();
+  if (recognizing_) {
+    recognizer_.push(samples, out);
+  } else {
+    aligner_.push(samples, out);
+  }
+  samples_ += samples.size();
+  count_from_stream_start(out, first);
+}
+
+void LiveUtterances::end(std::vector<tts::SpokenPhoneme>& out) {
+  if (!open_) return;
+  open_ = false;
+  const size_t first = out.size();
+  if (recognizing_) {
+    recognizer_.finish(out);
+  } else {
+    aligner_.finish(out);
+  }
+  count_from_stream_start(out, first);
+}
+
+void LiveUtterances::count_from_stream_start(std::vector<tts::SpokenPhoneme>& out,
+                                             size_t first) const {
+  for (size_t i = first; i < out.size(); ++i) out[i].start += from_;
 }
 
 }  // namespace pfap::align

@@ -12,6 +12,9 @@
 #include <string>
 #include <vector>
 
+#include "recognizer.h"
+#include "streaming.h"
+
 namespace pfap::align {
 
 // Where a stream's phonemes come from, offline and live: its texts, when it has any; else the
@@ -59,5 +62,45 @@ std::vector<UtteranceSpan> live_utterances_before(std::vector<TimedText>& texts,
 // Appends the S16LE samples in `bytes` (an odd last byte left out) to `samples`, at most
 // `max_count` of them; returns how many `bytes` held.
 void append_s16le(std::span<const uint8_t> bytes, size_t max_count, std::vector<int16_t>& samples);
+
+// Live: a stream's utterances, one open at a time, as its audio comes: each aligned to its
+// text (StreamingAligner) or, without a text, recognized to the stream's end
+// (StreamingRecognizer). Phoneme starts count from the stream's first sample.
+class LiveUtterances {
+ public:
+  // A new stream: nothing open, no audio yet.
+  void reset();
+  bool is_open() const { return open_; }
+  bool is_recognizing() const { return open_ && recognizing_; }
+  size_t samples() const { return samples_; }       // the audio so far
+  size_t utterance_start() const { return from_; }  // the open utterance's first sample
+
+  // Opens the utterance of `utterance` at the audio so far (end() the open one first). False
+  // with `error` where espeak-ng cannot speak; problem() and inexact() then say what of it
+  // cannot be aligned exactly.
+  bool start_text(const tts::Utterance& utterance, const tts::VoiceSettings& voice, unsigned rate,
+                  std::string& error);
+  // Opens the recognizer's utterance at the audio so far (end() the open one first). False
+  // with `error` where the model cannot be loaded.
+  bool start_recognition(unsigned rate, std::string& error);
+  // Gives `samples` to the open utterance; the phonemes now settled to `out`.
+  void push(std::span<const int16_t> samples, std::vector<tts::SpokenPhoneme>& out);
+  // Ends the open utterance, if any, at the audio so far: its last phonemes to `out`.
+  void end(std::vector<tts::SpokenPhoneme>& out);
+
+  Problem problem() const { return aligner_.problem(); }
+  const std::vector<tts::Speech::Inexact>& inexact() const { return aligner_.inexact(); }
+  RecognitionProblem recognition_problem() const { return recognizer_.problem(); }
+
+ private:
+  void count_from_stream_start(std::vector<tts::SpokenPhoneme>& out, size_t first) const;
+
+  StreamingAligner aligner_;
+  StreamingRecognizer recognizer_;
+  bool open_ = false;
+  bool recognizing_ = false;
+  size_t from_ = 0;
+  size_t samples_ = 0;
+};
 
 }  // namespace pfap::align

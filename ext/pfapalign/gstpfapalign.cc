@@ -109,12 +109,7 @@ struct Stream {
 
   // Live: upstream is live, and the phonemes go out as the audio comes (live_* below).
   bool live = false;
-  pfap::align::StreamingAligner aligner;
-  pfap::align::StreamingRecognizer recognizer;  // without a text
-  bool utterance_open = false;                  // the aligner (or the recognizer) has an utterance
-  bool recognizing = false;                     // the open utterance is the recognizer's
-  size_t utterance_from = 0;                    // its first sample, counted from `first`
-  size_t live_samples = 0;                      // samples since `first`
+  pfap::align::LiveUtterances utterances;  // sample counts from `first`
 
   std::mutex lock;  // guards what follows, shared with the text pad's thread
   std::condition_variable text_changed;
@@ -184,8 +179,7 @@ static void reset(GstPfapAlign* self) {
   s.samples.clear();
   s.overflow_warned = false;
   s.pfap_discont = true;
-  s.utterance_open = false;
-  s.live_samples = 0;
+  s.utterances.reset();
   gst_segment_init(&s.segment, GST_FORMAT_TIME);
   std::lock_guard<std::mutex> guard(s.lock);
   s.texts.clear();
@@ -410,25 +404,18 @@ static pfap::align::PhonemeSource live_source(GstPfapAlign* self) {
   return pfap::align::phoneme_source(has_property || gst_pad_is_linked(self->textpad));
 }
 
-static GstFlowReturn live_push(GstPfapAlign* self,
-                               const std::vector<pfap::tts::SpokenPhoneme>& phonemes) {
-  return push_phonemes(self, phonemes, self->stream->utterance_from);
-}
-
 // Ends the open utterance at the audio so far and pushes its last phonemes.
 static GstFlowReturn live_end_utterance(GstPfapAlign* self) {
   Stream& s = *self->stream;
-  if (!s.utterance_open) return GST_FLOW_OK;
-  s.utterance_open = false;
+  const bool recognizing = s.utterances.is_recognizing();
   std::vector<pfap::tts::SpokenPhoneme> phonemes;
-  if (s.recognizing) {
-    s.recognizer.finish(phonemes);
-    const GstClockTime at = s.first + gst_util_uint64_scale(s.utterance_from, GST_SECOND, s.rate);
-    warn_recognition_problem(self, s.recognizer.problem(), at);
-  } else {
-    s.aligner.finish(phonemes);
+  s.utterances.end(phonemes);
+  if (recognizing) {
+    const GstClockTime at =
+        s.first + gst_util_uint64_scale(s.utterances.utterance_start(), GST_SECOND, s.rate);
+    warn_recognition_problem(self, s.utterances.recognition_problem(), at);
   }
-  return live_push(self, phonemes);
+  return push_phonemes(self, phonemes, 0);
 }
 
 // Ends the open utterance and starts that of `bytes` at the audio so far. `is_text` as in
@@ -438,47 +425,35 @@ static GstFlowReturn live_start_utterance(GstPfapAlign* self, const std::string&
   Stream& s = *self->stream;
   const GstFlowReturn ret = live_end_utterance(self);
   if (ret != GST_FLOW_OK) return ret;
-  const GstClockTime at = s.first + gst_util_uint64_scale(s.live_samples, GST_SECOND, s.rate);
+  const GstClockTime at =
+      s.first + gst_util_uint64_scale(s.utterances.samples(), GST_SECOND, s.rate);
   const pfap::tts::Utterance utterance = parse_text(self, bytes, at);
   const pfap::tts::VoiceSettings voice = voice_settings(self);
   std::string error;
-  if (!s.aligner.start(utterance, voice, s.rate, error)) {
+  if (!s.utterances.start_text(utterance, voice, s.rate, error)) {
     GST_ELEMENT_ERROR(self, LIBRARY, FAILED, ("%s", error.c_str()), (nullptr));
     return GST_FLOW_ERROR;
   }
-  if (is_text) warn_problem(self, s.aligner.problem(), at, 0, -1);
-  PFAP_WARN_INEXACT_PHONEMES(self, s.aligner.inexact(), voice.voice, s.warned_phonemes);
-  s.utterance_open = true;
-  s.recognizing = false;
-  s.utterance_from = s.live_samples;
+  if (is_text) warn_problem(self, s.utterances.problem(), at, 0, -1);
+  PFAP_WARN_INEXACT_PHONEMES(self, s.utterances.inexact(), voice.voice, s.warned_phonemes);
   return GST_FLOW_OK;
 }
 
 // Without a text: the recognizer's utterance from the audio so far, to the stream's end.
 static GstFlowReturn live_start_recognition(GstPfapAlign* self) {
-  Stream& s = *self->stream;
   std::string error;
-  if (!s.recognizer.start(s.rate, error)) {  // the model is missing
-    GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));
+  if (!self->stream->utterances.start_recognition(self->stream->rate, error)) {
+    GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));  // no model
     return GST_FLOW_ERROR;
   }
-  s.utterance_open = true;
-  s.recognizing = true;
-  s.utterance_from = s.live_samples;
   return GST_FLOW_OK;
 }
 
 // Gives `samples` to the open utterance and pushes the phonemes now settled.
 static GstFlowReturn live_feed(GstPfapAlign* self, std::span<const int16_t> samples) {
-  Stream& s = *self->stream;
   std::vector<pfap::tts::SpokenPhoneme> phonemes;
-  if (s.recognizing) {
-    s.recognizer.push(samples, phonemes);
-  } else {
-    s.aligner.push(samples, phonemes);
-  }
-  s.live_samples += samples.size();
-  return live_push(self, phonemes);
+  self->stream->utterances.push(samples, phonemes);
+  return push_phonemes(self, phonemes, 0);
 }
 
 // Takes the texts of text_sink that start before sample `end` as utterances in order, none
@@ -490,7 +465,7 @@ static std::vector<pfap::align::UtteranceSpan> live_take_texts(GstPfapAlign* sel
   for (Text& t : s.texts) timed.push_back({text_sample(self, t.running_time), std::move(t.bytes)});
   std::vector<size_t> later;
   std::vector<pfap::align::UtteranceSpan> starting =
-      pfap::align::live_utterances_before(timed, s.live_samples, end, later);
+      pfap::align::live_utterances_before(timed, s.utterances.samples(), end, later);
   std::vector<Text> waiting;
   for (size_t i : later) waiting.push_back({s.texts[i].running_time, std::move(timed[i].bytes)});
   s.texts.swap(waiting);
@@ -508,7 +483,7 @@ static GstFlowReturn live_chain(GstPfapAlign* self, GstBuffer* buffer) {
     gst_buffer_unmap(buffer, &map);
   }
   GstFlowReturn ret = GST_FLOW_OK;
-  if (!s.utterance_open) {
+  if (!s.utterances.is_open()) {
     GST_OBJECT_LOCK(self);
     const bool has_property = self->text != nullptr;
     const std::string property = has_property ? self->text : "";
@@ -524,9 +499,9 @@ static GstFlowReturn live_chain(GstPfapAlign* self, GstBuffer* buffer) {
   }
   size_t done = 0;
   for (const pfap::align::UtteranceSpan& u :
-       live_take_texts(self, s.live_samples + samples.size())) {
+       live_take_texts(self, s.utterances.samples() + samples.size())) {
     if (ret != GST_FLOW_OK) break;
-    const size_t n = u.from - s.live_samples;
+    const size_t n = u.from - s.utterances.samples();
     ret = live_feed(self, std::span(samples).subspan(done, n));
     done += n;
     if (ret == GST_FLOW_OK) ret = live_start_utterance(self, u.text, true);
@@ -545,7 +520,7 @@ static GstFlowReturn live_end(GstPfapAlign* self) {
   Stream& s = *self->stream;
   const GstFlowReturn ret = live_end_utterance(self);
   s.first = GST_CLOCK_TIME_NONE;
-  s.live_samples = 0;
+  s.utterances.reset();
   return ret;
 }
 

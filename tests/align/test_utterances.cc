@@ -8,12 +8,14 @@
 #include <vector>
 
 #include "recognizer.h"
+#include "speech_fixtures.h"
 #include "utterances.h"
 
 namespace {
 
 using pfap::align::TimedText;
 using pfap::align::UtteranceSpan;
+namespace tts = pfap::tts;
 
 struct Expected {
   size_t from;
@@ -109,6 +111,49 @@ TEST(Utterances, S16leIsLittleEndianSignedAndCapped) {
   EXPECT_EQ(samples, (std::vector<int16_t>{7, 1, -1, -32768, 32767}));  // the odd byte left out
   pfap::align::append_s16le(bytes, 2, samples);
   EXPECT_EQ(samples, (std::vector<int16_t>{7, 1, -1, -32768, 32767, 1, -1}));
+}
+
+TEST(Utterances, LivePhonemesCountFromTheStreamsStartAndTileIt) {
+  const tts::Speech one = pfap::align::testing::say("Hello world.", {});
+  const tts::Speech two = pfap::align::testing::say("Good morning.", {});
+  const unsigned rate = one.sample_rate;
+  pfap::align::LiveUtterances live;
+  std::vector<tts::SpokenPhoneme> out;
+  std::string error;
+  EXPECT_FALSE(live.is_open());
+  ASSERT_TRUE(live.start_text(pfap::align::testing::utterance("Hello world."), {}, rate, error))
+      << error;
+  EXPECT_TRUE(live.is_open());
+  EXPECT_FALSE(live.is_recognizing());
+  const size_t block = rate / 50;
+  for (size_t i = 0; i < one.samples.size(); i += block) {
+    live.push(std::span(one.samples).subspan(i, std::min(block, one.samples.size() - i)), out);
+  }
+  live.end(out);
+  EXPECT_FALSE(live.is_open());
+  const size_t first_count = out.size();
+  ASSERT_TRUE(live.start_text(pfap::align::testing::utterance("Good morning."), {}, rate, error))
+      << error;
+  EXPECT_EQ(live.utterance_start(), one.samples.size());
+  for (size_t i = 0; i < two.samples.size(); i += block) {
+    live.push(std::span(two.samples).subspan(i, std::min(block, two.samples.size() - i)), out);
+  }
+  live.end(out);
+  live.end(out);  // nothing open: nothing more
+  EXPECT_EQ(live.samples(), one.samples.size() + two.samples.size());
+
+  ASSERT_GT(out.size(), first_count);
+  EXPECT_EQ(out[first_count].start, one.samples.size());  // the second from its first sample
+  size_t next = 0;
+  for (const tts::SpokenPhoneme& p : out) {
+    EXPECT_EQ(p.start, next);
+    next = p.start + p.n_samples;
+  }
+  EXPECT_EQ(next, live.samples());
+
+  live.reset();
+  EXPECT_EQ(live.samples(), 0u);
+  EXPECT_FALSE(live.is_open());
 }
 
 }  // namespace
