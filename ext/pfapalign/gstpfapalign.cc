@@ -57,6 +57,7 @@
 #include <array>
 #include <condition_variable>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -298,6 +299,15 @@ static pfap::tts::Utterance parse_text(GstPfapAlign* self, const std::string& by
   return utterance;
 }
 
+// The text property, if set.
+static std::optional<std::string> text_property(GstPfapAlign* self) {
+  GST_OBJECT_LOCK(self);
+  std::optional<std::string> text;
+  if (self->text != nullptr) text = self->text;
+  GST_OBJECT_UNLOCK(self);
+  return text;
+}
+
 static pfap::tts::VoiceSettings voice_settings(GstPfapAlign* self) {
   GST_OBJECT_LOCK(self);
   pfap::tts::VoiceSettings voice;
@@ -347,10 +357,7 @@ static std::optional<size_t> text_sample(GstPfapAlign* self, GstClockTime runnin
 // the end of the stream (`eos`) it first waits for the text pad's EOS, when it is linked.
 static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
   Stream& s = *self->stream;
-  GST_OBJECT_LOCK(self);
-  const std::string property = self->text != nullptr ? self->text : "";
-  const bool has_property = self->text != nullptr;
-  GST_OBJECT_UNLOCK(self);
+  const std::optional<std::string> property = text_property(self);
   const bool text_linked = gst_pad_is_linked(self->textpad);
 
   std::vector<Text> texts;
@@ -369,8 +376,7 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
   for (Text& t : texts) timed.push_back({text_sample(self, t.running_time), std::move(t.bytes)});
   std::vector<size_t> later;  // texts for audio still to come
   const std::vector<pfap::align::UtteranceSpan> utterances = pfap::align::utterances_of(
-      timed, !text_linked && has_property ? std::optional(property) : std::nullopt,
-      s.samples.size(), eos, later);
+      timed, text_linked ? std::nullopt : property, s.samples.size(), eos, later);
   if (!later.empty()) {
     std::lock_guard<std::mutex> guard(s.lock);
     std::vector<Text> waiting;
@@ -398,10 +404,8 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
 // Where live phonemes come from: the text property, or text_sink when it is linked (even if it
 // gives nothing: the audio is then a pause until its first text).
 static pfap::align::PhonemeSource live_source(GstPfapAlign* self) {
-  GST_OBJECT_LOCK(self);
-  const bool has_property = self->text != nullptr;
-  GST_OBJECT_UNLOCK(self);
-  return pfap::align::phoneme_source(has_property || gst_pad_is_linked(self->textpad));
+  return pfap::align::phoneme_source(text_property(self).has_value() ||
+                                     gst_pad_is_linked(self->textpad));
 }
 
 // Ends the open utterance at the audio so far and pushes its last phonemes.
@@ -484,17 +488,15 @@ static GstFlowReturn live_chain(GstPfapAlign* self, GstBuffer* buffer) {
   }
   GstFlowReturn ret = GST_FLOW_OK;
   if (!s.utterances.is_open()) {
-    GST_OBJECT_LOCK(self);
-    const bool has_property = self->text != nullptr;
-    const std::string property = has_property ? self->text : "";
-    GST_OBJECT_UNLOCK(self);
+    const std::optional<std::string> property = text_property(self);
     const bool from_pad = gst_pad_is_linked(self->textpad);
     const pfap::align::PhonemeSource source = live_source(self);
     if (source == pfap::align::PhonemeSource::kRecognition) {
       ret = live_start_recognition(self);
     } else {
       if (source == pfap::align::PhonemeSource::kPause) warn_cannot_recognize(self);
-      ret = live_start_utterance(self, from_pad ? "" : property, !from_pad && has_property);
+      ret = live_start_utterance(self, from_pad ? "" : property.value_or(""),
+                                 !from_pad && property.has_value());
     }
   }
   size_t done = 0;
@@ -749,11 +751,7 @@ static GstStateChangeReturn gst_pfap_align_change_state(GstElement* element,
     GST_OBJECT_UNLOCK(self);
     unsigned rate = 0;
     std::string error;
-    GST_OBJECT_LOCK(self);
-    pfap::tts::VoiceSettings voice;
-    voice.voice = self->voice;
-    GST_OBJECT_UNLOCK(self);
-    if (!pfap::tts::check_voice(voice, rate, error)) {
+    if (!pfap::tts::check_voice(voice_settings(self), rate, error)) {
       GST_ELEMENT_ERROR(self, RESOURCE, NOT_FOUND, ("%s", error.c_str()), (nullptr));
       return GST_STATE_CHANGE_FAILURE;
     }
