@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// Which stretch of a recording each text is the utterance of, for pfapalign (offline and
-// live) without GStreamer: the texts come with the sample they start at (the element turns
-// their running time into it) and the rules below cut the audio into utterances. Also the
-// audio's bytes (S16LE) into samples. docs/align.md, "Timeline and utterances".
+// pfapalign's logic beside the aligner and the recognizer, without GStreamer: where a stream's
+// phonemes come from (its texts, the recognizer or a pause), which stretch of the recording
+// each text is the utterance of (the texts come with the sample they start at: the element
+// turns their running time into it), the live mode's open utterance, and the audio's bytes
+// (S16LE) as samples. docs/align.md, "Timeline and utterances".
 #pragma once
 
 #include <cstddef>
@@ -60,7 +61,7 @@ std::vector<UtteranceSpan> live_utterances_before(std::vector<TimedText>& texts,
                                                   size_t end, std::vector<size_t>& later);
 
 // Appends the S16LE samples in `bytes` (an odd last byte left out) to `samples`, at most
-// `max_count` of them; returns how many `bytes` held.
+// `max_count` of them.
 void append_s16le(std::span<const uint8_t> bytes, size_t max_count, std::vector<int16_t>& samples);
 
 // Live: a stream's utterances, one open at a time, as its audio comes: each aligned to its
