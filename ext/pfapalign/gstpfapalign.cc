@@ -57,17 +57,20 @@
 #include <array>
 #include <condition_variable>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
 
 #include "aligner.h"
+#include "inexact.h"
 #include "markupbuffer.h"
 #include "pfap/markup.h"
 #include "ratelimit.h"
 #include "recognizer.h"
 #include "sparse.h"
 #include "streaming.h"
+#include "utterances.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapalign_debug);
 #define GST_CAT_DEFAULT pfapalign_debug
@@ -107,13 +110,7 @@ struct Stream {
 
   // Live: upstream is live, and the phonemes go out as the audio comes (live_* below).
   bool live = false;
-  pfap::align::StreamingAligner aligner;
-  pfap::align::StreamingRecognizer recognizer;  // without a text
-  bool utterance_open = false;                  // the aligner (or the recognizer) has an utterance
-  bool recognizing = false;                     // the open utterance is the recognizer's
-  bool utterance_is_text = false;               // from a text, not the audio before the first
-  size_t utterance_from = 0;                    // its first sample, counted from `first`
-  size_t live_samples = 0;                      // samples since `first`
+  pfap::align::LiveUtterances utterances;  // sample counts from `first`
 
   std::mutex lock;  // guards what follows, shared with the text pad's thread
   std::condition_variable text_changed;
@@ -183,8 +180,7 @@ static void reset(GstPfapAlign* self) {
   s.samples.clear();
   s.overflow_warned = false;
   s.pfap_discont = true;
-  s.utterance_open = false;
-  s.live_samples = 0;
+  s.utterances.reset();
   gst_segment_init(&s.segment, GST_FORMAT_TIME);
   std::lock_guard<std::mutex> guard(s.lock);
   s.texts.clear();
@@ -259,15 +255,15 @@ static void warn_recognition_problem(GstPfapAlign* self, pfap::align::Recognitio
                       ("%" G_GUINT64_FORMAT " so far", s.recognition_problems[k]));
 }
 
-// Without a text: the phonemes of all the audio kept recognized from it alone (the
-// `recognition` build), or one pause with a warning where the build cannot.
-static GstFlowReturn recognize_kept(GstPfapAlign* self) {
+// Without a text: the phonemes of all the audio kept recognized from it alone (`source`
+// kRecognition), or one pause with a warning where the build cannot (kPause).
+static GstFlowReturn recognize_kept(GstPfapAlign* self, pfap::align::PhonemeSource source) {
   Stream& s = *self->stream;
   GST_INFO_OBJECT(self, "no text: recognizing %zu samples", s.samples.size());
   pfap::align::Recognition recognition;
   std::string error;
   if (!pfap::align::recognize(s.samples, s.rate, recognition, error)) {
-    if (pfap::align::recognition_available()) {  // the model is missing
+    if (source == pfap::align::PhonemeSource::kRecognition) {  // the model is missing
       GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));
       return GST_FLOW_ERROR;
     }
@@ -303,6 +299,15 @@ static pfap::tts::Utterance parse_text(GstPfapAlign* self, const std::string& by
   return utterance;
 }
 
+// The text property, if set.
+static std::optional<std::string> text_property(GstPfapAlign* self) {
+  GST_OBJECT_LOCK(self);
+  std::optional<std::string> text;
+  if (self->text != nullptr) text = self->text;
+  GST_OBJECT_UNLOCK(self);
+  return text;
+}
+
 static pfap::tts::VoiceSettings voice_settings(GstPfapAlign* self) {
   GST_OBJECT_LOCK(self);
   pfap::tts::VoiceSettings voice;
@@ -311,32 +316,17 @@ static pfap::tts::VoiceSettings voice_settings(GstPfapAlign* self) {
   return voice;
 }
 
-// As pfaptts warns: once per mnemonic of a voice whose phonemes x-pfap-arpabet lacks.
-static void warn_inexact(GstPfapAlign* self, const std::vector<pfap::tts::Speech::Inexact>& inexact,
-                         const pfap::tts::VoiceSettings& voice) {
+// Aligns the utterance `u` of the audio kept and pushes its phonemes on `pfap`.
+static GstFlowReturn align_utterance(GstPfapAlign* self, const pfap::align::UtteranceSpan& u) {
   Stream& s = *self->stream;
-  for (const pfap::tts::Speech::Inexact& i : inexact) {
-    if (!s.warned_phonemes.insert(i.mnemonic).second) continue;
-    const std::string sent_as(i.sent_as);
-    GST_ELEMENT_WARNING(self, STREAM, FORMAT,
-                        ("espeak-ng phoneme \"%s\" of voice \"%s\" is not in x-pfap-arpabet",
-                         i.mnemonic.c_str(), voice.voice.c_str()),
-                        ("sent as %s", sent_as.c_str()));
-  }
-}
-
-// Aligns `bytes` to samples [from, to) and pushes its phonemes on `pfap`. `is_text`: false
-// for the audio before the first utterance, whose empty text is no problem.
-static GstFlowReturn align_utterance(GstPfapAlign* self, const std::string& bytes, size_t from,
-                                     size_t to, bool is_text) {
-  Stream& s = *self->stream;
+  const size_t from = u.from;
   const GstClockTime at = s.first + gst_util_uint64_scale(from, GST_SECOND, s.rate);
-  const pfap::tts::Utterance utterance = parse_text(self, bytes, at);
+  const pfap::tts::Utterance utterance = parse_text(self, u.text, at);
   const pfap::tts::VoiceSettings voice = voice_settings(self);
 
   pfap::align::Alignment alignment;
   std::string error;
-  const std::span<const int16_t> audio(s.samples.data() + from, to - from);
+  const std::span<const int16_t> audio(s.samples.data() + from, u.to - from);
   if (!pfap::align::align(utterance, voice, audio, s.rate, alignment, error)) {
     GST_ELEMENT_ERROR(self, LIBRARY, FAILED, ("%s", error.c_str()), (nullptr));
     return GST_FLOW_ERROR;
@@ -344,17 +334,19 @@ static GstFlowReturn align_utterance(GstPfapAlign* self, const std::string& byte
   GST_DEBUG_OBJECT(self, "utterance at %" GST_TIME_FORMAT ": %zu phonemes, %zu samples, cost %.2f",
                    GST_TIME_ARGS(at), alignment.phonemes.size(), audio.size(),
                    alignment.relative_cost);
-  if (is_text) {
+  if (u.is_text) {
     warn_problem(self, alignment.problem, at, alignment.relative_cost, alignment.heard_agreement);
   }
-  warn_inexact(self, alignment.inexact, voice);
+  PFAP_WARN_INEXACT_PHONEMES(self, alignment.inexact, voice.voice, s.warned_phonemes);
 
   return push_phonemes(self, alignment.phonemes, from);
 }
 
-// The sample, counted from `first`, where a text at `running_time` starts; 0 before the audio.
-static size_t text_start(GstPfapAlign* self, GstClockTime running_time) {
+// The sample, counted from `first`, where a text at `running_time` starts; 0 before the audio,
+// none for a text without a time.
+static std::optional<size_t> text_sample(GstPfapAlign* self, GstClockTime running_time) {
   Stream& s = *self->stream;
+  if (!GST_CLOCK_TIME_IS_VALID(running_time)) return std::nullopt;
   const guint64 position =
       gst_segment_position_from_running_time(&s.segment, GST_FORMAT_TIME, running_time);
   if (!GST_CLOCK_TIME_IS_VALID(position) || position <= s.first) return 0;
@@ -365,10 +357,7 @@ static size_t text_start(GstPfapAlign* self, GstClockTime running_time) {
 // the end of the stream (`eos`) it first waits for the text pad's EOS, when it is linked.
 static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
   Stream& s = *self->stream;
-  GST_OBJECT_LOCK(self);
-  const std::string property = self->text != nullptr ? self->text : "";
-  const bool has_property = self->text != nullptr;
-  GST_OBJECT_UNLOCK(self);
+  const std::optional<std::string> property = text_property(self);
   const bool text_linked = gst_pad_is_linked(self->textpad);
 
   std::vector<Text> texts;
@@ -383,42 +372,23 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
     texts.swap(s.texts);
   }
 
-  // Utterances as (first sample, text), in order.
-  const size_t n = s.samples.size();
-  std::vector<std::pair<size_t, std::string>> utterances;
-  std::vector<Text> later;  // texts for audio still to come
-  if (!text_linked && has_property) utterances.emplace_back(0, property);
-  for (Text& t : texts) {
-    if (!GST_CLOCK_TIME_IS_VALID(t.running_time)) {
-      if (utterances.empty()) {
-        utterances.emplace_back(0, std::move(t.bytes));
-      } else {
-        utterances.back().second += t.bytes;
-      }
-      continue;
-    }
-    const size_t from = text_start(self, t.running_time);
-    if (from >= n && !eos) {
-      later.push_back(std::move(t));
-      continue;
-    }
-    utterances.emplace_back(std::min(from, n), std::move(t.bytes));
-  }
+  std::vector<pfap::align::TimedText> timed;
+  for (Text& t : texts) timed.push_back({text_sample(self, t.running_time), std::move(t.bytes)});
+  std::vector<size_t> later;  // texts for audio still to come
+  const std::vector<pfap::align::UtteranceSpan> utterances = pfap::align::utterances_of(
+      timed, text_linked ? std::nullopt : property, s.samples.size(), eos, later);
   if (!later.empty()) {
     std::lock_guard<std::mutex> guard(s.lock);
-    s.texts.insert(s.texts.begin(), later.begin(), later.end());
+    std::vector<Text> waiting;
+    for (size_t i : later) waiting.push_back({texts[i].running_time, std::move(timed[i].bytes)});
+    s.texts.insert(s.texts.begin(), waiting.begin(), waiting.end());
   }
-  std::stable_sort(utterances.begin(), utterances.end(),
-                   [](const auto& a, const auto& b) { return a.first < b.first; });
-  GstFlowReturn ret = GST_FLOW_OK;
-  if (utterances.empty()) {
-    ret = recognize_kept(self);
-  } else if (utterances.front().first > 0) {
-    ret = align_utterance(self, "", 0, utterances.front().first, false);
-  }
-  for (size_t i = 0; i < utterances.size() && ret == GST_FLOW_OK; ++i) {
-    const size_t to = i + 1 < utterances.size() ? utterances[i + 1].first : n;
-    ret = align_utterance(self, utterances[i].second, utterances[i].first, to, true);
+  const pfap::align::PhonemeSource source = pfap::align::phoneme_source(!utterances.empty());
+  GstFlowReturn ret =
+      source == pfap::align::PhonemeSource::kTexts ? GST_FLOW_OK : recognize_kept(self, source);
+  for (const pfap::align::UtteranceSpan& u : utterances) {
+    if (ret != GST_FLOW_OK) break;
+    ret = align_utterance(self, u);
   }
   s.samples.clear();
   s.first = GST_CLOCK_TIME_NONE;
@@ -431,34 +401,25 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
 // the audio before the first; without any text, the recognizer's (align/recognizer.h) over
 // the whole stream.
 
-// Whether live audio is recognized: no text, neither the property nor a linked text_sink, and
-// a build with the recognizer.
-static bool live_recognizes(GstPfapAlign* self) {
-  GST_OBJECT_LOCK(self);
-  const bool has_property = self->text != nullptr;
-  GST_OBJECT_UNLOCK(self);
-  return !has_property && !gst_pad_is_linked(self->textpad) && pfap::align::recognition_available();
-}
-
-static GstFlowReturn live_push(GstPfapAlign* self,
-                               const std::vector<pfap::tts::SpokenPhoneme>& phonemes) {
-  return push_phonemes(self, phonemes, self->stream->utterance_from);
+// Where live phonemes come from: the text property, or text_sink when it is linked (even if it
+// gives nothing: the audio is then a pause until its first text).
+static pfap::align::PhonemeSource live_source(GstPfapAlign* self) {
+  return pfap::align::phoneme_source(text_property(self).has_value() ||
+                                     gst_pad_is_linked(self->textpad));
 }
 
 // Ends the open utterance at the audio so far and pushes its last phonemes.
 static GstFlowReturn live_end_utterance(GstPfapAlign* self) {
   Stream& s = *self->stream;
-  if (!s.utterance_open) return GST_FLOW_OK;
-  s.utterance_open = false;
+  const bool recognizing = s.utterances.is_recognizing();
   std::vector<pfap::tts::SpokenPhoneme> phonemes;
-  if (s.recognizing) {
-    s.recognizer.finish(phonemes);
-    const GstClockTime at = s.first + gst_util_uint64_scale(s.utterance_from, GST_SECOND, s.rate);
-    warn_recognition_problem(self, s.recognizer.problem(), at);
-  } else {
-    s.aligner.finish(phonemes);
+  s.utterances.end(phonemes);
+  if (recognizing) {
+    const GstClockTime at =
+        s.first + gst_util_uint64_scale(s.utterances.utterance_start(), GST_SECOND, s.rate);
+    warn_recognition_problem(self, s.utterances.recognition_problem(), at);
   }
-  return live_push(self, phonemes);
+  return push_phonemes(self, phonemes, 0);
 }
 
 // Ends the open utterance and starts that of `bytes` at the audio so far. `is_text` as in
@@ -468,69 +429,50 @@ static GstFlowReturn live_start_utterance(GstPfapAlign* self, const std::string&
   Stream& s = *self->stream;
   const GstFlowReturn ret = live_end_utterance(self);
   if (ret != GST_FLOW_OK) return ret;
-  const GstClockTime at = s.first + gst_util_uint64_scale(s.live_samples, GST_SECOND, s.rate);
+  const GstClockTime at =
+      s.first + gst_util_uint64_scale(s.utterances.samples(), GST_SECOND, s.rate);
   const pfap::tts::Utterance utterance = parse_text(self, bytes, at);
   const pfap::tts::VoiceSettings voice = voice_settings(self);
   std::string error;
-  if (!s.aligner.start(utterance, voice, s.rate, error)) {
+  if (!s.utterances.start_text(utterance, voice, s.rate, error)) {
     GST_ELEMENT_ERROR(self, LIBRARY, FAILED, ("%s", error.c_str()), (nullptr));
     return GST_FLOW_ERROR;
   }
-  if (is_text) warn_problem(self, s.aligner.problem(), at, 0, -1);
-  warn_inexact(self, s.aligner.inexact(), voice);
-  s.utterance_open = true;
-  s.recognizing = false;
-  s.utterance_from = s.live_samples;
+  if (is_text) warn_problem(self, s.utterances.problem(), at, 0, -1);
+  PFAP_WARN_INEXACT_PHONEMES(self, s.utterances.inexact(), voice.voice, s.warned_phonemes);
   return GST_FLOW_OK;
 }
 
 // Without a text: the recognizer's utterance from the audio so far, to the stream's end.
 static GstFlowReturn live_start_recognition(GstPfapAlign* self) {
-  Stream& s = *self->stream;
   std::string error;
-  if (!s.recognizer.start(s.rate, error)) {  // the model is missing
-    GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));
+  if (!self->stream->utterances.start_recognition(self->stream->rate, error)) {
+    GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));  // no model
     return GST_FLOW_ERROR;
   }
-  s.utterance_open = true;
-  s.recognizing = true;
-  s.utterance_from = s.live_samples;
   return GST_FLOW_OK;
 }
 
 // Gives `samples` to the open utterance and pushes the phonemes now settled.
 static GstFlowReturn live_feed(GstPfapAlign* self, std::span<const int16_t> samples) {
-  Stream& s = *self->stream;
   std::vector<pfap::tts::SpokenPhoneme> phonemes;
-  if (s.recognizing) {
-    s.recognizer.push(samples, phonemes);
-  } else {
-    s.aligner.push(samples, phonemes);
-  }
-  s.live_samples += samples.size();
-  return live_push(self, phonemes);
+  self->stream->utterances.push(samples, phonemes);
+  return push_phonemes(self, phonemes, 0);
 }
 
-// Takes the texts of text_sink that start before sample `end`, as (first sample, bytes) in
-// order, none before the audio so far.
-static std::vector<std::pair<size_t, std::string>> live_take_texts(GstPfapAlign* self, size_t end) {
+// Takes the texts of text_sink that start before sample `end` as utterances in order, none
+// before the audio so far.
+static std::vector<pfap::align::UtteranceSpan> live_take_texts(GstPfapAlign* self, size_t end) {
   Stream& s = *self->stream;
-  std::vector<std::pair<size_t, std::string>> starting;
   std::lock_guard<std::mutex> guard(s.lock);
-  std::vector<Text> later;
-  for (Text& t : s.texts) {
-    const size_t from = GST_CLOCK_TIME_IS_VALID(t.running_time)
-                            ? std::max(text_start(self, t.running_time), s.live_samples)
-                            : s.live_samples;
-    if (from < end) {
-      starting.emplace_back(from, std::move(t.bytes));
-    } else {
-      later.push_back(std::move(t));
-    }
-  }
-  s.texts.swap(later);
-  std::stable_sort(starting.begin(), starting.end(),
-                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<pfap::align::TimedText> timed;
+  for (Text& t : s.texts) timed.push_back({text_sample(self, t.running_time), std::move(t.bytes)});
+  std::vector<size_t> later;
+  std::vector<pfap::align::UtteranceSpan> starting =
+      pfap::align::live_utterances_before(timed, s.utterances.samples(), end, later);
+  std::vector<Text> waiting;
+  for (size_t i : later) waiting.push_back({s.texts[i].running_time, std::move(timed[i].bytes)});
+  s.texts.swap(waiting);
   return starting;
 }
 
@@ -541,34 +483,30 @@ static GstFlowReturn live_chain(GstPfapAlign* self, GstBuffer* buffer) {
   std::vector<int16_t> samples;
   GstMapInfo map;
   if (gst_buffer_map(buffer, &map, GST_MAP_READ)) {
-    const auto* in = reinterpret_cast<const uint8_t*>(map.data);
-    samples.resize(map.size / sizeof(int16_t));
-    for (size_t i = 0; i < samples.size(); ++i) {
-      samples[i] = static_cast<int16_t>(GST_READ_UINT16_LE(in + 2 * i));
-    }
+    pfap::align::append_s16le(std::span(map.data, map.size), map.size, samples);
     gst_buffer_unmap(buffer, &map);
   }
   GstFlowReturn ret = GST_FLOW_OK;
-  if (!s.utterance_open) {
-    GST_OBJECT_LOCK(self);
-    const bool has_property = self->text != nullptr;
-    const std::string property = has_property ? self->text : "";
-    GST_OBJECT_UNLOCK(self);
+  if (!s.utterances.is_open()) {
+    const std::optional<std::string> property = text_property(self);
     const bool from_pad = gst_pad_is_linked(self->textpad);
-    if (live_recognizes(self)) {
+    const pfap::align::PhonemeSource source = live_source(self);
+    if (source == pfap::align::PhonemeSource::kRecognition) {
       ret = live_start_recognition(self);
     } else {
-      if (!from_pad && !has_property) warn_cannot_recognize(self);
-      ret = live_start_utterance(self, from_pad ? "" : property, !from_pad && has_property);
+      if (source == pfap::align::PhonemeSource::kPause) warn_cannot_recognize(self);
+      ret = live_start_utterance(self, from_pad ? "" : property.value_or(""),
+                                 !from_pad && property.has_value());
     }
   }
   size_t done = 0;
-  for (auto& [from, bytes] : live_take_texts(self, s.live_samples + samples.size())) {
+  for (const pfap::align::UtteranceSpan& u :
+       live_take_texts(self, s.utterances.samples() + samples.size())) {
     if (ret != GST_FLOW_OK) break;
-    const size_t n = from - s.live_samples;
+    const size_t n = u.from - s.utterances.samples();
     ret = live_feed(self, std::span(samples).subspan(done, n));
     done += n;
-    if (ret == GST_FLOW_OK) ret = live_start_utterance(self, bytes, true);
+    if (ret == GST_FLOW_OK) ret = live_start_utterance(self, u.text, true);
   }
   if (ret == GST_FLOW_OK) ret = live_feed(self, std::span(samples).subspan(done));
   if (ret != GST_FLOW_OK) {
@@ -584,7 +522,7 @@ static GstFlowReturn live_end(GstPfapAlign* self) {
   Stream& s = *self->stream;
   const GstFlowReturn ret = live_end_utterance(self);
   s.first = GST_CLOCK_TIME_NONE;
-  s.live_samples = 0;
+  s.utterances.reset();
   return ret;
 }
 
@@ -594,8 +532,9 @@ static gboolean live_latency_query(GstPfapAlign* self, GstQuery* query) {
   gboolean live = FALSE;
   GstClockTime min = 0, max = GST_CLOCK_TIME_NONE;
   gst_query_parse_latency(query, &live, &min, &max);
-  const GstClockTime ours = (live_recognizes(self) ? pfap::align::kLiveRecognitionLatencyMs
-                                                   : pfap::align::kLiveLatencyMs) *
+  const GstClockTime ours = (live_source(self) == pfap::align::PhonemeSource::kRecognition
+                                 ? pfap::align::kLiveRecognitionLatencyMs
+                                 : pfap::align::kLiveLatencyMs) *
                             GST_MSECOND;
   GST_DEBUG_OBJECT(self, "upstream latency %" GST_TIME_FORMAT ", ours %" GST_TIME_FORMAT,
                    GST_TIME_ARGS(min), GST_TIME_ARGS(ours));
@@ -639,10 +578,7 @@ static GstFlowReturn chain_audio(GstPfapAlign* self, GstBuffer* buffer) {
                            kMaxSeconds),
                           ("give the text as utterances with PTS on text_sink"));
     }
-    const auto* in = reinterpret_cast<const uint8_t*>(map.data);
-    for (size_t i = 0; i < std::min(count, room); ++i) {
-      s.samples.push_back(static_cast<int16_t>(GST_READ_UINT16_LE(in + 2 * i)));
-    }
+    pfap::align::append_s16le(std::span(map.data, map.size), room, s.samples);
     gst_buffer_unmap(buffer, &map);
   }
   return gst_flow_combiner_update_pad_flow(self->flow_combiner, self->srcpad,
@@ -815,11 +751,7 @@ static GstStateChangeReturn gst_pfap_align_change_state(GstElement* element,
     GST_OBJECT_UNLOCK(self);
     unsigned rate = 0;
     std::string error;
-    GST_OBJECT_LOCK(self);
-    pfap::tts::VoiceSettings voice;
-    voice.voice = self->voice;
-    GST_OBJECT_UNLOCK(self);
-    if (!pfap::tts::check_voice(voice, rate, error)) {
+    if (!pfap::tts::check_voice(voice_settings(self), rate, error)) {
       GST_ELEMENT_ERROR(self, RESOURCE, NOT_FOUND, ("%s", error.c_str()), (nullptr));
       return GST_STATE_CHANGE_FAILURE;
     }

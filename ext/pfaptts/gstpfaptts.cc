@@ -49,10 +49,13 @@
 #include <string>
 #include <vector>
 
-#include "pfap/markup.h"
+#include "inexact.h"
 #include "markupbuffer.h"
+#include "noseek.h"
+#include "pfap/markup.h"
 #include "pieces.h"
 #include "ratelimit.h"
+#include "sparse.h"
 #include "speech.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfaptts_debug);
@@ -189,7 +192,7 @@ static void send_events(GstPfapTts* self, unsigned rate) {
       GstEvent* start = gst_event_new_stream_start(id);
       g_free(id);
       gst_event_set_group_id(start, group);
-      if (pad == self->pfappad) gst_event_set_stream_flags(start, GST_STREAM_FLAG_SPARSE);
+      if (pad == self->pfappad) start = pfap_make_sparse(start);
       gst_pad_push_event(pad, start);
     }
     GstCaps* caps = gst_static_pad_template_get_caps(&pfap_template);
@@ -262,18 +265,6 @@ static GstFlowReturn push_silence(GstPfapTts* self, GstClockTime until) {
   return push_audio(self, nullptr, n);
 }
 
-static void warn_inexact(GstPfapTts* self, const pfap::tts::Speech& speech,
-                         const std::string& voice) {
-  for (const pfap::tts::Speech::Inexact& i : speech.inexact) {
-    if (!self->stream->warned_phonemes.insert(i.mnemonic).second) continue;
-    const std::string sent_as(i.sent_as);
-    GST_ELEMENT_WARNING(self, STREAM, FORMAT,
-                        ("espeak-ng phoneme \"%s\" of voice \"%s\" is not in x-pfap-arpabet",
-                         i.mnemonic.c_str(), voice.c_str()),
-                        ("sent as %s", sent_as.c_str()));
-  }
-}
-
 // Speaks one piece of an utterance starting at running time `at` (GST_CLOCK_TIME_NONE: right
 // after the audio before it) and pushes it on both pads, phonemes interleaved with their audio.
 static GstFlowReturn speak_piece(GstPfapTts* self, const pfap::tts::Utterance& piece,
@@ -286,7 +277,7 @@ static GstFlowReturn speak_piece(GstPfapTts* self, const pfap::tts::Utterance& p
     return GST_FLOW_ERROR;
   }
   if (s.cancel) return GST_FLOW_FLUSHING;
-  warn_inexact(self, speech, settings.voice);
+  PFAP_WARN_INEXACT_PHONEMES(self, speech.inexact, settings.voice, s.warned_phonemes);
 
   send_events(self, speech.sample_rate);
   GstFlowReturn ret = GST_FLOW_OK;
@@ -439,15 +430,6 @@ static gboolean gst_pfap_tts_sink_event(GstPad* pad, GstObject* parent, GstEvent
       break;
     default:
       break;
-  }
-  return gst_pad_event_default(pad, parent, event);
-}
-
-// The utterances' times come from upstream or from the text alone: seeking cannot work.
-static gboolean gst_pfap_tts_src_event(GstPad* pad, GstObject* parent, GstEvent* event) {
-  if (GST_EVENT_TYPE(event) == GST_EVENT_SEEK) {
-    gst_event_unref(event);
-    return FALSE;
   }
   return gst_pad_event_default(pad, parent, event);
 }
@@ -700,7 +682,8 @@ static void gst_pfap_tts_init(GstPfapTts* self) {
   gst_pad_set_activatemode_function(self->audiopad, gst_pfap_tts_audio_activate_mode);
   for (GstPad* pad : {self->audiopad, self->pfappad}) {
     gst_pad_use_fixed_caps(pad);
-    gst_pad_set_event_function(pad, gst_pfap_tts_src_event);
+    // The utterances' times come from upstream or from the text alone: seeking cannot work.
+    gst_pad_set_event_function(pad, pfap_noseek_src_event);
     gst_element_add_pad(GST_ELEMENT(self), pad);
     gst_flow_combiner_add_pad(self->flow_combiner, pad);
   }

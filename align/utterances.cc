@@ -1,0 +1,127 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+#include "utterances.h"
+
+#include <algorithm>
+#include <utility>
+
+namespace pfap::align {
+
+namespace {
+
+void sort_by_start(std::vector<UtteranceSpan>& utterances) {
+  std::stable_sort(utterances.begin(), utterances.end(),
+                   [](const UtteranceSpan& a, const UtteranceSpan& b) { return a.from < b.from; });
+}
+
+}  // namespace
+
+PhonemeSource phoneme_source(bool has_text) {
+  if (has_text) return PhonemeSource::kTexts;
+  return recognition_available() ? PhonemeSource::kRecognition : PhonemeSource::kPause;
+}
+
+std::vector<UtteranceSpan> utterances_of(std::vector<TimedText>& texts,
+                                         const std::optional<std::string>& whole, size_t n,
+                                         bool end_of_stream, std::vector<size_t>& later) {
+  std::vector<UtteranceSpan> utterances;
+  if (whole.has_value()) utterances.push_back({0, n, *whole, true});
+  for (size_t i = 0; i < texts.size(); ++i) {
+    TimedText& t = texts[i];
+    if (!t.from.has_value()) {
+      if (utterances.empty()) {
+        utterances.push_back({0, n, std::move(t.bytes), true});
+      } else {
+        utterances.back().text += t.bytes;
+      }
+      continue;
+    }
+    if (*t.from >= n && !end_of_stream) {
+      later.push_back(i);
+      continue;
+    }
+    utterances.push_back({std::min(*t.from, n), n, std::move(t.bytes), true});
+  }
+  if (utterances.empty()) return utterances;
+  sort_by_start(utterances);
+  for (size_t i = 0; i + 1 < utterances.size(); ++i) utterances[i].to = utterances[i + 1].from;
+  utterances.back().to = n;
+  if (utterances.front().from > 0) {
+    utterances.insert(utterances.begin(), {0, utterances.front().from, std::string(), false});
+  }
+  return utterances;
+}
+
+std::vector<UtteranceSpan> live_utterances_before(std::vector<TimedText>& texts, size_t now,
+                                                  size_t end, std::vector<size_t>& later) {
+  std::vector<UtteranceSpan> starting;
+  for (size_t i = 0; i < texts.size(); ++i) {
+    const size_t from = std::max(texts[i].from.value_or(now), now);
+    if (from < end) {
+      starting.push_back({from, end, std::move(texts[i].bytes), true});
+    } else {
+      later.push_back(i);
+    }
+  }
+  sort_by_start(starting);
+  return starting;
+}
+
+void append_s16le(std::span<const uint8_t> bytes, size_t max_count, std::vector<int16_t>& samples) {
+  const size_t taken = std::min(bytes.size() / sizeof(int16_t), max_count);
+  samples.reserve(samples.size() + taken);
+  for (size_t i = 0; i < taken; ++i) {
+    samples.push_back(static_cast<int16_t>(bytes[2 * i] | (bytes[2 * i + 1] << 8)));
+  }
+}
+
+void LiveUtterances::reset() {
+  open_ = false;
+  samples_ = 0;
+}
+
+bool LiveUtterances::start_text(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
+                                unsigned rate, std::string& error) {
+  if (!aligner_.start(utterance, voice, rate, error)) return false;
+  open_ = true;
+  recognizing_ = false;
+  from_ = samples_;
+  return true;
+}
+
+bool LiveUtterances::start_recognition(unsigned rate, std::string& error) {
+  if (!recognizer_.start(rate, error)) return false;
+  open_ = true;
+  recognizing_ = true;
+  from_ = samples_;
+  return true;
+}
+
+void LiveUtterances::push(std::span<const int16_t> samples, std::vector<tts::SpokenPhoneme>& out) {
+  const size_t first = out.size();
+  if (recognizing_) {
+    recognizer_.push(samples, out);
+  } else {
+    aligner_.push(samples, out);
+  }
+  samples_ += samples.size();
+  count_from_stream_start(out, first);
+}
+
+void LiveUtterances::end(std::vector<tts::SpokenPhoneme>& out) {
+  if (!open_) return;
+  open_ = false;
+  const size_t first = out.size();
+  if (recognizing_) {
+    recognizer_.finish(out);
+  } else {
+    aligner_.finish(out);
+  }
+  count_from_stream_start(out, first);
+}
+
+void LiveUtterances::count_from_stream_start(std::vector<tts::SpokenPhoneme>& out,
+                                             size_t first) const {
+  for (size_t i = first; i < out.size(); ++i) out[i].start += from_;
+}
+
+}  // namespace pfap::align

@@ -1,0 +1,107 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// pfapalign's logic beside the aligner and the recognizer, without GStreamer: where a stream's
+// phonemes come from (its texts, the recognizer or a pause), which stretch of the recording
+// each text is the utterance of (the texts come with the sample they start at: the element
+// turns their running time into it), the live mode's open utterance, and the audio's bytes
+// (S16LE) as samples. docs/align.md, "Timeline and utterances".
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "recognizer.h"
+#include "streaming.h"
+
+namespace pfap::align {
+
+// Where a stream's phonemes come from, offline and live: its texts, when it has any; else the
+// audio alone, recognized (recognizer.h); else, in a build without the recognizer, one pause
+// (which the element warns about).
+enum class PhonemeSource { kTexts, kRecognition, kPause };
+PhonemeSource phoneme_source(bool has_text);
+
+// One text: the sample it starts at, counted from the first sample kept (none: it has no
+// time, and continues the text before it offline or starts at the audio so far live), and its
+// bytes (any, UTF-8 is checked later).
+struct TimedText {
+  std::optional<size_t> from;
+  std::string bytes;
+};
+
+// The utterance of `text` over samples [from, to). `is_text`: false for the audio before the
+// first text, a pause whose empty text is no problem.
+struct UtteranceSpan {
+  size_t from = 0;
+  size_t to = 0;
+  std::string text;
+  bool is_text = true;
+};
+
+// Offline: the utterances of the `n` samples kept, in order, tiling [0, n). `whole` is the
+// text of the whole stream (the text property, when no text pad is linked), an utterance from
+// 0 before `texts`. A text without a start continues the one before (the first starts at 0);
+// a text from beyond the audio starts at its end at `end_of_stream`, and else waits: its index
+// in `texts` goes to `later` (in order) and it is left as it is; the bytes of the others are
+// moved out. The audio before the first
+// utterance is one that is not a text. Empty when there is no text at all: the audio is to be
+// recognized.
+std::vector<UtteranceSpan> utterances_of(std::vector<TimedText>& texts,
+                                         const std::optional<std::string>& whole, size_t n,
+                                         bool end_of_stream, std::vector<size_t>& later);
+
+// Live: of `texts`, those that start before sample `end`, as utterance starts in order
+// (UtteranceSpan::to is `end`), none before `now` (the audio so far; a text without a start,
+// or a late one, starts there). The others' indices go to `later`, in order, and they are left
+// as they are; the bytes of those taken are moved out.
+std::vector<UtteranceSpan> live_utterances_before(std::vector<TimedText>& texts, size_t now,
+                                                  size_t end, std::vector<size_t>& later);
+
+// Appends the S16LE samples in `bytes` (an odd last byte left out) to `samples`, at most
+// `max_count` of them.
+void append_s16le(std::span<const uint8_t> bytes, size_t max_count, std::vector<int16_t>& samples);
+
+// Live: a stream's utterances, one open at a time, as its audio comes: each aligned to its
+// text (StreamingAligner) or, without a text, recognized to the stream's end
+// (StreamingRecognizer). Phoneme starts count from the stream's first sample.
+class LiveUtterances {
+ public:
+  // A new stream: nothing open, no audio yet.
+  void reset();
+  bool is_open() const { return open_; }
+  bool is_recognizing() const { return open_ && recognizing_; }
+  size_t samples() const { return samples_; }       // the audio so far
+  size_t utterance_start() const { return from_; }  // the open utterance's first sample
+
+  // Opens the utterance of `utterance` at the audio so far (end() the open one first). False
+  // with `error` where espeak-ng cannot speak; problem() and inexact() then say what of it
+  // cannot be aligned exactly.
+  bool start_text(const tts::Utterance& utterance, const tts::VoiceSettings& voice, unsigned rate,
+                  std::string& error);
+  // Opens the recognizer's utterance at the audio so far (end() the open one first). False
+  // with `error` where the model cannot be loaded.
+  bool start_recognition(unsigned rate, std::string& error);
+  // Gives `samples` to the open utterance; the phonemes now settled to `out`.
+  void push(std::span<const int16_t> samples, std::vector<tts::SpokenPhoneme>& out);
+  // Ends the open utterance, if any, at the audio so far: its last phonemes to `out`.
+  void end(std::vector<tts::SpokenPhoneme>& out);
+
+  Problem problem() const { return aligner_.problem(); }
+  const std::vector<tts::Speech::Inexact>& inexact() const { return aligner_.inexact(); }
+  RecognitionProblem recognition_problem() const { return recognizer_.problem(); }
+
+ private:
+  void count_from_stream_start(std::vector<tts::SpokenPhoneme>& out, size_t first) const;
+
+  StreamingAligner aligner_;
+  StreamingRecognizer recognizer_;
+  bool open_ = false;
+  bool recognizing_ = false;
+  size_t from_ = 0;
+  size_t samples_ = 0;
+};
+
+}  // namespace pfap::align

@@ -1,0 +1,159 @@
+// SPDX-License-Identifier: LGPL-2.1-or-later
+// pfapalign's cutting of the audio into utterances (align/utterances.h), offline and live,
+// and its reading of S16LE.
+#include <gtest/gtest.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "recognizer.h"
+#include "speech_fixtures.h"
+#include "utterances.h"
+
+namespace {
+
+using pfap::align::TimedText;
+using pfap::align::UtteranceSpan;
+namespace tts = pfap::tts;
+
+struct Expected {
+  size_t from;
+  size_t to;
+  std::string text;
+  bool is_text;
+};
+
+void expect_spans(const std::vector<UtteranceSpan>& got, const std::vector<Expected>& want) {
+  ASSERT_EQ(got.size(), want.size());
+  for (size_t i = 0; i < want.size(); ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_EQ(got[i].from, want[i].from);
+    EXPECT_EQ(got[i].to, want[i].to);
+    EXPECT_EQ(got[i].text, want[i].text);
+    EXPECT_EQ(got[i].is_text, want[i].is_text);
+  }
+}
+
+TEST(Utterances, TextsComeFirstThenTheRecognizerThenAPause) {
+  using pfap::align::PhonemeSource;
+  EXPECT_EQ(pfap::align::phoneme_source(true), PhonemeSource::kTexts);
+  EXPECT_EQ(pfap::align::phoneme_source(false), pfap::align::recognition_available()
+                                                    ? PhonemeSource::kRecognition
+                                                    : PhonemeSource::kPause);
+}
+
+TEST(Utterances, NoTextAtAllIsToBeRecognized) {
+  std::vector<TimedText> texts;
+  std::vector<size_t> later;
+  EXPECT_TRUE(pfap::align::utterances_of(texts, std::nullopt, 1000, true, later).empty());
+  EXPECT_TRUE(later.empty());
+}
+
+TEST(Utterances, TheWholeTextCoversTheAudio) {
+  std::vector<TimedText> texts;
+  std::vector<size_t> later;
+  expect_spans(pfap::align::utterances_of(texts, std::string("Hello."), 1000, true, later),
+               {{0, 1000, "Hello.", true}});
+}
+
+TEST(Utterances, TextsWithoutATimeContinueTheOneBefore) {
+  // A file read in blocks: the first block starts at 0, the others continue it.
+  std::vector<TimedText> texts = {
+      {std::nullopt, "Hel"}, {std::nullopt, "lo."}, {500, "Bye."}, {std::nullopt, " Now."}};
+  std::vector<size_t> later;
+  expect_spans(pfap::align::utterances_of(texts, std::nullopt, 1000, false, later),
+               {{0, 500, "Hello.", true}, {500, 1000, "Bye. Now.", true}});
+}
+
+TEST(Utterances, TheAudioBeforeTheFirstTextIsAPauseAndTextsAreSorted) {
+  std::vector<TimedText> texts = {{700, "Two."}, {300, "One."}};
+  std::vector<size_t> later;
+  expect_spans(pfap::align::utterances_of(texts, std::nullopt, 1000, false, later),
+               {{0, 300, "", false}, {300, 700, "One.", true}, {700, 1000, "Two.", true}});
+}
+
+TEST(Utterances, TextsBeyondTheAudioWaitUntilTheEnd) {
+  std::vector<TimedText> texts = {{100, "Now."}, {1000, "Later."}, {5000, "Much later."}};
+  std::vector<size_t> later;
+  const auto spans = pfap::align::utterances_of(texts, std::nullopt, 1000, false, later);
+  expect_spans(spans, {{0, 100, "", false}, {100, 1000, "Now.", true}});
+  EXPECT_EQ(later, (std::vector<size_t>{1, 2}));
+  EXPECT_EQ(texts[1].bytes, "Later.");  // left for the caller to keep
+  EXPECT_EQ(texts[2].bytes, "Much later.");
+
+  // At the end of the stream they start at the audio's end, empty.
+  std::vector<TimedText> at_end = {{100, "Now."}, {5000, "Much later."}};
+  later.clear();
+  expect_spans(pfap::align::utterances_of(at_end, std::nullopt, 1000, true, later),
+               {{0, 100, "", false}, {100, 1000, "Now.", true}, {1000, 1000, "Much later.", true}});
+  EXPECT_TRUE(later.empty());
+}
+
+TEST(Utterances, LiveTextsStartNoEarlierThanTheAudioSoFar) {
+  std::vector<TimedText> texts = {{900, "Late in the block."},
+                                  {std::nullopt, "No time."},
+                                  {100, "Came late."},
+                                  {2000, "Next."}};
+  std::vector<size_t> later;
+  expect_spans(pfap::align::live_utterances_before(texts, 500, 1000, later),
+               {{500, 1000, "No time.", true},
+                {500, 1000, "Came late.", true},
+                {900, 1000, "Late in the block.", true}});
+  EXPECT_EQ(later, (std::vector<size_t>{3}));
+  EXPECT_EQ(texts[3].bytes, "Next.");
+}
+
+TEST(Utterances, S16leIsLittleEndianSignedAndCapped) {
+  const std::vector<uint8_t> bytes = {0x01, 0x00, 0xff, 0xff, 0x00, 0x80, 0xff, 0x7f, 0x42};
+  std::vector<int16_t> samples = {7};
+  pfap::align::append_s16le(bytes, 100, samples);
+  EXPECT_EQ(samples, (std::vector<int16_t>{7, 1, -1, -32768, 32767}));  // the odd byte left out
+  pfap::align::append_s16le(bytes, 2, samples);
+  EXPECT_EQ(samples, (std::vector<int16_t>{7, 1, -1, -32768, 32767, 1, -1}));
+}
+
+TEST(Utterances, LivePhonemesCountFromTheStreamsStartAndTileIt) {
+  const tts::Speech one = pfap::align::testing::say("Hello world.", {});
+  const tts::Speech two = pfap::align::testing::say("Good morning.", {});
+  const unsigned rate = one.sample_rate;
+  pfap::align::LiveUtterances live;
+  std::vector<tts::SpokenPhoneme> out;
+  std::string error;
+  EXPECT_FALSE(live.is_open());
+  ASSERT_TRUE(live.start_text(pfap::align::testing::utterance("Hello world."), {}, rate, error))
+      << error;
+  EXPECT_TRUE(live.is_open());
+  EXPECT_FALSE(live.is_recognizing());
+  const size_t block = rate / 50;
+  for (size_t i = 0; i < one.samples.size(); i += block) {
+    live.push(std::span(one.samples).subspan(i, std::min(block, one.samples.size() - i)), out);
+  }
+  live.end(out);
+  EXPECT_FALSE(live.is_open());
+  const size_t first_count = out.size();
+  ASSERT_TRUE(live.start_text(pfap::align::testing::utterance("Good morning."), {}, rate, error))
+      << error;
+  EXPECT_EQ(live.utterance_start(), one.samples.size());
+  for (size_t i = 0; i < two.samples.size(); i += block) {
+    live.push(std::span(two.samples).subspan(i, std::min(block, two.samples.size() - i)), out);
+  }
+  live.end(out);
+  live.end(out);  // nothing open: nothing more
+  EXPECT_EQ(live.samples(), one.samples.size() + two.samples.size());
+
+  ASSERT_GT(out.size(), first_count);
+  EXPECT_EQ(out[first_count].start, one.samples.size());  // the second from its first sample
+  size_t next = 0;
+  for (const tts::SpokenPhoneme& p : out) {
+    EXPECT_EQ(p.start, next);
+    next = p.start + p.n_samples;
+  }
+  EXPECT_EQ(next, live.samples());
+
+  live.reset();
+  EXPECT_EQ(live.samples(), 0u);
+  EXPECT_FALSE(live.is_open());
+}
+
+}  // namespace
