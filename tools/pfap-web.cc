@@ -22,6 +22,7 @@
 // the page its own address when the browser hides it (pfap-web-stun.h, docs/web.md).
 #include <glib-unix.h>
 #include <gst/app/gstappsink.h>
+#include <gst/app/gstappsrc.h>
 #include <gst/gst.h>
 #include <gst/rtp/gstrtpbuffer.h>
 #include <gst/sdp/sdp.h>
@@ -599,6 +600,37 @@ gboolean on_bus(GstBus*, GstMessage* m, gpointer data) {
   return G_SOURCE_CONTINUE;
 }
 
+// webrtcbin 1.22 leaks the ERROR message that its data channel's appsrc posts when a push
+// fails, and with it the appsrc: the data channel's bin takes the message and never unrefs
+// it (WebRTCErrorIgnoreBin in gst-plugins-bad's webrtcdatachannel.c; fixed upstream later).
+// A push fails when the peer leaves mid-sentence: its SCTP association is gone while PFAP
+// packets still flow, until the WebSocket closes and the session with it. So the appsrc's
+// buffers go downstream through this probe, and a failed push ends its task quietly, as a
+// flushing pad does. What failed is not hidden: sctpenc posts its own error to the bus.
+GstPadProbeReturn push_without_error(GstPad* pad, GstPadProbeInfo* info, gpointer) {
+  GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+  GST_PAD_PROBE_INFO_DATA(info) = nullptr;
+  GstPad* peer = gst_pad_get_peer(pad);
+  GstFlowReturn flow = GST_FLOW_NOT_LINKED;
+  if (peer != nullptr) {
+    flow = gst_pad_chain(peer, buffer);
+    gst_object_unref(peer);
+  } else {
+    gst_buffer_unref(buffer);
+  }
+  GST_PAD_PROBE_INFO_FLOW_RETURN(info) =
+      flow == GST_FLOW_NOT_LINKED || flow < GST_FLOW_EOS ? GST_FLOW_FLUSHING : flow;
+  return GST_PAD_PROBE_HANDLED;
+}
+
+// webrtcbin adds the data channel's appsrc once the channel is linked to SCTP.
+void on_webrtc_element_added(GstBin*, GstBin*, GstElement* element, gpointer) {
+  if (!GST_IS_APP_SRC(element)) return;
+  GstPad* src = gst_element_get_static_pad(element, "src");
+  gst_pad_add_probe(src, GST_PAD_PROBE_TYPE_BUFFER, push_without_error, nullptr, nullptr);
+  gst_object_unref(src);
+}
+
 void close_session(const std::shared_ptr<Session>& s) {
   if (s->closed) return;
   s->closed = true;
@@ -706,6 +738,8 @@ std::shared_ptr<Session> open_session(Server& server, SoupWebsocketConnection* w
                         weak(s), free_weak, GConnectFlags(0));
   g_signal_connect_data(s->webrtc, "on-ice-candidate", G_CALLBACK(on_ice_candidate), weak(s),
                         free_weak, GConnectFlags(0));
+  g_signal_connect(s->webrtc, "deep-element-added", G_CALLBACK(on_webrtc_element_added),
+                   nullptr);
   gst_bus_add_watch_full(GST_ELEMENT_BUS(s->pipeline), G_PRIORITY_DEFAULT, on_bus, weak(s),
                          free_weak_data);
 
