@@ -34,6 +34,7 @@
 
 #include "command_line.h"
 #include "launch_value.h"
+#include "pad_time.h"
 #include "pfap/model.h"
 #include "pfap/payload.h"
 #include "pfap/recovery.h"
@@ -148,18 +149,6 @@ void send_text(Sender& s, const std::string& json) { send_datagram(s, json.data(
 uint32_t pfap_timestamp(const Sender& s, GstClockTime running) {
   return s.pfap_ts_offset +
          static_cast<uint32_t>(gst_util_uint64_scale_int(running, kPfapClockRate, GST_SECOND));
-}
-
-GstClockTime running_time_of(GstPad* pad, GstBuffer* buffer) {
-  if (!GST_BUFFER_PTS_IS_VALID(buffer)) return GST_CLOCK_TIME_NONE;
-  GstEvent* event = gst_pad_get_sticky_event(pad, GST_EVENT_SEGMENT, 0);
-  if (event == nullptr) return GST_CLOCK_TIME_NONE;
-  const GstSegment* segment = nullptr;
-  gst_event_parse_segment(event, &segment);
-  const GstClockTime running =
-      gst_segment_to_running_time(segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
-  gst_event_unref(event);
-  return running;
 }
 
 // -- The level: the RMS of each ms by PFAP timestamp, sent as the audio enters the queue ------

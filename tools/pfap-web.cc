@@ -49,6 +49,7 @@
 
 #include "command_line.h"
 #include "launch_value.h"
+#include "pad_time.h"
 #include "pfap-web-signal.h"
 #include "pfap-web-stun.h"
 #include "pfap/model.h"
@@ -420,16 +421,7 @@ GstPadProbeReturn on_speech(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
   }
   GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
   if (e.start == GST_CLOCK_TIME_NONE) {
-    GstEvent* event = gst_pad_get_sticky_event(pad, GST_EVENT_SEGMENT, 0);
-    if (event == nullptr || !GST_BUFFER_PTS_IS_VALID(buffer)) {
-      if (event != nullptr) gst_event_unref(event);
-      return GST_PAD_PROBE_OK;
-    }
-    const GstSegment* segment = nullptr;
-    gst_event_parse_segment(event, &segment);
-    const GstClockTime running =
-        gst_segment_to_running_time(segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
-    gst_event_unref(event);
+    const GstClockTime running = running_time_of(pad, buffer);
     if (!GST_CLOCK_TIME_IS_VALID(running)) return GST_PAD_PROBE_OK;
     e.start = running + e.offset;
   }
