@@ -24,9 +24,9 @@
  * viseme's time from the start of the input. The output is a TIME segment from 0.
  *
  * A bad line (not JSON, a missing field, an unknown viseme, time going back, more than 64 KiB)
- * is an error naming its line, its column (bytes, from 1) and what is wrong; with
- * #GstPfapMarksParse:skip-bad-lines it is a warning (rate-limited: the 1st, 2nd, 4th, ...) and
- * reading goes on. In a Rhubarb JSON document the bad item is a cue: skipped, every other cue
+ * is an error naming its line, its column (bytes, from 1), the file when upstream reads one,
+ * and what is wrong; with #GstPfapMarksParse:skip-bad-lines it is a warning (rate-limited: the
+ * 1st, 2nd, 4th, ...) and reading goes on. In a Rhubarb JSON document the bad item is a cue: skipped, every other cue
  * is kept (the time it held is a rest); a document past 16 MiB is one bad item. A UTF-8 byte
  * order mark at the start of the input is skipped.
  *

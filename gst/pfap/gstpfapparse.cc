@@ -20,10 +20,11 @@
  * lines give nothing.
  *
  * A bad line (a field that does not parse, time going back, bad bookmarks, invalid UTF-8,
- * more than 65536 bytes, or a time past about 292 years) is an
- * error naming its line, its column (in bytes, from 1) and what is wrong; with
- * #GstPfapParse:skip-bad-lines it is a warning instead (at the 1st, 2nd, 4th, ... bad line,
- * all counted in the stats property's bad-lines), and the lines after it are read as usual. Input
+ * more than 65536 bytes without its line end, or a time past about 292 years) is an error
+ * naming its line, its column (in bytes, from 1) and what is wrong, and nothing after it is
+ * read; with #GstPfapParse:skip-bad-lines it is a warning instead (at the 1st, 2nd, 4th, ...
+ * bad line, all counted in the stats property's bad-lines), and the lines after it are read
+ * as usual. Input
  * that arrives from sources without caps (filesrc, fdsrc) is taken as .pfap text; caps, when
  * given, must be text/x-pfap (the typefinder's, for decodebin) or text/x-raw,format=utf8.
  *
