@@ -158,7 +158,8 @@ static GstFlowReturn gst_pfap_marks_parse_read_chunk(GstPfapBaseParse* parse,
   Stream& s = *self->stream;
   if (!s.started) {
     const size_t first = data.find_first_not_of(" \t\r\n");
-    if (first == std::string_view::npos) return GST_FLOW_OK;
+    // Blank lines still count (a document's are only white space before it).
+    if (first == std::string_view::npos) return gst_pfap_base_parse_read_lines(parse, data);
     s.started = true;
     s.document = data[first] == '{' && s.reader.alphabet() == pfap::kRhubarbShapeAlphabet;
   }
