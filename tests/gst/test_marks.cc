@@ -245,8 +245,7 @@ TEST_F(MarksParse, RhubarbJsonAfterBuffersOfWhiteSpaceIsADocument) {
   make("pfapmarksparse format=rhubarb");
   const std::string doc = "{\"mouthCues\":[{\"start\":0.0,\"end\":0.1,\"value\":\"A\"}]}";
   for (const std::string& piece : {std::string("\n"), std::string("  "), doc}) {
-    ASSERT_EQ(gst_harness_push(h_, gst_buffer_new_memdup(piece.data(), piece.size())),
-              GST_FLOW_OK);
+    ASSERT_EQ(gst_harness_push(h_, gst_buffer_new_memdup(piece.data(), piece.size())), GST_FLOW_OK);
   }
   gst_harness_push_event(h_, gst_event_new_eos());
   EXPECT_EQ(pull_events(h_).size(), 1u);
