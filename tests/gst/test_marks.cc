@@ -228,6 +228,30 @@ TEST_F(MarksParse, BadLineIsAnErrorNamingLineAndColumn) {
   EXPECT_EQ(errors[0], "Bad line 2, column 34: not a viseme of this format");
 }
 
+// Blank lines before the first mark count however they come: they were left uncounted when a
+// buffer held nothing else.
+TEST_F(MarksParse, BlankLinesInBuffersOfTheirOwnAreCounted) {
+  make("pfapmarksparse format=azure");
+  for (const std::string piece : {"\n", "  \r\n", "{\"audioOffset\":0,\"visemeId\":99}\n"}) {
+    gst_harness_push(h_, gst_buffer_new_memdup(piece.data(), piece.size()));
+  }
+  const std::vector<std::string> errors = messages(bus_, GST_MESSAGE_ERROR);
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_EQ(errors[0], "Bad line 3, column 29: not a viseme of this format");
+}
+
+// White space in buffers of its own before a Rhubarb JSON document is no line of TSV.
+TEST_F(MarksParse, RhubarbJsonAfterBuffersOfWhiteSpaceIsADocument) {
+  make("pfapmarksparse format=rhubarb");
+  const std::string doc = "{\"mouthCues\":[{\"start\":0.0,\"end\":0.1,\"value\":\"A\"}]}";
+  for (const std::string& piece : {std::string("\n"), std::string("  "), doc}) {
+    ASSERT_EQ(gst_harness_push(h_, gst_buffer_new_memdup(piece.data(), piece.size())), GST_FLOW_OK);
+  }
+  gst_harness_push_event(h_, gst_event_new_eos());
+  EXPECT_EQ(pull_events(h_).size(), 1u);
+  EXPECT_TRUE(messages(bus_, GST_MESSAGE_ERROR).empty());
+}
+
 TEST_F(MarksParse, SkipBadLinesWarnsRateLimitedAndGoesOn) {
   make("pfapmarksparse format=rhubarb skip-bad-lines=true");
   std::string text = "0.00\tX\n";
