@@ -39,7 +39,7 @@ std::string_view to_string(MarksFormat format);
 // once at finish() for Rhubarb JSON (one document), per batch of frames for ARKit.
 class MarksWriter {
  public:
-  // Receives each piece of text as it is complete; returns false to stop writing.
+  // Receives each piece of text once it is written; returns false to stop writing.
   using Sink = std::function<bool(std::string_view)>;
 
   static constexpr size_t kMaxUtterancePhonemes = 4096;
