@@ -19,13 +19,14 @@
 #include <iostream>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "documented_commands.h"
+#include "element_harness.h"
 #include "pfap/fap_animation.h"
 #include "pfap/fap_file.h"
 #include "pfap/fap_state.h"
-#include "documented_commands.h"
-#include "element_harness.h"
 #include "pfap_buffers.h"
 #include "pipeline.h"
 #include "temp_dir.h"
@@ -506,6 +507,28 @@ GstBuffer* phoneme_at(GstClockTime pts, uint16_t duration_ms, std::vector<pfap::
   e.phoneme.duration_ms = duration_ms;
   e.faps = std::move(faps);
   return pfap::testing::markup_buffer(e, pts);
+}
+
+// frame-rate is a fraction, as GStreamer's framerates are; "25" typed in a pipeline is still
+// 25/1 (1.22 refuses a decimal: 12.5 is typed 25/2). The file's header holds a decimal number.
+TEST(PfapFapEnc, FrameRateIsAFractionAndWholeNumbersStillParse) {
+  ASSERT_TRUE(plugin_available(kElements));
+  for (const auto& [typed, rate] :
+       {std::pair{"25", 25.0}, std::pair{"25/2", 12.5}, std::pair{"30000/1001", 29.97002997}}) {
+    const Encoded out = encode(std::string("frame-rate=") + typed,
+                               {phoneme_at(0, 100, {{3, 50, 0, pfap::Curve::kLinear}})});
+    pfap::FapFile file;
+    const pfap::FapFileResult result = pfap::read_fap_file(out.text, file);
+    ASSERT_TRUE(result.ok()) << typed << ": " << pfap::describe(result) << "\n" << out.text;
+    EXPECT_EQ(file.header.frame_rate, rate) << typed;
+    EXPECT_TRUE(out.warnings.empty()) << typed;
+  }
+  GstElement* enc = gst_element_factory_make("pfapfapenc", nullptr);
+  ASSERT_NE(enc, nullptr);
+  GParamSpec* spec = g_object_class_find_property(G_OBJECT_GET_CLASS(enc), "frame-rate");
+  ASSERT_NE(spec, nullptr);
+  EXPECT_EQ(spec->value_type, GST_TYPE_FRACTION);
+  gst_object_unref(enc);
 }
 
 TEST(PfapFapEnc, MalformedEventsAreDroppedWithAWarningAndTheFileGoesOn) {

@@ -72,6 +72,10 @@ std::string value_summary(GParamSpec* pspec) {
       out << (i ? ", " : " ") << e->values[i].value_nick << " (" << e->values[i].value << ")";
     }
     out << " }, default " << g_enum_get_value(e, g_value_get_enum(def))->value_nick;
+  } else if (GST_IS_PARAM_SPEC_FRACTION(pspec)) {
+    const auto* p = GST_PARAM_SPEC_FRACTION(pspec);
+    out << "fraction " << p->min_num << "/" << p->min_den << ".." << p->max_num << "/" << p->max_den
+        << ", default " << p->def_num << "/" << p->def_den;
   } else {
     out << g_type_name(pspec->value_type);
   }

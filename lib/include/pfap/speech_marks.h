@@ -56,7 +56,9 @@ class MarksWriter {
   // this half-open mouth, the nearest to pfapface's generic mouth.
   static constexpr VisemeSet kUnknownVisemes{Viseme::kE, OculusViseme::kE, 4, 14, 3};
 
-  MarksWriter(MarksFormat format, int frames_per_second);
+  // ARKit frames go at `rate_num` / `rate_den` frames a second (GStreamer's fractions, so
+  // that 30000/1001 is exact); the other formats have no frames.
+  MarksWriter(MarksFormat format, int rate_num, int rate_den = 1);
 
   // The alphabet of the phoneme symbols; nullptr when not known.
   void set_alphabet(const PhonemeAlphabet* alphabet) { alphabet_ = alphabet; }
@@ -93,7 +95,8 @@ class MarksWriter {
   int64_t first_frame_from(int64_t ns) const;
 
   MarksFormat format_;
-  int fps_;
+  int64_t rate_num_;
+  int64_t rate_den_;
   const PhonemeAlphabet* alphabet_ = nullptr;
   std::vector<Spoken> utterance_;
   uint64_t unknown_phonemes_ = 0;
