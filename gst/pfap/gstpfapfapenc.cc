@@ -4,14 +4,14 @@
 /**
  * SECTION:element-pfapfapenc
  * @title: pfapfapenc
- * @see_also: fapparse, pfaptextenc, rtppfapdepay
+ * @see_also: pfapfapparse, pfaptextenc, rtppfapdepay
  *
  * Writes a phoneme / facial animation parameter (PFAP) stream as an MPEG-4 FAP file (.fap,
  * version 2.1, the format Xface, Greta and other MPEG-4 face players read;
  * docs/fap-files.md): the receiver's FAP state, built from the application/x-pfap events as
  * pfapface builds it (phoneme FAPs at their start, recovered entries at their time, a
  * complete state replacing everything), sampled at #GstPfapFapEnc:frame-rate. Frame 0 is
- * stream time 0, as every writer's times count (docs/elements.md), so that fapparse's frames
+ * stream time 0, as every writer's times count (docs/elements.md), so that pfapfapparse's frames
  * come back as the same frames even when the first events are lost; a stream whose first
  * event comes later starts with neutral frames, the receiver's state until then. Frame k is k / frame rate seconds
  * after frame 0, rounded to the ms; the file ends with the last frame before the end of the
@@ -279,7 +279,7 @@ static void gst_pfap_fap_enc_class_init(GstPfapFapEncClass* klass) {
   /**
    * GstPfapFapEnc:max-frames:
    *
-   * The most frames kept for the file (it is written at EOS): at most fapparse's limit,
+   * The most frames kept for the file (it is written at EOS): at most pfapfapparse's limit,
    * 360000 (4 hours at 25 frames a second).
    */
   g_object_class_install_property(

@@ -30,10 +30,10 @@
  *
  * ## Example pipelines
  * |[
- * gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfapparse alphabet=x-pfap-arpabet ! pfapmarksenc format=polly ! filesink location=hello.marks
+ * gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfaptextparse alphabet=x-pfap-arpabet ! pfapmarksenc format=polly ! filesink location=hello.marks
  * ]| Writes hello.pfap as Polly speech marks.
  * |[
- * gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfapparse alphabet=x-pfap-arpabet ! pfapmarksenc format=arkit-csv frame-rate=60 ! filesink location=hello.csv
+ * gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfaptextparse alphabet=x-pfap-arpabet ! pfapmarksenc format=arkit-csv frame-rate=60 ! filesink location=hello.csv
  * ]| Writes ARKit blendshape weights at 60 frames per second.
  */
 // clang-format on
@@ -176,7 +176,7 @@ static GstFlowReturn gst_pfap_marks_enc_handle_event(GstPfapBaseEnc* enc, GstBuf
                          "half-open mouth.",
                          unknown),
                         ("set the alphabet field of the input caps to a known alphabet, e.g. "
-                         "pfapparse alphabet=x-pfap-arpabet"));
+                         "pfaptextparse alphabet=x-pfap-arpabet"));
   }
   return s.flow;
 }

@@ -66,7 +66,8 @@
  *
  * ## Example pipeline
  * |[
- * gst-launch-1.0 filesrc location=hello.pfap ! pfapparse ! rtppfappay ! udpsink host=127.0.0.1 port=5004
+ * gst-launch-1.0 filesrc location=hello.pfap ! pfaptextparse ! rtppfappay ! udpsink host=127.0.0.1
+ * port=5004
  * ]| Sends the phonemes and FAPs of hello.pfap as PFAP RTP packets to port 5004.
  */
 #include "gstrtppfappay.h"

@@ -32,7 +32,7 @@ using pfap::testing::source_path;
 using pfap::testing::TempDir;
 
 constexpr GstClockTime kMs = GST_MSECOND;
-constexpr std::array<const char*, 5> kElements{"pfapmarksenc", "pfapmarksparse", "pfapparse",
+constexpr std::array<const char*, 5> kElements{"pfapmarksenc", "pfapmarksparse", "pfaptextparse",
                                                "rtppfappay", "pfapface"};
 
 // The messages of the bus's warnings (or errors), taken off it.

@@ -211,8 +211,8 @@ TEST(RegistryReference, DocsSayWhatTheRegistryHolds) {
 // The reference checks what it should: every element and the typefinder are in it.
 TEST(RegistryReference, CoversEveryElementAndTheTypefinder) {
   const std::string registry = registry_reference();
-  for (const char* name : {"rtppfappay", "rtppfapdepay", "pfapparse", "pfaptextenc", "pfaptts",
-                           "pfapface"}) {
+  for (const char* name :
+       {"rtppfappay", "rtppfapdepay", "pfaptextparse", "pfaptextenc", "pfaptts", "pfapface"}) {
     EXPECT_NE(registry.find(std::string("\nelement ") + name + ":"), std::string::npos) << name;
   }
   EXPECT_NE(registry.find("\ntypefinder text/x-pfap:"), std::string::npos);
