@@ -2,9 +2,9 @@
 // The example pipelines stay on one line, to be copied.
 // clang-format off
 /**
- * SECTION:element-fapparse
- * @title: fapparse
- * @see_also: pfapfapenc, pfapparse, rtppfappay, pfapface
+ * SECTION:element-pfapfapparse
+ * @title: pfapfapparse
+ * @see_also: pfapfapenc, pfaptextparse, rtppfappay, pfapface
  *
  * Reads an MPEG-4 FAP file (.fap, the FBA text format of Xface, Greta and other MPEG-4 face
  * players; docs/fap-files.md) and outputs its animation as application/x-pfap events, which
@@ -22,7 +22,7 @@
  * The output is a TIME segment from 0 with the first frame at 0; a sink with sync=true plays
  * the animation in real time. The caps carry `alphabet` (#GstFapParse:alphabet).
  *
- * With the request pad `speech` linked to a phoneme stream (pfaptts, pfapparse), the file's
+ * With the request pad `speech` linked to a phoneme stream (pfaptts, pfaptextparse), the file's
  * bookmarks go on the speech's phonemes instead (pfap::merge_with_speech): a phoneme that
  * spans a frame with changes is split there into pieces of the same symbol, and silence
  * phonemes carry only the frames where no one speaks. Both are timed from their segment's
@@ -39,13 +39,13 @@
  *
  * ## Example pipelines
  * |[
- * gst-launch-1.0 filesrc location=joy.fap ! fapparse ! pfapface ! videoconvert ! autovideosink
+ * gst-launch-1.0 filesrc location=joy.fap ! pfapfapparse ! pfapface ! videoconvert ! autovideosink
  * ]| Plays joy.fap on the pfapface face.
  * |[
- * gst-launch-1.0 filesrc location=joy.fap ! fapparse ! rtppfappay ! udpsink host=127.0.0.1 port=5004
+ * gst-launch-1.0 filesrc location=joy.fap ! pfapfapparse ! rtppfappay ! udpsink host=127.0.0.1 port=5004
  * ]| Sends joy.fap as PFAP RTP packets to port 5004, in real time.
  * |[
- * gst-launch-1.0 pfaptts text="Hello world." name=t t.pfap ! p.speech filesrc location=joy.fap ! fapparse name=p ! pfapface ! videoconvert ! autovideosink
+ * gst-launch-1.0 pfaptts text="Hello world." name=t t.pfap ! p.speech filesrc location=joy.fap ! pfapfapparse name=p ! pfapface ! videoconvert ! autovideosink
  * ]| Smiles joy.fap's smile on the phonemes of a spoken sentence.
  */
 // clang-format on
@@ -128,7 +128,7 @@ static GstStaticPadTemplate src_template =
     GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
 
 G_DEFINE_TYPE(GstFapParse, gst_fap_parse, GST_TYPE_PFAP_BASE_PARSE)
-GST_ELEMENT_REGISTER_DEFINE(fapparse, "fapparse", GST_RANK_NONE, GST_TYPE_FAP_PARSE)
+GST_ELEMENT_REGISTER_DEFINE(pfapfapparse, "pfapfapparse", GST_RANK_NONE, GST_TYPE_FAP_PARSE)
 
 // Back to the start of a file (READY to PAUSED, FLUSH_STOP).
 static void gst_fap_parse_reset(GstPfapBaseParse* parse) {
@@ -506,7 +506,7 @@ static void gst_fap_parse_class_init(GstFapParseClass* klass) {
   GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
   GstPfapBaseParseClass* parse_class = GST_PFAP_BASE_PARSE_CLASS(klass);
 
-  GST_DEBUG_CATEGORY_INIT(fapparse_debug, "fapparse", 0, "MPEG-4 FAP file parser");
+  GST_DEBUG_CATEGORY_INIT(fapparse_debug, "pfapfapparse", 0, "MPEG-4 FAP file parser");
 
   gobject_class->set_property = gst_fap_parse_set_property;
   gobject_class->get_property = gst_fap_parse_get_property;

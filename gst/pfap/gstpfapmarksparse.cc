@@ -4,7 +4,7 @@
 /**
  * SECTION:element-pfapmarksparse
  * @title: pfapmarksparse
- * @see_also: pfapmarksenc, pfapparse, rtppfappay
+ * @see_also: pfapmarksenc, pfaptextparse, rtppfappay
  *
  * Reads the visemes of a TTS service or lip-sync tool and outputs them as application/x-pfap
  * phoneme events, so that a stream from a service we do not run becomes PFAP

@@ -2,8 +2,8 @@
 // The example pipelines stay on one line, to be copied.
 // clang-format off
 /**
- * SECTION:element-pfapparse
- * @title: pfapparse
+ * SECTION:element-pfaptextparse
+ * @title: pfaptextparse
  * @see_also: pfaptextenc, rtppfappay
  *
  * Reads the .pfap text format (docs/text-format.md: UTF-8, one phoneme or FAP state event per
@@ -34,10 +34,10 @@
  *
  * ## Example pipelines
  * |[
- * gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfapparse ! rtppfappay ! udpsink host=127.0.0.1 port=5004
+ * gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfaptextparse ! rtppfappay ! udpsink host=127.0.0.1 port=5004
  * ]| Sends the phonemes and FAPs of hello.pfap as PFAP RTP packets to port 5004, in real time.
  * |[
- * cat docs/examples/hello.pfap | gst-launch-1.0 fdsrc ! pfapparse skip-bad-lines=true ! fakesink dump=true
+ * cat docs/examples/hello.pfap | gst-launch-1.0 fdsrc ! pfaptextparse skip-bad-lines=true ! fakesink dump=true
  * ]| Reads .pfap text from standard input, warns about bad lines and dumps each event.
  */
 // clang-format on
@@ -80,7 +80,7 @@ static GstStaticPadTemplate src_template =
 
 G_DEFINE_TYPE(GstPfapParse, gst_pfap_parse, GST_TYPE_PFAP_BASE_PARSE)
 // A rank, so that decodebin plugs it for text/x-pfap (gst-play-1.0 file.pfap).
-GST_ELEMENT_REGISTER_DEFINE(pfapparse, "pfapparse", GST_RANK_SECONDARY, GST_TYPE_PFAP_PARSE)
+GST_ELEMENT_REGISTER_DEFINE(pfaptextparse, "pfaptextparse", GST_RANK_SECONDARY, GST_TYPE_PFAP_PARSE)
 
 // Back to the start of a stream (READY to PAUSED, FLUSH_STOP).
 static void gst_pfap_parse_reset(GstPfapBaseParse* parse) {
@@ -169,7 +169,7 @@ static void gst_pfap_parse_class_init(GstPfapParseClass* klass) {
   GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
   GstPfapBaseParseClass* parse_class = GST_PFAP_BASE_PARSE_CLASS(klass);
 
-  GST_DEBUG_CATEGORY_INIT(pfapparse_debug, "pfapparse", 0, "PFAP text parser");
+  GST_DEBUG_CATEGORY_INIT(pfapparse_debug, "pfaptextparse", 0, "PFAP text parser");
 
   gobject_class->set_property = gst_pfap_parse_set_property;
   gobject_class->get_property = gst_pfap_parse_get_property;

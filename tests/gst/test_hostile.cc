@@ -407,7 +407,7 @@ TEST(StateChanges, EveryElementGoesThroughEveryStateAndBack) {
   const GstState down[] = {GST_STATE_PAUSED, GST_STATE_READY, GST_STATE_NULL};
   std::mt19937 random(22);
   for (const char* name :
-       {"rtppfappay", "rtppfapdepay", "pfapparse", "pfaptextenc", "pfaptts", "pfapface"}) {
+       {"rtppfappay", "rtppfapdepay", "pfaptextparse", "pfaptextenc", "pfaptts", "pfapface"}) {
     SCOPED_TRACE(name);
     GstElement* element = gst_element_factory_make(name, nullptr);
     ASSERT_NE(element, nullptr);
