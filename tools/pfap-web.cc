@@ -49,7 +49,6 @@
 
 #include "command_line.h"
 #include "launch_value.h"
-#include "pad_time.h"
 #include "pfap-web-signal.h"
 #include "pfap-web-stun.h"
 #include "pfap/model.h"
@@ -387,50 +386,14 @@ GstPadProbeReturn on_sink_gap(GstPad*, GstPadProbeInfo* info, gpointer data) {
 // The speech's level, sent to the page as it leaves the speaker (up to a second before it is
 // played): the RMS of each millisecond at its running time, which the page finds again in the
 // audio it plays to learn which running time it is hearing (docs/web.md, Timing).
-struct Envelope {
-  std::weak_ptr<Session> session;
-  GstClockTime offset = 0;  // the speaker's pad offset: its running time in the pipeline's
-  GstClockTime start = GST_CLOCK_TIME_NONE;  // running time of the first level waiting
-  SpeechLevel level;
-};
-
-void send_envelope(Envelope& e) {
-  if (e.level.empty()) return;
-  const std::vector<int64_t> levels = e.level.take();
-  const bool silent = std::all_of(levels.begin(), levels.end(), [](int64_t v) { return v == 0; });
-  std::shared_ptr<Session> session = e.session.lock();
-  if (!silent && session != nullptr) {
-    post(session, [start = e.start, levels](Session& s) {
-      JsonBuilder* b = message("envelope");
-      member(b, "runningTimeNs", static_cast<int64_t>(start));
-      json_builder_set_member_name(b, "rms");
-      json_builder_begin_array(b);
-      for (int64_t v : levels) json_builder_add_int_value(b, v);
-      json_builder_end_array(b);
-      finish(s, b);
-    });
-  }
-  e.start += levels.size() * GST_MSECOND;
-}
-
-GstPadProbeReturn on_speech(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
-  auto& e = *static_cast<Envelope*>(data);
-  if ((info->type & GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM) != 0) {
-    if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) == GST_EVENT_EOS) send_envelope(e);
-    return GST_PAD_PROBE_OK;
-  }
-  GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
-  if (e.start == GST_CLOCK_TIME_NONE) {
-    const GstClockTime running = running_time_of(pad, buffer);
-    if (!GST_CLOCK_TIME_IS_VALID(running)) return GST_PAD_PROBE_OK;
-    e.start = running + e.offset;
-  }
-  GstMapInfo map;
-  if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) return GST_PAD_PROBE_OK;
-  e.level.add({reinterpret_cast<const int16_t*>(map.data), map.size / 2},
-              [&] { send_envelope(e); });
-  gst_buffer_unmap(buffer, &map);
-  return GST_PAD_PROBE_OK;
+void send_envelope(Session& s, GstClockTime start, const std::vector<int64_t>& levels) {
+  JsonBuilder* b = message("envelope");
+  member(b, "runningTimeNs", static_cast<int64_t>(start));
+  json_builder_set_member_name(b, "rms");
+  json_builder_begin_array(b);
+  for (int64_t v : levels) json_builder_add_int_value(b, v);
+  json_builder_end_array(b);
+  finish(s, b);
 }
 
 // Starts saying `text` now, or after the text being said.
@@ -474,12 +437,15 @@ void say(Session& s, const std::string& text) {
   // Its level, as early as the speaker makes it (the queue before the mixer fills ahead).
   GstElement* queue = gst_bin_get_by_name(GST_BIN(speaker), "audio");
   GstPad* queue_sink = gst_element_get_static_pad(queue, "sink");
-  auto* envelope = new Envelope;
-  envelope->session = s.weak_from_this();
-  envelope->offset = now + kSpeakLead;
-  gst_pad_add_probe(
-      queue_sink, GstPadProbeType(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM),
-      on_speech, envelope, [](gpointer data) { delete static_cast<Envelope*>(data); });
+  add_speech_level_probe(
+      queue_sink, now + kSpeakLead,
+      [session = s.weak_from_this()](GstClockTime start, std::vector<int64_t> levels) {
+        if (std::shared_ptr<Session> locked = session.lock()) {
+          post(locked, [start, levels = std::move(levels)](Session& s) {
+            send_envelope(s, start, levels);
+          });
+        }
+      });
   gst_object_unref(queue_sink);
   gst_object_unref(queue);
 
