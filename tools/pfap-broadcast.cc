@@ -151,12 +151,9 @@ uint32_t pfap_timestamp(const Sender& s, GstClockTime running) {
 // -- The level: the RMS of each ms by PFAP timestamp, sent as the audio enters the queue ------
 
 void send_levels(Sender& s, GstClockTime start, const std::vector<int64_t>& levels) {
-  std::string json = "{\"type\":\"level\",\"ssrc\":" + std::to_string(s.ssrc) +
-                     ",\"timestamp\":" + std::to_string(pfap_timestamp(s, start)) + ",\"rms\":[";
-  for (size_t i = 0; i < levels.size(); ++i) {
-    json += (i == 0 ? "" : ",") + std::to_string(levels[i]);
-  }
-  send_text(s, json + "]}");
+  send_text(s, "{\"type\":\"level\",\"ssrc\":" + std::to_string(s.ssrc) +
+                   ",\"timestamp\":" + std::to_string(pfap_timestamp(s, start)) + ",\"level\":\"" +
+                   encode_levels(levels) + "\"}");
 }
 
 // -- The clock: the PFAP timestamp of the audio as it goes to the audio port -----------------

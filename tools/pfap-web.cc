@@ -389,10 +389,7 @@ GstPadProbeReturn on_sink_gap(GstPad*, GstPadProbeInfo* info, gpointer data) {
 void send_envelope(Session& s, GstClockTime start, const std::vector<int64_t>& levels) {
   JsonBuilder* b = message("envelope");
   member(b, "runningTimeNs", static_cast<int64_t>(start));
-  json_builder_set_member_name(b, "rms");
-  json_builder_begin_array(b);
-  for (int64_t v : levels) json_builder_add_int_value(b, v);
-  json_builder_end_array(b);
+  member(b, "level", encode_levels(levels).c_str());
   finish(s, b);
 }
 
