@@ -626,9 +626,9 @@ gboolean on_connect_timeout(gpointer data) {
 // One session's pipeline. The mixer makes the audio's pace alone (force-live: it mixes on the
 // clock with no live source upstream), silence between the texts, so no silent source runs
 // beside it. Opus frames of 20 ms at complexity 5: the encoder's instructions 0.59× those of
-// 10 ms at complexity 10, and half the packets to protect and send (docs/performance.md,
-// "Where the CPU goes"); 5 is what libwebrtc gives Opus on phones. The mixer's output buffers
-// are one Opus frame each.
+// 10 ms at complexity 10, and half the packets to protect and send, for the same lip sync
+// (docs/performance.md, "pfap-web: sessions per server"); 5 is what libwebrtc gives Opus on
+// phones. The mixer's output buffers are one Opus frame each.
 constexpr const char* kSessionPipeline =
     "webrtcbin name=webrtc bundle-policy=max-bundle "
     "audiomixer name=mix force-live=true output-buffer-duration=20000000 "
