@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "live.h"
 #include "recognizer.h"
-#include "streaming.h"
 
 namespace pfap::align {
 
@@ -65,8 +65,8 @@ std::vector<UtteranceSpan> live_utterances_before(std::vector<TimedText>& texts,
 void append_s16le(std::span<const uint8_t> bytes, size_t max_count, std::vector<int16_t>& samples);
 
 // Live: a stream's utterances, one open at a time, as its audio comes: each aligned to its
-// text (StreamingAligner) or, without a text, recognized to the stream's end
-// (StreamingRecognizer). Phoneme starts count from the stream's first sample.
+// text (LiveAligner) or, without a text, recognized to the stream's end
+// (LiveRecognizer). Phoneme starts count from the stream's first sample.
 class LiveUtterances {
  public:
   // A new stream: nothing open, no audio yet.
@@ -96,8 +96,8 @@ class LiveUtterances {
  private:
   void count_from_stream_start(std::vector<tts::SpokenPhoneme>& out, size_t first) const;
 
-  StreamingAligner aligner_;
-  StreamingRecognizer recognizer_;
+  LiveAligner aligner_;
+  LiveRecognizer recognizer_;
   bool open_ = false;
   bool recognizing_ = false;
   size_t from_ = 0;

@@ -2,7 +2,7 @@
 // A frame-level viseme detector for live audio without a text: the 15 Oculus visemes (the
 // MPEG-4 visemes with silence, pfap::Viseme) of each 10 ms frame, from MFCCs with 80 ms of
 // past and 40 ms ahead through a small network (align/viseme_model.txt, made by
-// tools/viseme-train), smoothed into runs. Streaming: push audio as it comes, take the runs
+// tools/viseme-train), smoothed into runs. Live: push audio as it comes, take the runs
 // that are settled; each needs at most kVisemeLookaheadMs of audio after its frames. No
 // GStreamer; web/src/viseme_detector.js is the same in JavaScript. docs/align.md, "A viseme
 // detector".

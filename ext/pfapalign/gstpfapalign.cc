@@ -64,12 +64,12 @@
 
 #include "aligner.h"
 #include "inexact.h"
+#include "live.h"
 #include "markupbuffer.h"
 #include "pfap/markup.h"
 #include "ratelimit.h"
 #include "recognizer.h"
 #include "sparse.h"
-#include "streaming.h"
 #include "utterances.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapalign_debug);
@@ -395,7 +395,7 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
   return ret;
 }
 
-// Live (#GstPfapAlign:live): the phonemes go out as the audio comes, by align/streaming.h;
+// Live (#GstPfapAlign:live): the phonemes go out as the audio comes, by align/live.h;
 // docs/align.md, "Live". One utterance is open at a time: the text property's, each text
 // buffer's from its PTS (or from its arrival when it has none or comes late), or a pause for
 // the audio before the first; without any text, the recognizer's (align/recognizer.h) over

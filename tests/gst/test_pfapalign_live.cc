@@ -19,11 +19,11 @@
 
 #include "boundaries.h"
 #include "documented_commands.h"
+#include "live.h"
 #include "markupbuffer.h"
 #include "pipeline.h"
 #include "recognizer.h"
 #include "speech.h"
-#include "streaming.h"
 #include "temp_dir.h"
 #include "udp_ports.h"
 
@@ -35,9 +35,8 @@ constexpr const char* kText = "Please call Stella and ask her to bring these thi
 constexpr GstClockTime kBlock = 20 * GST_MSECOND;
 constexpr GstClockTime kDeclared = pfap::align::kLiveLatencyMs * GST_MSECOND;
 // Without a text: the same bound, and time for the recognizer's search.
-constexpr GstClockTime kDeclaredRecognizing =
-    pfap::align::kLiveRecognitionLatencyMs * GST_MSECOND;
-// The bound align/streaming.h states: kLookaheadMs + kHoldMs + kStepMs and one block.
+constexpr GstClockTime kDeclaredRecognizing = pfap::align::kLiveRecognitionLatencyMs * GST_MSECOND;
+// The bound align/live.h states: kLookaheadMs + kHoldMs + kStepMs and one block.
 constexpr GstClockTime kBound =
     (pfap::align::kLookaheadMs + pfap::align::kHoldMs + pfap::align::kStepMs) * GST_MSECOND +
     kBlock;
@@ -304,7 +303,8 @@ TEST(PfapAlignLive, WithoutTheTextRecognizesWithinTheSameBoundAndDeclaresMore) {
       "before the audio's end, pushed at most %.0f ms after its start by the clock (declared "
       "%.0f ms)\n",
       got.size(), speech, static_cast<double>(most_behind) / GST_MSECOND,
-      static_cast<double>(most_late) / GST_MSECOND, static_cast<double>(kDeclaredRecognizing) / GST_MSECOND);
+      static_cast<double>(most_late) / GST_MSECOND,
+      static_cast<double>(kDeclaredRecognizing) / GST_MSECOND);
 }
 
 // Utterances on text_sink, live: each starts at its PTS, the phonemes of the first come while
