@@ -74,6 +74,73 @@ void append_s16le(std::span<const uint8_t> bytes, size_t max_count, std::vector<
   }
 }
 
+void KeptAudio::reset() {
+  samples_.clear();
+  overflowed_ = false;
+}
+
+bool KeptAudio::append(std::span<const uint8_t> bytes, unsigned rate) {
+  const size_t limit = size_t{kMaxAudioSeconds} * rate;
+  const size_t room = limit - std::min(samples_.size(), limit);
+  append_s16le(bytes, room, samples_);
+  if (bytes.size() / sizeof(int16_t) <= room || overflowed_) return false;
+  overflowed_ = true;
+  return true;
+}
+
+void TextQueue::reset() {
+  std::lock_guard guard(lock_);
+  texts_.clear();
+  ended_ = false;
+  flushing_ = false;
+}
+
+void TextQueue::add(PadText text) {
+  std::lock_guard guard(lock_);
+  texts_.push_back(std::move(text));
+}
+
+void TextQueue::end() {
+  {
+    std::lock_guard guard(lock_);
+    ended_ = true;
+  }
+  changed_.notify_all();
+}
+
+void TextQueue::clear() {
+  std::lock_guard guard(lock_);
+  texts_.clear();
+  ended_ = false;
+}
+
+void TextQueue::flush() {
+  {
+    std::lock_guard guard(lock_);
+    flushing_ = true;
+  }
+  changed_.notify_all();
+}
+
+bool TextQueue::ready(bool wait_for_end) {
+  std::unique_lock guard(lock_);
+  if (wait_for_end) changed_.wait(guard, [&] { return ended_ || flushing_; });
+  return !flushing_;
+}
+
+std::vector<PadText> TextQueue::take() {
+  std::lock_guard guard(lock_);
+  std::vector<PadText> taken;
+  taken.swap(texts_);
+  return taken;
+}
+
+void TextQueue::put_back(std::vector<PadText> texts) {
+  std::lock_guard guard(lock_);
+  texts_.insert(texts_.begin(), std::make_move_iterator(texts.begin()),
+                std::make_move_iterator(texts.end()));
+}
+
 void LiveUtterances::reset() {
   open_ = false;
   samples_ = 0;

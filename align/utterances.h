@@ -6,13 +6,16 @@
 // (S16LE) as samples. docs/align.md, "Timeline and utterances".
 #pragma once
 
+#include <condition_variable>
 #include <cstddef>
 #include <cstdint>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "aligner.h"  // kMaxAudioSeconds
 #include "live.h"
 #include "recognizer.h"
 
@@ -63,6 +66,57 @@ std::vector<UtteranceSpan> live_utterances_before(std::vector<TimedText>& texts,
 // Appends the S16LE samples in `bytes` (an odd last byte left out) to `samples`, at most
 // `max_count` of them.
 void append_s16le(std::span<const uint8_t> bytes, size_t max_count, std::vector<int16_t>& samples);
+
+// Offline: the audio kept for one alignment, at most kMaxAudioSeconds of it (aligner.h); the
+// rest is left out, and the element warns once.
+class KeptAudio {
+ public:
+  // Forgets the audio and the overflow.
+  void reset();
+  // Appends the S16LE `bytes` of audio at `rate` Hz, as much as the limit lets in. True the
+  // first time some of them are left out.
+  bool append(std::span<const uint8_t> bytes, unsigned rate);
+  const std::vector<int16_t>& samples() const { return samples_; }
+
+ private:
+  std::vector<int16_t> samples_;
+  bool overflowed_ = false;
+};
+
+// One buffer of the text pad: its start, a running time in ns (none: it continues the one
+// before), and its bytes.
+struct PadText {
+  std::optional<uint64_t> running_time;
+  std::string bytes;
+};
+
+// The text pad's buffers, from its thread to the audio's: offline, the alignment at the
+// audio's end waits for the text pad's end (its EOS) unless the stream flushes or stops.
+class TextQueue {
+ public:
+  // A new stream: no texts, not ended, not flushing.
+  void reset();
+  void add(PadText text);
+  // The text pad's EOS: every text is here.
+  void end();
+  // The text pad's flush: its texts dropped, and it has not ended.
+  void clear();
+  // The audio flushes or the element stops: waiting stops, until reset().
+  void flush();
+  // With `wait_for_end`, waits for end() or flush() first. False when flushing.
+  bool ready(bool wait_for_end);
+  // Takes the texts, in order.
+  std::vector<PadText> take();
+  // Puts `texts` (taken, for audio still to come) back before those added since.
+  void put_back(std::vector<PadText> texts);
+
+ private:
+  std::mutex lock_;
+  std::condition_variable changed_;
+  std::vector<PadText> texts_;
+  bool ended_ = false;
+  bool flushing_ = false;
+};
 
 // Live: a stream's utterances, one open at a time, as its audio comes: each aligned to its
 // text (LiveAligner) or, without a text, recognized to the stream's end

@@ -55,8 +55,6 @@
 
 #include <algorithm>
 #include <array>
-#include <condition_variable>
-#include <mutex>
 #include <optional>
 #include <set>
 #include <string>
@@ -78,9 +76,6 @@ GST_DEBUG_CATEGORY_STATIC(pfapalign_debug);
 namespace {
 
 constexpr const char* kDefaultVoice = "en";
-// Audio kept for one alignment at most: pfap::align::kMaxAudioSeconds, 10 minutes. Beyond,
-// the rest is a pause (warned).
-constexpr uint64_t kMaxSeconds = pfap::align::kMaxAudioSeconds;
 
 enum {
   PROP_0,
@@ -89,19 +84,12 @@ enum {
   PROP_LIVE,
 };
 
-// One text buffer: its running time (NONE: it continues the one before) and bytes.
-struct Text {
-  GstClockTime running_time;
-  std::string bytes;
-};
-
-// The audio streaming thread's, but for what `lock` guards.
+// The audio streaming thread's, but for `texts` and `text_segment`.
 struct Stream {
   unsigned rate = 0;
   GstSegment segment;                        // the audio's, also sent on `pfap`
-  GstClockTime first = GST_CLOCK_TIME_NONE;  // segment position of samples[0]
-  std::vector<int16_t> samples;
-  bool overflow_warned = false;
+  GstClockTime first = GST_CLOCK_TIME_NONE;  // segment position of the first sample kept
+  pfap::align::KeptAudio kept;               // offline
   bool pfap_discont = true;
   std::array<guint64, 6> problems{};  // per pfap::align::Problem, for pfap_warn_at
   guint64 bad_bookmarks = 0;
@@ -112,12 +100,8 @@ struct Stream {
   bool live = false;
   pfap::align::LiveUtterances utterances;  // sample counts from `first`
 
-  std::mutex lock;  // guards what follows, shared with the text pad's thread
-  std::condition_variable text_changed;
-  std::vector<Text> texts;
-  bool text_eos = false;
-  bool flushing = false;  // the audio pad flushes or the element stops: stop waiting for text
-  GstSegment text_segment;
+  pfap::align::TextQueue texts;  // shared with the text pad's thread
+  GstSegment text_segment;       // the text pad's thread's
 };
 
 }  // namespace
@@ -177,16 +161,11 @@ static GstFlowReturn guarded(GstPfapAlign* self, Work&& work) {
 static void reset(GstPfapAlign* self) {
   Stream& s = *self->stream;
   s.first = GST_CLOCK_TIME_NONE;
-  s.samples.clear();
-  s.overflow_warned = false;
+  s.kept.reset();
   s.pfap_discont = true;
   s.utterances.reset();
   gst_segment_init(&s.segment, GST_FORMAT_TIME);
-  std::lock_guard<std::mutex> guard(s.lock);
-  s.texts.clear();
-  s.text_eos = false;
-  s.flushing = false;
-  gst_segment_init(&s.text_segment, GST_FORMAT_TIME);
+  s.texts.reset();
   gst_flow_combiner_reset(self->flow_combiner);
 }
 
@@ -259,10 +238,10 @@ static void warn_recognition_problem(GstPfapAlign* self, pfap::align::Recognitio
 // kRecognition), or one pause with a warning where the build cannot (kPause).
 static GstFlowReturn recognize_kept(GstPfapAlign* self, pfap::align::PhonemeSource source) {
   Stream& s = *self->stream;
-  GST_INFO_OBJECT(self, "no text: recognizing %zu samples", s.samples.size());
+  GST_INFO_OBJECT(self, "no text: recognizing %zu samples", s.kept.samples().size());
   pfap::align::Recognition recognition;
   std::string error;
-  if (!pfap::align::recognize(s.samples, s.rate, recognition, error)) {
+  if (!pfap::align::recognize(s.kept.samples(), s.rate, recognition, error)) {
     if (source == pfap::align::PhonemeSource::kRecognition) {  // the model is missing
       GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));
       return GST_FLOW_ERROR;
@@ -326,7 +305,7 @@ static GstFlowReturn align_utterance(GstPfapAlign* self, const pfap::align::Utte
 
   pfap::align::Alignment alignment;
   std::string error;
-  const std::span<const int16_t> audio(s.samples.data() + from, u.to - from);
+  const std::span<const int16_t> audio(s.kept.samples().data() + from, u.to - from);
   if (!pfap::align::align(utterance, voice, audio, s.rate, alignment, error)) {
     GST_ELEMENT_ERROR(self, LIBRARY, FAILED, ("%s", error.c_str()), (nullptr));
     return GST_FLOW_ERROR;
@@ -344,11 +323,11 @@ static GstFlowReturn align_utterance(GstPfapAlign* self, const pfap::align::Utte
 
 // The sample, counted from `first`, where a text at `running_time` starts; 0 before the audio,
 // none for a text without a time.
-static std::optional<size_t> text_sample(GstPfapAlign* self, GstClockTime running_time) {
+static std::optional<size_t> text_sample(GstPfapAlign* self, std::optional<uint64_t> running_time) {
   Stream& s = *self->stream;
-  if (!GST_CLOCK_TIME_IS_VALID(running_time)) return std::nullopt;
+  if (!running_time.has_value()) return std::nullopt;
   const guint64 position =
-      gst_segment_position_from_running_time(&s.segment, GST_FORMAT_TIME, running_time);
+      gst_segment_position_from_running_time(&s.segment, GST_FORMAT_TIME, *running_time);
   if (!GST_CLOCK_TIME_IS_VALID(position) || position <= s.first) return 0;
   return gst_util_uint64_scale_round(position - s.first, s.rate, GST_SECOND);
 }
@@ -360,29 +339,21 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
   const std::optional<std::string> property = text_property(self);
   const bool text_linked = gst_pad_is_linked(self->textpad);
 
-  std::vector<Text> texts;
-  {
-    std::unique_lock<std::mutex> guard(s.lock);
-    if (eos && text_linked) {
-      s.text_changed.wait(guard, [&] { return s.text_eos || s.flushing; });
-    }
-    if (s.flushing) return GST_FLOW_FLUSHING;
-    // No audio yet (the first caps and segment): the texts wait for it.
-    if (s.samples.empty() || s.rate == 0) return GST_FLOW_OK;
-    texts.swap(s.texts);
-  }
+  if (!s.texts.ready(eos && text_linked)) return GST_FLOW_FLUSHING;
+  // No audio yet (the first caps and segment): the texts wait for it.
+  if (s.kept.samples().empty() || s.rate == 0) return GST_FLOW_OK;
+  std::vector<pfap::align::PadText> texts = s.texts.take();
 
   std::vector<pfap::align::TimedText> timed;
-  for (Text& t : texts) timed.push_back({text_sample(self, t.running_time), std::move(t.bytes)});
+  for (pfap::align::PadText& t : texts) {
+    timed.push_back({text_sample(self, t.running_time), std::move(t.bytes)});
+  }
   std::vector<size_t> later;  // texts for audio still to come
   const std::vector<pfap::align::UtteranceSpan> utterances = pfap::align::utterances_of(
-      timed, text_linked ? std::nullopt : property, s.samples.size(), eos, later);
-  if (!later.empty()) {
-    std::lock_guard<std::mutex> guard(s.lock);
-    std::vector<Text> waiting;
-    for (size_t i : later) waiting.push_back({texts[i].running_time, std::move(timed[i].bytes)});
-    s.texts.insert(s.texts.begin(), waiting.begin(), waiting.end());
-  }
+      timed, text_linked ? std::nullopt : property, s.kept.samples().size(), eos, later);
+  std::vector<pfap::align::PadText> waiting;
+  for (size_t i : later) waiting.push_back({texts[i].running_time, std::move(timed[i].bytes)});
+  s.texts.put_back(std::move(waiting));
   const pfap::align::PhonemeSource source = pfap::align::phoneme_source(!utterances.empty());
   GstFlowReturn ret =
       source == pfap::align::PhonemeSource::kTexts ? GST_FLOW_OK : recognize_kept(self, source);
@@ -390,7 +361,7 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
     if (ret != GST_FLOW_OK) break;
     ret = align_utterance(self, u);
   }
-  s.samples.clear();
+  s.kept.reset();
   s.first = GST_CLOCK_TIME_NONE;
   return ret;
 }
@@ -464,15 +435,17 @@ static GstFlowReturn live_feed(GstPfapAlign* self, std::span<const int16_t> samp
 // before the audio so far.
 static std::vector<pfap::align::UtteranceSpan> live_take_texts(GstPfapAlign* self, size_t end) {
   Stream& s = *self->stream;
-  std::lock_guard<std::mutex> guard(s.lock);
+  std::vector<pfap::align::PadText> texts = s.texts.take();
   std::vector<pfap::align::TimedText> timed;
-  for (Text& t : s.texts) timed.push_back({text_sample(self, t.running_time), std::move(t.bytes)});
+  for (pfap::align::PadText& t : texts) {
+    timed.push_back({text_sample(self, t.running_time), std::move(t.bytes)});
+  }
   std::vector<size_t> later;
   std::vector<pfap::align::UtteranceSpan> starting =
       pfap::align::live_utterances_before(timed, s.utterances.samples(), end, later);
-  std::vector<Text> waiting;
-  for (size_t i : later) waiting.push_back({s.texts[i].running_time, std::move(timed[i].bytes)});
-  s.texts.swap(waiting);
+  std::vector<pfap::align::PadText> waiting;
+  for (size_t i : later) waiting.push_back({texts[i].running_time, std::move(timed[i].bytes)});
+  s.texts.put_back(std::move(waiting));
   return starting;
 }
 
@@ -567,18 +540,12 @@ static GstFlowReturn chain_audio(GstPfapAlign* self, GstBuffer* buffer) {
   if (s.live) return live_chain(self, buffer);
   GstMapInfo map;
   if (gst_buffer_map(buffer, &map, GST_MAP_READ)) {
-    const size_t count = map.size / sizeof(int16_t);
-    const size_t room =
-        kMaxSeconds * s.rate - std::min<size_t>(s.samples.size(), kMaxSeconds * s.rate);
-    if (count > room && !s.overflow_warned) {
-      s.overflow_warned = true;
+    if (s.kept.append(std::span(map.data, map.size), s.rate)) {
       GST_ELEMENT_WARNING(self, STREAM, TOO_LAZY,
-                          ("More than %" G_GUINT64_FORMAT " s of audio in one stream: the rest "
-                           "is not aligned",
-                           kMaxSeconds),
+                          ("More than %u s of audio in one stream: the rest is not aligned",
+                           pfap::align::kMaxAudioSeconds),
                           ("give the text as utterances with PTS on text_sink"));
     }
-    pfap::align::append_s16le(std::span(map.data, map.size), room, s.samples);
     gst_buffer_unmap(buffer, &map);
   }
   return gst_flow_combiner_update_pad_flow(self->flow_combiner, self->srcpad,
@@ -591,9 +558,16 @@ static GstFlowReturn gst_pfap_align_chain(GstPad*, GstObject* parent, GstBuffer*
 }
 
 // The audio ended (EOS, a new segment or rate): its phonemes, aligned now or the live
-// utterance's last.
-static void end_audio(GstPfapAlign* self, bool eos) {
-  guarded(self, [&] { return self->stream->live ? live_end(self) : align_kept(self, eos); });
+// utterance's last. An event function cannot return their flow: a fatal one is posted, as
+// gst-plugins-good's demuxers post a flow that stops their task (GST_FLOW_ERROR was posted
+// where it arose). False then, and the event still goes on.
+static bool end_audio(GstPfapAlign* self, bool eos) {
+  const GstFlowReturn ret =
+      guarded(self, [&] { return self->stream->live ? live_end(self) : align_kept(self, eos); });
+  if (ret == GST_FLOW_OK || ret == GST_FLOW_FLUSHING || ret == GST_FLOW_EOS) return true;
+  GST_DEBUG_OBJECT(self, "phonemes at the audio's end: %s", gst_flow_get_name(ret));
+  if (ret != GST_FLOW_ERROR) GST_ELEMENT_FLOW_ERROR(self, ret);
+  return false;
 }
 
 // `pfap`'s stream-start (in the audio's group, sparse) and caps, when the audio's stream starts.
@@ -614,6 +588,7 @@ static void push_pfap_start(GstPfapAlign* self, GstEvent* audio_start) {
 static gboolean gst_pfap_align_sink_event(GstPad* pad, GstObject* parent, GstEvent* event) {
   GstPfapAlign* self = GST_PFAP_ALIGN(parent);
   Stream& s = *self->stream;
+  bool ended = true;  // the phonemes of audio that ended here were pushed
   switch (GST_EVENT_TYPE(event)) {
     case GST_EVENT_STREAM_START:
       push_pfap_start(self, event);
@@ -624,7 +599,7 @@ static gboolean gst_pfap_align_sink_event(GstPad* pad, GstObject* parent, GstEve
       gint rate = 0;
       gst_structure_get_int(gst_caps_get_structure(caps, 0), "rate", &rate);
       if (static_cast<unsigned>(rate) != s.rate) {
-        end_audio(self, false);
+        ended = end_audio(self, false);
         s.rate = static_cast<unsigned>(rate);
         if (s.rate < pfap::align::kMinRate || s.rate > pfap::align::kMaxRate) {
           GST_ELEMENT_WARNING(self, STREAM, FORMAT,
@@ -636,7 +611,7 @@ static gboolean gst_pfap_align_sink_event(GstPad* pad, GstObject* parent, GstEve
       break;
     }
     case GST_EVENT_SEGMENT: {
-      end_audio(self, false);
+      ended = end_audio(self, false);
       const GstSegment* segment = nullptr;
       gst_event_parse_segment(event, &segment);
       gst_segment_copy_into(segment, &s.segment);
@@ -647,18 +622,13 @@ static gboolean gst_pfap_align_sink_event(GstPad* pad, GstObject* parent, GstEve
       gst_pad_push_event(self->pfappad, gst_event_ref(event));
       break;
     case GST_EVENT_EOS:
-      end_audio(self, true);
+      ended = end_audio(self, true);
       gst_pad_push_event(self->pfappad, gst_event_new_eos());
       break;
-    case GST_EVENT_FLUSH_START: {
-      {
-        std::lock_guard<std::mutex> guard(s.lock);
-        s.flushing = true;
-      }
-      s.text_changed.notify_all();
+    case GST_EVENT_FLUSH_START:
+      s.texts.flush();
       gst_pad_push_event(self->pfappad, gst_event_ref(event));
       break;
-    }
     case GST_EVENT_FLUSH_STOP:
       reset(self);
       gst_pad_push_event(self->pfappad, gst_event_ref(event));
@@ -666,26 +636,24 @@ static gboolean gst_pfap_align_sink_event(GstPad* pad, GstObject* parent, GstEve
     default:
       break;
   }
-  return gst_pad_event_default(pad, parent, event);
+  return gst_pad_event_default(pad, parent, event) && ended;
 }
 
 static GstFlowReturn gst_pfap_align_text_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
   GstPfapAlign* self = GST_PFAP_ALIGN(parent);
   Stream& s = *self->stream;
-  Text t{GST_CLOCK_TIME_NONE, {}};
+  pfap::align::PadText t;
   GstMapInfo map;
   if (gst_buffer_map(buffer, &map, GST_MAP_READ)) {
     t.bytes.assign(reinterpret_cast<const char*>(map.data), map.size);
     gst_buffer_unmap(buffer, &map);
   }
-  {
-    std::lock_guard<std::mutex> guard(s.lock);
-    if (GST_BUFFER_PTS_IS_VALID(buffer) && s.text_segment.format == GST_FORMAT_TIME) {
-      t.running_time =
-          gst_segment_to_running_time(&s.text_segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
-    }
-    s.texts.push_back(std::move(t));
+  if (GST_BUFFER_PTS_IS_VALID(buffer) && s.text_segment.format == GST_FORMAT_TIME) {
+    const guint64 running_time =
+        gst_segment_to_running_time(&s.text_segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
+    if (GST_CLOCK_TIME_IS_VALID(running_time)) t.running_time = running_time;
   }
+  s.texts.add(std::move(t));
   gst_buffer_unref(buffer);
   return GST_FLOW_OK;
 }
@@ -695,27 +663,22 @@ static GstFlowReturn gst_pfap_align_text_chain(GstPad*, GstObject* parent, GstBu
 static gboolean gst_pfap_align_text_event(GstPad*, GstObject* parent, GstEvent* event) {
   GstPfapAlign* self = GST_PFAP_ALIGN(parent);
   Stream& s = *self->stream;
-  {
-    std::lock_guard<std::mutex> guard(s.lock);
-    switch (GST_EVENT_TYPE(event)) {
-      case GST_EVENT_SEGMENT: {
-        const GstSegment* segment = nullptr;
-        gst_event_parse_segment(event, &segment);
-        gst_segment_copy_into(segment, &s.text_segment);
-        break;
-      }
-      case GST_EVENT_EOS:
-        s.text_eos = true;
-        break;
-      case GST_EVENT_FLUSH_STOP:
-        s.texts.clear();
-        s.text_eos = false;
-        break;
-      default:
-        break;
+  switch (GST_EVENT_TYPE(event)) {
+    case GST_EVENT_SEGMENT: {
+      const GstSegment* segment = nullptr;
+      gst_event_parse_segment(event, &segment);
+      gst_segment_copy_into(segment, &s.text_segment);
+      break;
     }
+    case GST_EVENT_EOS:
+      s.texts.end();
+      break;
+    case GST_EVENT_FLUSH_STOP:
+      s.texts.clear();
+      break;
+    default:
+      break;
   }
-  if (GST_EVENT_TYPE(event) == GST_EVENT_EOS) s.text_changed.notify_all();
   gst_event_unref(event);
   return TRUE;
 }
@@ -741,6 +704,7 @@ static GstStateChangeReturn gst_pfap_align_change_state(GstElement* element,
   Stream& s = *self->stream;
   if (transition == GST_STATE_CHANGE_READY_TO_PAUSED) {
     reset(self);
+    gst_segment_init(&s.text_segment, GST_FORMAT_TIME);
     s.rate = 0;
     s.problems = {};
     s.recognition_problems = {};
@@ -757,11 +721,7 @@ static GstStateChangeReturn gst_pfap_align_change_state(GstElement* element,
     }
   } else if (transition == GST_STATE_CHANGE_PAUSED_TO_READY) {
     // An EOS waiting for the text's stops before the pads deactivate.
-    {
-      std::lock_guard<std::mutex> guard(s.lock);
-      s.flushing = true;
-    }
-    s.text_changed.notify_all();
+    s.texts.flush();
   }
   return GST_ELEMENT_CLASS(gst_pfap_align_parent_class)->change_state(element, transition);
 }

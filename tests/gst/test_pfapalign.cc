@@ -401,6 +401,57 @@ TEST(PfapAlign, WaitForTheTextsEosEndsWithTheStream) {
   gst_harness_teardown(h);
 }
 
+// A push of phonemes at the audio's EOS that fails (here `pfap`'s peer refuses them) is posted
+// as an error, offline and live: the event function cannot return it, and it was lost.
+TEST(PfapAlign, AFailedPushAtTheEndIsPostedAsAnError) {
+  const pfap::tts::Speech truth = say(kText);
+  for (const bool live : {false, true}) {
+    SCOPED_TRACE(live ? "live" : "offline");
+    GstHarness* h = gst_harness_new_with_padnames("pfapalign", "sink", "src");
+    if (live) {  // read when the element goes to PAUSED
+      gst_element_set_state(h->element, GST_STATE_READY);
+      g_object_set(h->element, "live", TRUE, nullptr);
+      gst_element_set_state(h->element, GST_STATE_PLAYING);
+    }
+    GstPad* refusing = gst_pad_new("refusing", GST_PAD_SINK);
+    gst_pad_set_chain_function(refusing, [](GstPad*, GstObject*, GstBuffer* b) {
+      gst_buffer_unref(b);
+      return GST_FLOW_NOT_NEGOTIATED;
+    });
+    gst_pad_set_event_function(refusing, [](GstPad*, GstObject*, GstEvent* e) -> gboolean {
+      gst_event_unref(e);
+      return TRUE;
+    });
+    gst_pad_set_active(refusing, TRUE);
+    GstPad* pfap = gst_element_get_static_pad(h->element, "pfap");
+    ASSERT_EQ(gst_pad_link(pfap, refusing), GST_PAD_LINK_OK);
+    GstBus* bus = gst_bus_new();
+    gst_element_set_bus(h->element, bus);
+    g_object_set(h->element, "text", kText, nullptr);
+    gst_harness_set_src_caps_str(h, caps_at(truth.sample_rate).c_str());
+    // Live, 100 ms: the phonemes settle later than this, all of them at the EOS.
+    const size_t n = live ? truth.sample_rate / 10 : truth.samples.size();
+    EXPECT_EQ(gst_harness_push(h, gst_buffer_new_memdup(truth.samples.data(), n * 2)), GST_FLOW_OK);
+    gst_harness_push_event(h, gst_event_new_eos());
+    GstMessage* m = gst_bus_pop_filtered(bus, GST_MESSAGE_ERROR);
+    ASSERT_NE(m, nullptr);
+    GError* error = nullptr;
+    gchar* debug = nullptr;
+    gst_message_parse_error(m, &error, &debug);
+    EXPECT_TRUE(g_error_matches(error, GST_STREAM_ERROR, GST_STREAM_ERROR_FAILED));
+    EXPECT_NE(std::string(debug).find("not-negotiated"), std::string::npos) << debug;
+    g_error_free(error);
+    g_free(debug);
+    gst_message_unref(m);
+    gst_bus_set_flushing(bus, TRUE);
+    gst_harness_teardown(h);
+    gst_pad_set_active(refusing, FALSE);
+    gst_object_unref(refusing);
+    gst_object_unref(pfap);
+    gst_object_unref(bus);
+  }
+}
+
 // The launch lines of docs/elements.md's pfapalign section, each run on a WAV pfaptts makes;
 // the live one (live=true, RTP in and out) is run by test_pfapalign_live.
 std::vector<std::string> documented_commands() {
