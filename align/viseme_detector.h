@@ -20,10 +20,8 @@
 
 namespace pfap::align {
 
-// The alphabet of the detector's phonemes: symbol k is Oculus viseme k (0 sil, 1 PP, 2 FF,
-// 3 TH, 4 DD, 5 kk, 6 CH, 7 SS, 8 nn, 9 RR, 10 aa, 11 E, 12 ih, 13 oh, 14 ou), which is
-// MPEG-4 viseme k (docs/visemes.md).
-inline constexpr std::string_view kOculusVisemeAlphabet = "x-pfap-oculus-viseme";
+// The detector's phonemes are of pfap::kOculusVisemeAlphabet: symbol k is Oculus viseme k,
+// which is MPEG-4 viseme k (docs/visemes.md).
 inline constexpr size_t kVisemeCount = 15;
 
 // The model's context: frames before and after the one it decides.
