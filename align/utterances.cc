@@ -15,8 +15,9 @@ void sort_by_start(std::vector<UtteranceSpan>& utterances) {
 
 }  // namespace
 
-PhonemeSource phoneme_source(bool has_text) {
+PhonemeSource phoneme_source(bool has_text, Recognizer recognizer) {
   if (has_text) return PhonemeSource::kTexts;
+  if (recognizer == Recognizer::kVisemes) return PhonemeSource::kVisemes;
   return recognition_available() ? PhonemeSource::kRecognition : PhonemeSource::kPause;
 }
 
@@ -150,7 +151,7 @@ bool LiveUtterances::start_text(const tts::Utterance& utterance, const tts::Voic
                                 unsigned rate, std::string& error) {
   if (!aligner_.start(utterance, voice, rate, error)) return false;
   open_ = true;
-  recognizing_ = false;
+  kind_ = Kind::kText;
   from_ = samples_;
   return true;
 }
@@ -158,17 +159,30 @@ bool LiveUtterances::start_text(const tts::Utterance& utterance, const tts::Voic
 bool LiveUtterances::start_recognition(unsigned rate, std::string& error) {
   if (!recognizer_.start(rate, error)) return false;
   open_ = true;
-  recognizing_ = true;
+  kind_ = Kind::kRecognition;
   from_ = samples_;
   return true;
 }
 
+void LiveUtterances::start_visemes(unsigned rate) {
+  visemes_.emplace(rate, kLiveVisemeRunFrames);
+  open_ = true;
+  kind_ = Kind::kVisemes;
+  from_ = samples_;
+}
+
 void LiveUtterances::push(std::span<const int16_t> samples, std::vector<tts::SpokenPhoneme>& out) {
   const size_t first = out.size();
-  if (recognizing_) {
-    recognizer_.push(samples, out);
-  } else {
-    aligner_.push(samples, out);
+  switch (kind_) {
+    case Kind::kText:
+      aligner_.push(samples, out);
+      break;
+    case Kind::kRecognition:
+      recognizer_.push(samples, out);
+      break;
+    case Kind::kVisemes:
+      visemes_->push(samples, out);
+      break;
   }
   samples_ += samples.size();
   count_from_stream_start(out, first);
@@ -178,10 +192,16 @@ void LiveUtterances::end(std::vector<tts::SpokenPhoneme>& out) {
   if (!open_) return;
   open_ = false;
   const size_t first = out.size();
-  if (recognizing_) {
-    recognizer_.finish(out);
-  } else {
-    aligner_.finish(out);
+  switch (kind_) {
+    case Kind::kText:
+      aligner_.finish(out);
+      break;
+    case Kind::kRecognition:
+      recognizer_.finish(out);
+      break;
+    case Kind::kVisemes:
+      visemes_->finish(out);
+      break;
   }
   count_from_stream_start(out, first);
 }

@@ -18,14 +18,16 @@
 #include "aligner.h"  // kMaxAudioSeconds
 #include "live.h"
 #include "recognizer.h"
+#include "viseme_phonemes.h"
 
 namespace pfap::align {
 
 // Where a stream's phonemes come from, offline and live: its texts, when it has any; else the
-// audio alone, recognized (recognizer.h); else, in a build without the recognizer, one pause
-// (which the element warns about).
-enum class PhonemeSource { kTexts, kRecognition, kPause };
-PhonemeSource phoneme_source(bool has_text);
+// audio alone: by `recognizer`, pocketsphinx's phonemes (recognizer.h; in a build without it,
+// one pause, which the element warns about) or the viseme detector's (viseme_phonemes.h).
+enum class Recognizer { kPhonemes, kVisemes };
+enum class PhonemeSource { kTexts, kRecognition, kPause, kVisemes };
+PhonemeSource phoneme_source(bool has_text, Recognizer recognizer = Recognizer::kPhonemes);
 
 // One text: the sample it starts at, counted from the first sample kept (none: it has no
 // time, and continues the text before it offline or starts at the audio so far live), and its
@@ -119,14 +121,15 @@ class TextQueue {
 };
 
 // Live: a stream's utterances, one open at a time, as its audio comes: each aligned to its
-// text (LiveAligner) or, without a text, recognized to the stream's end
-// (LiveRecognizer). Phoneme starts count from the stream's first sample.
+// text (LiveAligner) or, without a text, recognized to the stream's end (LiveRecognizer, or
+// the viseme detector: VisemePhonemes). Phoneme starts count from the stream's first sample.
 class LiveUtterances {
  public:
   // A new stream: nothing open, no audio yet.
   void reset();
   bool is_open() const { return open_; }
-  bool is_recognizing() const { return open_ && recognizing_; }
+  // The open utterance is pocketsphinx's (start_recognition()).
+  bool is_recognizing() const { return open_ && kind_ == Kind::kRecognition; }
   size_t samples() const { return samples_; }       // the audio so far
   size_t utterance_start() const { return from_; }  // the open utterance's first sample
 
@@ -138,6 +141,9 @@ class LiveUtterances {
   // Opens the recognizer's utterance at the audio so far (end() the open one first). False
   // with `error` where the model cannot be loaded.
   bool start_recognition(unsigned rate, std::string& error);
+  // Opens the viseme detector's utterance at the audio so far (end() the open one first), its
+  // runs in pieces of kLiveVisemeRunFrames.
+  void start_visemes(unsigned rate);
   // Gives `samples` to the open utterance; the phonemes now settled to `out`.
   void push(std::span<const int16_t> samples, std::vector<tts::SpokenPhoneme>& out);
   // Ends the open utterance, if any, at the audio so far: its last phonemes to `out`.
@@ -150,10 +156,12 @@ class LiveUtterances {
  private:
   void count_from_stream_start(std::vector<tts::SpokenPhoneme>& out, size_t first) const;
 
+  enum class Kind { kText, kRecognition, kVisemes };
   LiveAligner aligner_;
   LiveRecognizer recognizer_;
+  std::optional<VisemePhonemes> visemes_;
   bool open_ = false;
-  bool recognizing_ = false;
+  Kind kind_ = Kind::kText;
   size_t from_ = 0;
   size_t samples_ = 0;
 };

@@ -43,6 +43,20 @@ inline constexpr double kVisemeLookaheadMs =
     (kVisemeAheadFrames + kSmoothFrames) * 10.0 + 2.25;
 static_assert(kVisemeLookaheadMs <= 60, "the detector looks at most 60 ms ahead");
 
+// Live (pfapalign live=true recognizer=visemes): runs go out in pieces of at most
+// kLiveVisemeRunFrames frames, so that a frame goes out once its piece's frames and the
+// lookahead have come: at most kLiveVisemeBoundMs after its start (a run is given out when
+// the next one's first frame is decided, or when it is a piece long). Smaller pieces: less
+// latency, more phonemes (at 3, 33 a second through a long pause). The latency pfapalign
+// declares adds kVisemeWorkMs for the work before the push (about 0.1 ms a 20 ms block,
+// docs/align.md) on a loaded machine, rounded up to a ms.
+inline constexpr size_t kLiveVisemeRunFrames = 3;
+inline constexpr double kLiveVisemeBoundMs = kLiveVisemeRunFrames * 10.0 + kVisemeLookaheadMs;
+inline constexpr double kVisemeWorkMs = 5;
+inline constexpr unsigned kLiveVisemeLatencyMs =
+    static_cast<unsigned>(kLiveVisemeBoundMs + kVisemeWorkMs + 0.999);
+static_assert(kLiveVisemeLatencyMs <= 100, "lips within 100 ms (issue 30)");
+
 // A run of frames showing one viseme: frames [start, start + frames), 10 ms each from the
 // stream's first sample.
 struct VisemeRun {

@@ -43,6 +43,11 @@ TEST(Utterances, TextsComeFirstThenTheRecognizerThenAPause) {
   EXPECT_EQ(pfap::align::phoneme_source(false), pfap::align::recognition_available()
                                                     ? PhonemeSource::kRecognition
                                                     : PhonemeSource::kPause);
+  // recognizer=visemes: the detector, in any build, and only without a text.
+  EXPECT_EQ(pfap::align::phoneme_source(false, pfap::align::Recognizer::kVisemes),
+            PhonemeSource::kVisemes);
+  EXPECT_EQ(pfap::align::phoneme_source(true, pfap::align::Recognizer::kVisemes),
+            PhonemeSource::kTexts);
 }
 
 TEST(Utterances, NoTextAtAllIsToBeRecognized) {
