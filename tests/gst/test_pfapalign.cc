@@ -41,6 +41,7 @@ struct Result {
   std::vector<int16_t> audio;
   std::vector<Event> events;
   std::vector<std::string> warnings;
+  std::string alphabet;  // of `pfap`'s caps
 };
 
 std::string caps_at(unsigned rate, int channels = 1) {
@@ -57,15 +58,19 @@ pfap::tts::Speech say(const std::string& text, int rate = 140, int pitch = 30) {
   return s;
 }
 
-// Runs pfapalign (espeak-ng voice `voice`) over `samples` at `rate` with the `text` property
-// (nullptr: none), or, when `texts` is not empty, with those (PTS, text) buffers on text_sink.
+// Runs pfapalign (espeak-ng voice `voice`, `recognizer` unless nullptr) over `samples` at
+// `rate` with the `text` property (nullptr: none), or, when `texts` is not empty, with those
+// (PTS, text) buffers on text_sink.
 Result run(const std::vector<int16_t>& samples, unsigned rate, const char* text,
            const std::vector<std::pair<GstClockTime, std::string>>& texts = {},
-           const char* voice = "en", bool live = false) {
+           const char* voice = "en", bool live = false, const char* recognizer = nullptr) {
   GstHarness* h = gst_harness_new_with_padnames("pfapalign", "sink", "src");
-  if (live) {  // read when the element goes to PAUSED
+  if (live || recognizer != nullptr) {  // read when the element goes to PAUSED
     gst_element_set_state(h->element, GST_STATE_READY);
-    g_object_set(h->element, "live", TRUE, nullptr);
+    if (live) g_object_set(h->element, "live", TRUE, nullptr);
+    if (recognizer != nullptr) {
+      gst_util_set_object_arg(G_OBJECT(h->element), "recognizer", recognizer);
+    }
     gst_element_set_state(h->element, GST_STATE_PLAYING);
   }
   GstHarness* pfap = gst_harness_new_with_element(h->element, nullptr, "pfap");
@@ -118,6 +123,13 @@ Result run(const std::vector<int16_t>& samples, unsigned rate, const char* text,
     g_error_free(error);
     gst_message_unref(m);
   }
+  GstPad* pfap_pad = gst_element_get_static_pad(h->element, "pfap");
+  if (GstCaps* caps = gst_pad_get_current_caps(pfap_pad)) {
+    const gchar* alphabet = gst_structure_get_string(gst_caps_get_structure(caps, 0), "alphabet");
+    r.alphabet = alphabet != nullptr ? alphabet : "";
+    gst_caps_unref(caps);
+  }
+  gst_object_unref(pfap_pad);
   gst_bus_set_flushing(bus, TRUE);
   if (t != nullptr) gst_harness_teardown(t);
   gst_harness_teardown(pfap);
@@ -399,6 +411,43 @@ TEST(PfapAlign, WaitForTheTextsEosEndsWithTheStream) {
   EXPECT_TRUE(returned);
   gst_harness_teardown(t);
   gst_harness_teardown(h);
+}
+
+// recognizer=visemes without a text: the detector's phonemes of the whole audio at its end,
+// in its alphabet; with a text, the text is aligned as without the property.
+TEST(PfapAlign, VisemesWithoutTextAndTheTextWhenThereIsOne) {
+  const pfap::tts::Speech truth = say(kText);
+  const GstClockTime end =
+      gst_util_uint64_scale(truth.samples.size(), GST_SECOND, truth.sample_rate);
+  const Result visemes = run(truth.samples, truth.sample_rate, nullptr, {}, "en", false, "visemes");
+  EXPECT_EQ(visemes.alphabet, "x-pfap-oculus-viseme");
+  EXPECT_EQ(visemes.audio, truth.samples);
+  EXPECT_TRUE(visemes.warnings.empty()) << visemes.warnings.front();
+  expect_tiles(visemes, end);
+  std::set<int> seen;
+  for (const Event& e : visemes.events) {
+    EXPECT_LT(e.event.phoneme.symbol, 15);
+    seen.insert(e.event.phoneme.symbol);
+  }
+  EXPECT_GT(seen.size(), 5u) << "speech is heard as several visemes";
+  // Smoothed runs, about ten a second, not a phoneme every frame.
+  EXPECT_LT(visemes.events.size(), truth.samples.size() * 20 / truth.sample_rate);
+
+  const Result text = run(truth.samples, truth.sample_rate, kText, {}, "en", false, "visemes");
+  EXPECT_EQ(text.alphabet, "x-pfap-arpabet");
+  ASSERT_EQ(text.events.size(), truth.phonemes.size());
+  for (size_t k = 0; k < text.events.size(); ++k) {
+    EXPECT_EQ(text.events[k].event.phoneme.symbol, truth.phonemes[k].event.phoneme.symbol);
+  }
+}
+
+// Below the detector's 8 kHz: a warning, and the audio is pauses.
+TEST(PfapAlign, VisemesAtARateTheDetectorCannotTakeWarnAndArePauses) {
+  const std::vector<int16_t> audio(6000, 1000);  // 1 s at 6 kHz
+  const Result r = run(audio, 6000, nullptr, {}, "en", false, "visemes");
+  EXPECT_TRUE(has_warning(r, "viseme detector cannot take it")) << r.warnings.size();
+  expect_tiles(r, GST_SECOND);
+  for (const Event& e : r.events) EXPECT_EQ(e.event.phoneme.symbol, 0);
 }
 
 // A push of phonemes at the audio's EOS that fails (here `pfap`'s peer refuses them) is posted
