@@ -379,11 +379,11 @@ TEST(PfapAlignVisemes, LiveDeclaresItsLatencyAndPushesEveryPhonemeWithinIt) {
     }
     std::printf(
         "recognizer=visemes, %" G_GUINT64_FORMAT
-        " ms blocks: %zu phonemes, %zu onsets; onset to "
+        " ms blocks: %zu phonemes in %.2f s, %zu onsets; onset to "
         "push from its entry median %.1f ms, max %.1f ms; from its capture median %.1f, max "
         "%.1f; every phoneme from its first sample's entry median %.1f, max %.1f (declared "
         "%.0f ms, upstream %.0f ms)\n",
-        block / GST_MSECOND, got.size(), onsets.size(),
+        block / GST_MSECOND, got.size(), static_cast<double>(audio_end) / GST_SECOND, onsets.size(),
         static_cast<double>(median_of(from_entry)) / GST_MSECOND,
         static_cast<double>(*std::max_element(from_entry.begin(), from_entry.end())) / GST_MSECOND,
         static_cast<double>(median_of(from_capture)) / GST_MSECOND,
