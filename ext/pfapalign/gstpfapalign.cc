@@ -28,7 +28,10 @@
  * Without a text (no #GstPfapAlign:text, `text_sink` not linked or given nothing), the
  * phonemes are recognized from the audio alone: pocketsphinx's all-phone search with its US
  * English model, whose visemes are right on most 10 ms frames (docs/align.md). Built only with
- * pocketsphinx (meson feature `recognition`); without it, a warning and one pause.
+ * pocketsphinx (meson feature `recognition`); without it, a warning and one pause. With
+ * #GstPfapAlign:recognizer `visemes`, the frame-level viseme detector hears them instead, as
+ * `alphabet=x-pfap-oculus-viseme`: less accurate on human speech, and live within 95 ms
+ * instead of 700 (docs/align.md, "The viseme detector in pfapalign").
  *
  * The phonemes come when the audio ends (EOS, a new segment or sample rate), after the text
  * pad's EOS; with #GstPfapAlign:live, for live sources, as the audio comes, each within the
@@ -44,6 +47,9 @@
  * |[
  * gst-launch-1.0 filesrc location=speech.wav ! wavparse ! audioconvert ! audioresample ! audio/x-raw,rate=16000 ! pfapalign name=a a.src ! queue ! fakesink a.pfap ! queue ! pfaptextenc ! filesink location=speech.pfap
  * ]| A WAV without its text: the phonemes recognized.
+ * |[
+ * gst-launch-1.0 udpsrc address=127.0.0.1 port=5004 caps="application/x-rtp,media=audio,clock-rate=16000,encoding-name=L16,channels=1,payload=96" ! rtpjitterbuffer latency=20 ! rtpL16depay ! audioconvert ! audio/x-raw,format=S16LE ! pfapalign live=true recognizer=visemes name=a a.src ! queue ! autoaudiosink a.pfap ! queue ! pfapface ! videoconvert ! autovideosink
+ * ]| Live RTP audio without a text: a face that moves with it, within 95 ms.
  * |[
  * gst-launch-1.0 rtpbin name=r udpsrc address=127.0.0.1 port=5004 caps="application/x-rtp,media=audio,clock-rate=16000,encoding-name=L16,channels=1,payload=96" ! rtpjitterbuffer latency=50 ! rtpL16depay ! audioconvert ! audio/x-raw,format=S16LE ! pfapalign live=true text="Hello world." name=a a.src ! queue ! audioconvert ! rtpL16pay pt=96 ! r.send_rtp_sink_0 r.send_rtp_src_0 ! udpsink host=127.0.0.1 port=5000 r.send_rtcp_src_0 ! udpsink host=127.0.0.1 port=5001 sync=false async=false a.pfap ! queue ! rtppfappay pt=97 ! r.send_rtp_sink_1 r.send_rtp_src_1 ! udpsink host=127.0.0.1 port=5002 r.send_rtcp_src_1 ! udpsink host=127.0.0.1 port=5003 sync=false async=false
  * ]| Live RTP audio in; the audio and its phonemes out as two RTP sessions, in sync by RTCP.

@@ -532,7 +532,7 @@ size_t file_size(const std::string& path) {
 
 TEST(PfapAlignDocumented, EveryCommandRuns) {
   const std::vector<std::string> commands = documented_commands();
-  ASSERT_EQ(commands.size(), 4u);
+  ASSERT_EQ(commands.size(), 5u);
   const pfap::testing::TempDir dir;
   const std::string text =
       "Please call Stella. Ask her to bring these things with her from the store.";
@@ -574,6 +574,12 @@ TEST(PfapAlignDocumented, EveryCommandRuns) {
   // Recognized phonemes, or one pause where the build cannot recognize.
   EXPECT_GT(std::count(without_text.begin(), without_text.end(), '\n'),
             pfap::align::recognition_available() ? 30 : 0);
+  ASSERT_EQ(run_line(commands[4], dir), "") << commands[4];
+  // The viseme detector's, in every build: runs of its 15 visemes.
+  const std::vector<std::string> visemes = symbols(read("speech.pfap"));
+  EXPECT_GT(visemes.size(), 20u);
+  EXPECT_TRUE(std::all_of(visemes.begin(), visemes.end(),
+                          [](const std::string& v) { return std::stoi(v) < 15; }));
 }
 
 }  // namespace
