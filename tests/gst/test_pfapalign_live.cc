@@ -51,6 +51,14 @@ pfap::tts::Speech say(const std::string& text, int rate, int pitch) {
   return s;
 }
 
+// Samples [i, i + n) of `audio` at `rate` as a buffer, with their PTS and duration.
+GstBuffer* audio_buffer(const std::vector<int16_t>& audio, size_t i, size_t n, unsigned rate) {
+  GstBuffer* b = gst_buffer_new_memdup(audio.data() + i, n * 2);
+  GST_BUFFER_PTS(b) = gst_util_uint64_scale(i, GST_SECOND, rate);
+  GST_BUFFER_DURATION(b) = gst_util_uint64_scale(i + n, GST_SECOND, rate) - GST_BUFFER_PTS(b);
+  return b;
+}
+
 // A phoneme as it left pfapalign, with what the element had of the audio then.
 struct Pushed {
   GstClockTime pts;
@@ -119,10 +127,7 @@ void push_in_real_time(GstElement* pipeline, GstElement* src, const std::vector<
   ASSERT_NE(clock, nullptr);
   const size_t block = static_cast<size_t>(gst_util_uint64_scale(kBlock, rate, GST_SECOND));
   for (size_t i = 0; i < audio.size(); i += block) {
-    const size_t n = std::min(block, audio.size() - i);
-    GstBuffer* b = gst_buffer_new_memdup(audio.data() + i, n * 2);
-    GST_BUFFER_PTS(b) = gst_util_uint64_scale(i, GST_SECOND, rate);
-    GST_BUFFER_DURATION(b) = gst_util_uint64_scale(i + n, GST_SECOND, rate) - GST_BUFFER_PTS(b);
+    GstBuffer* b = audio_buffer(audio, i, std::min(block, audio.size() - i), rate);
     const GstClockTime due =
         gst_element_get_base_time(pipeline) + GST_BUFFER_PTS(b) + GST_BUFFER_DURATION(b);
     while (gst_clock_get_time(clock) < due) std::this_thread::sleep_for(2ms);
@@ -324,11 +329,7 @@ TEST(PfapAlignVisemes, LiveDeclaresItsLatencyAndPushesEveryPhonemeWithinIt) {
     };
     const size_t n = static_cast<size_t>(gst_util_uint64_scale(block, rate, GST_SECOND));
     for (size_t i = 0; i < audio.size(); i += n) {
-      const size_t count = std::min(n, audio.size() - i);
-      GstBuffer* b = gst_buffer_new_memdup(audio.data() + i, count * 2);
-      GST_BUFFER_PTS(b) = gst_util_uint64_scale(i, GST_SECOND, rate);
-      GST_BUFFER_DURATION(b) =
-          gst_util_uint64_scale(i + count, GST_SECOND, rate) - GST_BUFFER_PTS(b);
+      GstBuffer* b = audio_buffer(audio, i, std::min(n, audio.size() - i), rate);
       const GstClockTime end = GST_BUFFER_PTS(b) + GST_BUFFER_DURATION(b);
       ASSERT_EQ(gst_harness_push(h, b), GST_FLOW_OK);
       take(end);
@@ -520,10 +521,7 @@ TEST(PfapAlignLive, UtterancesOnTheTextPadStartAtTheirPts) {
   const size_t block = rate / 50;
   for (size_t i = 0; i < audio.size(); i += block) {
     const size_t n = std::min(block, audio.size() - i);
-    GstBuffer* buffer = gst_buffer_new_memdup(audio.data() + i, n * 2);
-    GST_BUFFER_PTS(buffer) = gst_util_uint64_scale(i, GST_SECOND, rate);
-    GST_BUFFER_DURATION(buffer) =
-        gst_util_uint64_scale(i + n, GST_SECOND, rate) - GST_BUFFER_PTS(buffer);
+    GstBuffer* buffer = audio_buffer(audio, i, n, rate);
     ASSERT_EQ(gst_harness_push(h, buffer), GST_FLOW_OK);
     GstBuffer* out = gst_harness_pull(h);
     GstMapInfo map;
