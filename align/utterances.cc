@@ -142,6 +142,34 @@ void TextQueue::put_back(std::vector<PadText> texts) {
                 std::make_move_iterator(texts.end()));
 }
 
+template <typename Cut>
+std::vector<UtteranceSpan> TextQueue::take_cut(const ToSample& to_sample, Cut cut) {
+  std::vector<PadText> texts = take();
+  std::vector<TimedText> timed;
+  for (PadText& t : texts) timed.push_back({to_sample(t.running_time), std::move(t.bytes)});
+  std::vector<size_t> later;
+  std::vector<UtteranceSpan> utterances = cut(timed, later);
+  std::vector<PadText> waiting;
+  for (size_t i : later) waiting.push_back({texts[i].running_time, std::move(timed[i].bytes)});
+  put_back(std::move(waiting));
+  return utterances;
+}
+
+std::vector<UtteranceSpan> TextQueue::take_utterances(const ToSample& to_sample,
+                                                      const std::optional<std::string>& whole,
+                                                      size_t n, bool end_of_stream) {
+  return take_cut(to_sample, [&](std::vector<TimedText>& timed, std::vector<size_t>& later) {
+    return utterances_of(timed, whole, n, end_of_stream, later);
+  });
+}
+
+std::vector<UtteranceSpan> TextQueue::take_live_utterances(const ToSample& to_sample, size_t now,
+                                                           size_t end) {
+  return take_cut(to_sample, [&](std::vector<TimedText>& timed, std::vector<size_t>& later) {
+    return live_utterances_before(timed, now, end, later);
+  });
+}
+
 void LiveUtterances::reset() {
   open_ = false;
   samples_ = 0;

@@ -9,6 +9,7 @@
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <span>
@@ -112,7 +113,21 @@ class TextQueue {
   // Puts `texts` (taken, for audio still to come) back before those added since.
   void put_back(std::vector<PadText> texts);
 
+  // The sample a text's running time falls on (the element's timeline; none for none).
+  using ToSample = std::function<std::optional<size_t>(std::optional<uint64_t> running_time)>;
+  // Offline: utterances_of() over the texts taken; those for audio still to come stay.
+  std::vector<UtteranceSpan> take_utterances(const ToSample& to_sample,
+                                             const std::optional<std::string>& whole, size_t n,
+                                             bool end_of_stream);
+  // Live: live_utterances_before() over the texts taken; the others stay.
+  std::vector<UtteranceSpan> take_live_utterances(const ToSample& to_sample, size_t now,
+                                                  size_t end);
+
  private:
+  // Takes the texts, cuts them with `cut` (which says which are `later`), puts those back.
+  template <typename Cut>
+  std::vector<UtteranceSpan> take_cut(const ToSample& to_sample, Cut cut);
+
   std::mutex lock_;
   std::condition_variable changed_;
   std::vector<PadText> texts_;

@@ -149,11 +149,10 @@ static GstStaticPadTemplate text_template =
 static GstStaticPadTemplate src_template =
     GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(AUDIO_CAPS));
 
-static GstStaticPadTemplate pfap_template =
-    GST_STATIC_PAD_TEMPLATE("pfap", GST_PAD_SRC, GST_PAD_ALWAYS,
-                            GST_STATIC_CAPS(PFAP_MARKUP_CAPS
-                                            ", alphabet = (string) { x-pfap-arpabet, "
-                                            "x-pfap-oculus-viseme }"));
+static GstStaticPadTemplate pfap_template = GST_STATIC_PAD_TEMPLATE(
+    "pfap", GST_PAD_SRC, GST_PAD_ALWAYS,
+    GST_STATIC_CAPS(PFAP_MARKUP_CAPS ", alphabet = (string) { x-pfap-arpabet, "
+                                     "x-pfap-oculus-viseme }"));
 static_assert(pfap::kArpabetAlphabet == "x-pfap-arpabet");
 static_assert(pfap::kOculusVisemeAlphabet == "x-pfap-oculus-viseme");
 
@@ -164,8 +163,7 @@ static GType gst_pfap_align_recognizer_get_type() {
       {static_cast<gint>(pfap::align::Recognizer::kPhonemes),
        "pocketsphinx's phonemes, x-pfap-arpabet: the accurate choice", "phonemes"},
       {static_cast<gint>(pfap::align::Recognizer::kVisemes),
-       "the frame-level viseme detector's visemes, x-pfap-oculus-viseme: within 100 ms",
-       "visemes"},
+       "the frame-level viseme detector's visemes, x-pfap-oculus-viseme: within 100 ms", "visemes"},
       {0, nullptr, nullptr},
   };
   if (g_once_init_enter(&type)) {
@@ -385,18 +383,9 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
   if (!s.texts.ready(eos && text_linked)) return GST_FLOW_FLUSHING;
   // No audio yet (the first caps and segment): the texts wait for it.
   if (s.kept.samples().empty() || s.rate == 0) return GST_FLOW_OK;
-  std::vector<pfap::align::PadText> texts = s.texts.take();
-
-  std::vector<pfap::align::TimedText> timed;
-  for (pfap::align::PadText& t : texts) {
-    timed.push_back({text_sample(self, t.running_time), std::move(t.bytes)});
-  }
-  std::vector<size_t> later;  // texts for audio still to come
-  const std::vector<pfap::align::UtteranceSpan> utterances = pfap::align::utterances_of(
-      timed, text_linked ? std::nullopt : property, s.kept.samples().size(), eos, later);
-  std::vector<pfap::align::PadText> waiting;
-  for (size_t i : later) waiting.push_back({texts[i].running_time, std::move(timed[i].bytes)});
-  s.texts.put_back(std::move(waiting));
+  const std::vector<pfap::align::UtteranceSpan> utterances =
+      s.texts.take_utterances([self](std::optional<uint64_t> t) { return text_sample(self, t); },
+                              text_linked ? std::nullopt : property, s.kept.samples().size(), eos);
   const pfap::align::PhonemeSource source =
       pfap::align::phoneme_source(!utterances.empty(), s.recognizer);
   GstFlowReturn ret = GST_FLOW_OK;
@@ -484,18 +473,9 @@ static GstFlowReturn live_feed(GstPfapAlign* self, std::span<const int16_t> samp
 // before the audio so far.
 static std::vector<pfap::align::UtteranceSpan> live_take_texts(GstPfapAlign* self, size_t end) {
   Stream& s = *self->stream;
-  std::vector<pfap::align::PadText> texts = s.texts.take();
-  std::vector<pfap::align::TimedText> timed;
-  for (pfap::align::PadText& t : texts) {
-    timed.push_back({text_sample(self, t.running_time), std::move(t.bytes)});
-  }
-  std::vector<size_t> later;
-  std::vector<pfap::align::UtteranceSpan> starting =
-      pfap::align::live_utterances_before(timed, s.utterances.samples(), end, later);
-  std::vector<pfap::align::PadText> waiting;
-  for (size_t i : later) waiting.push_back({texts[i].running_time, std::move(timed[i].bytes)});
-  s.texts.put_back(std::move(waiting));
-  return starting;
+  return s.texts.take_live_utterances(
+      [self](std::optional<uint64_t> t) { return text_sample(self, t); }, s.utterances.samples(),
+      end);
 }
 
 // The audio of `buffer` to the aligner, cut where utterances start; the audio pushed after

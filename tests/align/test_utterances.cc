@@ -183,6 +183,27 @@ TEST(Utterances, TextQueueKeepsOrderAndWaitsForTheEndOrAFlush) {
   EXPECT_TRUE(queue.ready(false));
 }
 
+// The queue cuts its texts as utterances_of() and live_utterances_before() do, at the samples
+// the element's timeline gives, and keeps those for audio still to come, in order.
+TEST(Utterances, TextQueueCutsItsTextsAndKeepsThoseStillToCome) {
+  pfap::align::TextQueue queue;
+  const auto to_sample = [](std::optional<uint64_t> t) -> std::optional<size_t> {
+    if (!t) return std::nullopt;
+    return static_cast<size_t>(*t / 10);
+  };
+  queue.add({1000, "first"});
+  queue.add({std::nullopt, " more"});
+  queue.add({5000, "later"});
+  queue.add({7000, "last"});
+  expect_spans(queue.take_utterances(to_sample, std::nullopt, 300, false),
+               {{0, 100, "", false}, {100, 300, "first more", true}});
+  // Live: from the audio so far (400), those starting before 600.
+  expect_spans(queue.take_live_utterances(to_sample, 400, 600), {{500, 600, "later", true}});
+  expect_spans(queue.take_utterances(to_sample, std::nullopt, 800, true),
+               {{0, 700, "", false}, {700, 800, "last", true}});
+  EXPECT_TRUE(queue.take().empty());
+}
+
 TEST(Utterances, LivePhonemesCountFromTheStreamsStartAndTileIt) {
   const tts::Speech one = pfap::align::testing::say("Hello world.", {});
   const tts::Speech two = pfap::align::testing::say("Good morning.", {});
