@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: LGPL-2.1-or-later */
 // application/x-pfap GstBuffers from and to pfap::MarkupEvent, for the plugins' elements.
-// Header-only, like the rest of this folder, so that each plugin needs only libpfap.
+// Inline: a depayloader makes one buffer per phoneme.
 #pragma once
 
 #include <gst/gst.h>
