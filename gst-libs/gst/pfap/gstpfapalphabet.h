@@ -74,7 +74,7 @@ typedef enum {
  */
 typedef struct _GstPfapAlphabet GstPfapAlphabet;
 
-#define GST_PFAP_TYPE_ALPHABET (gst_pfap_alphabet_get_type ())
+#define GST_TYPE_PFAP_ALPHABET (gst_pfap_alphabet_get_type ())
 
 GST_PFAP_API
 GType gst_pfap_alphabet_get_type (void);

@@ -154,7 +154,7 @@ typedef struct {
   gint32 amplitude;
 } GstPfapFap;
 
-#define GST_PFAP_TYPE_FAP (gst_pfap_fap_get_type ())
+#define GST_TYPE_PFAP_FAP (gst_pfap_fap_get_type ())
 
 GST_PFAP_API
 GType gst_pfap_fap_get_type (void);
@@ -196,7 +196,7 @@ void gst_pfap_fap_free (GstPfapFap *fap);
  */
 typedef struct _GstPfapEvent GstPfapEvent;
 
-#define GST_PFAP_TYPE_EVENT (gst_pfap_event_get_type ())
+#define GST_TYPE_PFAP_EVENT (gst_pfap_event_get_type ())
 
 GST_PFAP_API
 GType gst_pfap_event_get_type (void);

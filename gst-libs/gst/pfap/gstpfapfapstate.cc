@@ -41,7 +41,7 @@ static void gst_pfap_fap_state_init (GstPfapFapState *self)
 
 GstPfapFapState *gst_pfap_fap_state_new (void)
 {
-  return GST_PFAP_FAP_STATE (g_object_new (GST_PFAP_TYPE_FAP_STATE, nullptr));
+  return GST_PFAP_FAP_STATE (g_object_new (GST_TYPE_PFAP_FAP_STATE, nullptr));
 }
 
 // libpfap's FapState takes only valid FAPs (it indexes its tracks by FAP index).
@@ -62,7 +62,7 @@ static int64_t to_ns (GstClockTime time)
 gboolean gst_pfap_fap_state_apply_event (GstPfapFapState *state, const GstPfapEvent *event,
                                          GstClockTime time, GError **error)
 {
-  g_return_val_if_fail (GST_PFAP_IS_FAP_STATE (state), FALSE);
+  g_return_val_if_fail (GST_IS_PFAP_FAP_STATE (state), FALSE);
   g_return_val_if_fail (event != nullptr, FALSE);
   g_return_val_if_fail (GST_CLOCK_TIME_IS_VALID (time), FALSE);
   for (const pfap::Fap& fap : event->event.faps) {
@@ -77,7 +77,7 @@ gboolean gst_pfap_fap_state_apply_event (GstPfapFapState *state, const GstPfapEv
 gboolean gst_pfap_fap_state_apply_fap (GstPfapFapState *state, const GstPfapFap *fap,
                                        GstClockTime time, GError **error)
 {
-  g_return_val_if_fail (GST_PFAP_IS_FAP_STATE (state), FALSE);
+  g_return_val_if_fail (GST_IS_PFAP_FAP_STATE (state), FALSE);
   g_return_val_if_fail (fap != nullptr, FALSE);
   g_return_val_if_fail (GST_CLOCK_TIME_IS_VALID (time), FALSE);
   const pfap::Fap f = gst_pfap_fap_to_lib (*fap);
@@ -93,7 +93,7 @@ gboolean gst_pfap_fap_state_apply_fap (GstPfapFapState *state, const GstPfapFap 
 gdouble gst_pfap_fap_state_get_amplitude (GstPfapFapState *state, guint index,
                                           GstClockTime time)
 {
-  g_return_val_if_fail (GST_PFAP_IS_FAP_STATE (state), 0.0);
+  g_return_val_if_fail (GST_IS_PFAP_FAP_STATE (state), 0.0);
   g_return_val_if_fail (VALID_INDEX (index), 0.0);
   g_return_val_if_fail (GST_CLOCK_TIME_IS_VALID (time), 0.0);
   g_mutex_lock (&state->lock);
@@ -104,7 +104,7 @@ gdouble gst_pfap_fap_state_get_amplitude (GstPfapFapState *state, guint index,
 
 gint32 gst_pfap_fap_state_get_settled (GstPfapFapState *state, guint index)
 {
-  g_return_val_if_fail (GST_PFAP_IS_FAP_STATE (state), 0);
+  g_return_val_if_fail (GST_IS_PFAP_FAP_STATE (state), 0);
   g_return_val_if_fail (VALID_INDEX (index), 0);
   g_mutex_lock (&state->lock);
   const gint32 settled = state->state->settled (static_cast<int> (index));
@@ -114,7 +114,7 @@ gint32 gst_pfap_fap_state_get_settled (GstPfapFapState *state, guint index)
 
 gboolean gst_pfap_fap_state_is_at_rest (GstPfapFapState *state, guint index, GstClockTime time)
 {
-  g_return_val_if_fail (GST_PFAP_IS_FAP_STATE (state), TRUE);
+  g_return_val_if_fail (GST_IS_PFAP_FAP_STATE (state), TRUE);
   g_return_val_if_fail (VALID_INDEX (index), TRUE);
   g_return_val_if_fail (GST_CLOCK_TIME_IS_VALID (time), TRUE);
   g_mutex_lock (&state->lock);
@@ -125,7 +125,7 @@ gboolean gst_pfap_fap_state_is_at_rest (GstPfapFapState *state, guint index, Gst
 
 void gst_pfap_fap_state_reset (GstPfapFapState *state)
 {
-  g_return_if_fail (GST_PFAP_IS_FAP_STATE (state));
+  g_return_if_fail (GST_IS_PFAP_FAP_STATE (state));
   g_mutex_lock (&state->lock);
   state->state->reset ();
   g_mutex_unlock (&state->lock);

@@ -21,10 +21,10 @@ G_BEGIN_DECLS
  * callback applying events while the application's thread draws.
  */
 
-#define GST_PFAP_TYPE_FAP_STATE (gst_pfap_fap_state_get_type ())
+#define GST_TYPE_PFAP_FAP_STATE (gst_pfap_fap_state_get_type ())
 
 GST_PFAP_API
-G_DECLARE_FINAL_TYPE (GstPfapFapState, gst_pfap_fap_state, GST_PFAP, FAP_STATE, GObject)
+G_DECLARE_FINAL_TYPE (GstPfapFapState, gst_pfap_fap_state, GST, PFAP_FAP_STATE, GObject)
 
 /**
  * gst_pfap_fap_state_new: (constructor)
