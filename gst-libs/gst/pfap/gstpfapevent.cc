@@ -2,13 +2,15 @@
  * SPDX-License-Identifier: LGPL-2.1-or-later
  *
  * GstPfapEvent wraps pfap::MarkupEvent: the byte layout and its rules stay in libpfap
- * (pfap/markup.h); this file only converts types and turns refusals into GErrors.
+ * (pfap/markup.h), and buffers are read and written as the plugins do (markupbuffer.h); this
+ * file only converts types and turns refusals into GErrors.
  */
 #include "gst/pfap/gstpfapevent.h"
 
 #include <string_view>
 
 #include "gstpfap-private.h"
+#include "markupbuffer.h"
 #include "pfap/markup.h"
 #include "pfap/model.h"
 
@@ -91,15 +93,13 @@ GstPfapEvent *gst_pfap_event_new_from_data(const guint8 *data, gsize size, GErro
 
 GstPfapEvent *gst_pfap_event_new_from_buffer(GstBuffer *buffer, GError **error) {
   g_return_val_if_fail(GST_IS_BUFFER(buffer), nullptr);
-  GstMapInfo map;
-  if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) {
+  const PfapBufferBytes bytes(buffer);
+  if (!bytes.mapped()) {
     g_set_error(error, GST_PFAP_EVENT_ERROR, GST_PFAP_EVENT_ERROR_MALFORMED,
                 "the buffer cannot be mapped for reading");
     return nullptr;
   }
-  GstPfapEvent *event = gst_pfap_event_new_from_data(map.data, map.size, error);
-  gst_buffer_unmap(buffer, &map);
-  return event;
+  return gst_pfap_event_new_from_data(bytes.bytes().data(), bytes.bytes().size(), error);
 }
 
 // Why write_markup refuses `event`, in words, or nullptr if it does not. The ranges are
@@ -130,13 +130,8 @@ GstBuffer *gst_pfap_event_to_buffer(const GstPfapEvent *event, GError **error) {
   // GStreamer's allocator exists only after gst_init(): say so rather than crash in it.
   g_return_val_if_fail(gst_is_initialized(), nullptr);
   const pfap::MarkupEvent &e = event->event;
-  GstBuffer *buffer = gst_buffer_new_allocate(nullptr, pfap::markup_size(e), nullptr);
-  GstMapInfo map;
-  gst_buffer_map(buffer, &map, GST_MAP_WRITE);
-  const bool ok = pfap::write_markup(e, {map.data, map.size});
-  gst_buffer_unmap(buffer, &map);
-  if (!ok) {
-    gst_buffer_unref(buffer);
+  GstBuffer *buffer = pfap_buffer_new(e);
+  if (buffer == nullptr) {
     gchar *why = out_of_range(e);
     g_set_error(error, GST_PFAP_EVENT_ERROR, GST_PFAP_EVENT_ERROR_OUT_OF_RANGE,
                 "the event cannot be written: %s",
