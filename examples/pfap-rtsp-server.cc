@@ -10,7 +10,7 @@
 //
 //   ( audiotestsrc name=audio is-live=true wave=ticks tick-interval=500000000
 //       ! audioconvert ! audio/x-raw,rate=44100,channels=1 ! rtpL16pay name=pay0 pt=96
-//     filesrc name=file ! pfapparse alphabet=x-pfap-arpabet ! identity sync=true
+//     filesrc name=file ! pfaptextparse alphabet=x-pfap-arpabet ! identity sync=true
 //       ! rtppfappay name=pay1 pt=97 )
 //
 //  - audiotestsrc stands for the speech; a real server has its TTS audio here. Its ticks,
@@ -24,7 +24,7 @@
 //    BYE, and a client sees the presentation end: rtspsrc and playbin post EOS, and a client
 //    that reads for a fixed time (ffmpeg -t 3) is not left waiting on a stream that ended
 //    while another went on.
-//  - pfapparse's alphabet names the phoneme alphabet in the caps (a .pfap file has symbol
+//  - pfaptextparse's alphabet names the phoneme alphabet in the caps (a .pfap file has symbol
 //    numbers only). rtppfappay copies it to its RTP caps, and
 //    gst-rtsp-server writes RTP caps fields to the SDP, so clients see
 //    "a=fmtp:97 alphabet=x-pfap-arpabet" and rtspsrc gives it back as a caps field.
@@ -58,7 +58,7 @@ namespace {
 constexpr const char* kLaunch =
     "( audiotestsrc name=audio is-live=true wave=ticks tick-interval=500000000 ! audioconvert "
     "! audio/x-raw,rate=44100,channels=1 ! rtpL16pay name=pay0 pt=96 "
-    "filesrc name=file ! pfapparse alphabet=x-pfap-arpabet ! identity sync=true "
+    "filesrc name=file ! pfaptextparse alphabet=x-pfap-arpabet ! identity sync=true "
     "! rtppfappay name=pay1 pt=97 )";
 
 // Ends the audio where the markup's last phoneme ends, so that one media's streams end
@@ -228,7 +228,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "pfap-rtsp-server: %s: not a readable file\n", file);
     return 2;
   }
-  for (const char* name : {"pfapparse", "rtppfappay"}) {
+  for (const char* name : {"pfaptextparse", "rtppfappay"}) {
     GstElementFactory* factory = gst_element_factory_find(name);
     if (factory == nullptr) {
       std::fprintf(stderr,

@@ -230,6 +230,270 @@ std::vector<pfap::Viseme> detect_visemes(const std::vector<int16_t>& samples, un
   return out;
 }
 
+// How this run measures, from the environment (the file's comment says how).
+struct Settings {
+  pfap::tts::VoiceSettings voice;  // PFAP_ALIGN_EVAL_VOICE, pfapalign's voice property
+  bool recognize = false;          // the text-free modes: built, and not TEXT_ONLY
+  bool live = false;
+  bool verbose = false;
+  int wrong_text_shift = 0;  // PFAP_ALIGN_EVAL_WRONG_TEXT: each recording with the text k on
+};
+
+// What is measured over every sentence.
+struct Totals {
+  std::vector<double> aligned_errors, first_errors, equal_errors, scaled_errors, costs;
+  size_t matched = 0, truth_phonemes = 0, poor = 0;
+  double audio_seconds = 0, align_seconds = 0;
+  std::vector<pfap::Viseme> truth_frames;  // every sentence's, for the baseline
+  Agreement aligned_agreement;
+  Agreement detector_agreement;  // the frame-level viseme detector's
+  double detector_cpu_seconds = 0;
+  // Without the text, offline and live.
+  Agreement recognized_agreement, live_agreement, live_offline_agreement;
+  double recognize_seconds = 0, recognize_cpu_seconds = 0, live_seconds = 0, live_cpu_seconds = 0;
+  size_t live_lag_ms = 0;  // the most audio not yet given out
+};
+
+// One recording, its text and its truth.
+struct Sentence {
+  std::vector<int16_t> samples;
+  unsigned rate = 0;
+  std::string text;
+  std::vector<Phone> truth;
+  double duration = 0;  // seconds
+};
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+double cpu_seconds_since(std::clock_t c0) {
+  return static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
+}
+
+std::string arpabet_name(uint8_t symbol) {
+  return std::string(
+      pfap::find_phoneme(*pfap::find_alphabet(pfap::kArpabetAlphabet), symbol)->name);
+}
+
+// PFAP_ALIGN_EVAL_VERBOSE: a phoneme sequence with its starts in ms.
+void print_phones(const std::vector<Phone>& phones) {
+  for (const Phone& p : phones) std::printf(" %s@%.0f", p.name.c_str(), p.start * 1000);
+  std::printf("\n");
+}
+
+void print_phonemes(const std::vector<pfap::tts::SpokenPhoneme>& phonemes, unsigned rate) {
+  for (const pfap::tts::SpokenPhoneme& p : phonemes) {
+    std::printf(" %s@%zu", arpabet_name(p.event.phoneme.symbol).c_str(), p.start * 1000 / rate);
+  }
+  std::printf("\n");
+}
+
+// DIR/NAME.wav and .segs, with the lead-in, and the text of DIR/TEXT_NAME.txt.
+bool read_sentence(const std::string& dir, const char* name, const char* text_name, Sentence& out) {
+  const std::string base = dir + "/" + name;
+  if (!pfap::tools::read_wav(base + ".wav", out.samples, out.rate)) {
+    std::fprintf(stderr, "%s.wav: not 16-bit mono PCM\n", base.c_str());
+    return false;
+  }
+  std::ifstream text_in(dir + "/" + text_name + ".txt");
+  std::stringstream text;
+  text << text_in.rdbuf();
+  out.text = text.str();
+  out.truth = read_segs(base + ".segs");
+  add_lead_in(out.samples, out.rate, out.truth);
+  out.duration = static_cast<double>(out.samples.size()) / out.rate;
+  return true;
+}
+
+// The alignment's boundary errors beside the two baselines': equal-length phonemes, and
+// espeak-ng's own times stretched to the recording's length (what the warp adds to that).
+// Returns the alignment's errors.
+std::vector<double> measure_boundaries(const Settings& settings, const Sentence& s,
+                                       const pfap::tts::Utterance& utterance,
+                                       const pfap::align::Alignment& alignment, Totals& totals,
+                                       size_t& matched) {
+  std::vector<Phone> got, equal, scaled;
+  for (const pfap::tts::SpokenPhoneme& p : alignment.phonemes) {
+    got.push_back(
+        {lower(arpabet_name(p.event.phoneme.symbol)), static_cast<double>(p.start) / s.rate});
+  }
+  pfap::tts::Speech syn;
+  std::string error;
+  pfap::tts::speak(utterance, settings.voice, syn, error);
+  const double syn_duration = static_cast<double>(syn.samples.size()) / syn.sample_rate;
+  for (size_t k = 0; k < syn.phonemes.size(); ++k) {
+    const std::string name = lower(arpabet_name(syn.phonemes[k].event.phoneme.symbol));
+    equal.push_back(
+        {name, s.duration * static_cast<double>(k) / static_cast<double>(syn.phonemes.size())});
+    scaled.push_back({name, static_cast<double>(syn.phonemes[k].start) / syn.sample_rate *
+                                s.duration / syn_duration});
+  }
+  if (settings.verbose) {
+    print_phones(got);
+    print_phones(s.truth);
+  }
+  size_t unused = 0;
+  const std::vector<double> e = matched_errors(got, s.truth, matched);
+  totals.aligned_errors.insert(totals.aligned_errors.end(), e.begin(), e.end());
+  totals.first_errors.push_back(first_sound_error(got, s.truth));
+  const std::vector<double> b1 = matched_errors(equal, s.truth, unused);
+  totals.equal_errors.insert(totals.equal_errors.end(), b1.begin(), b1.end());
+  const std::vector<double> b2 = matched_errors(scaled, s.truth, unused);
+  totals.scaled_errors.insert(totals.scaled_errors.end(), b2.begin(), b2.end());
+  totals.matched += matched;
+  totals.truth_phonemes += s.truth.size();
+  totals.costs.push_back(alignment.relative_cost);
+  return e;
+}
+
+// The text-free modes' viseme agreement with the truth, offline and (settings.live) live;
+// `share` is the offline one's for this sentence.
+bool measure_recognition(const Settings& settings, const Sentence& s,
+                         const std::vector<pfap::Viseme>& truth_visemes, Totals& totals,
+                         double& share, std::string& error) {
+  pfap::align::Recognition recognition;
+  const auto r0 = std::chrono::steady_clock::now();
+  const std::clock_t c0 = std::clock();
+  if (!pfap::align::recognize(s.samples, s.rate, recognition, error)) return false;
+  totals.recognize_seconds += seconds_since(r0);
+  totals.recognize_cpu_seconds += cpu_seconds_since(c0);
+  const std::vector<pfap::Viseme> visemes =
+      pfap::align::viseme_frames(timed(recognition.phonemes, s.rate), s.duration);
+  totals.recognized_agreement.add(visemes, truth_visemes);
+  share = pfap::align::viseme_agreement(visemes, truth_visemes);
+  if (settings.live) {
+    pfap::align::Recognition live_recognition;
+    size_t lag = 0;
+    const auto l0 = std::chrono::steady_clock::now();
+    const std::clock_t lc0 = std::clock();
+    if (!recognize_live(s.samples, s.rate, live_recognition, lag, error)) return false;
+    totals.live_seconds += seconds_since(l0);
+    totals.live_cpu_seconds += cpu_seconds_since(lc0);
+    totals.live_lag_ms = std::max(totals.live_lag_ms, lag * 1000 / s.rate);
+    const std::vector<pfap::Viseme> live_visemes =
+        pfap::align::viseme_frames(timed(live_recognition.phonemes, s.rate), s.duration);
+    totals.live_agreement.add(live_visemes, truth_visemes);
+    totals.live_offline_agreement.add(live_visemes, visemes);
+    if (settings.verbose) print_phonemes(live_recognition.phonemes, s.rate);
+  }
+  if (settings.verbose) print_phonemes(recognition.phonemes, s.rate);
+  return true;
+}
+
+// Aligns one sentence (and recognizes it without its text), adds what it measures to
+// `totals` and prints its line.
+bool evaluate(const Settings& settings, const char* name, const Sentence& s, Totals& totals) {
+  std::vector<pfap::tts::BadBookmark> bad;
+  const pfap::tts::Utterance utterance = pfap::tts::parse_utterance(s.text, bad);
+  pfap::align::Alignment alignment;
+  std::string error;
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!(settings.live
+            ? align_live(utterance, settings.voice, s.samples, s.rate, alignment, error)
+            : pfap::align::align(utterance, settings.voice, s.samples, s.rate, alignment, error))) {
+    std::fprintf(stderr, "%s\n", error.c_str());
+    return false;
+  }
+  totals.align_seconds += seconds_since(t0);
+  totals.audio_seconds += s.duration;
+
+  size_t matched = 0;
+  const std::vector<double> e =
+      measure_boundaries(settings, s, utterance, alignment, totals, matched);
+
+  std::vector<pfap::align::TimedSymbol> truth_symbols;
+  for (const Phone& p : s.truth) truth_symbols.push_back({p.start, festival_symbol(p.name)});
+  const std::vector<pfap::Viseme> truth_visemes =
+      pfap::align::viseme_frames(truth_symbols, s.duration);
+  totals.truth_frames.insert(totals.truth_frames.end(), truth_visemes.begin(), truth_visemes.end());
+  totals.aligned_agreement.add(
+      pfap::align::viseme_frames(timed(alignment.phonemes, s.rate), s.duration), truth_visemes);
+  const std::clock_t d0 = std::clock();
+  totals.detector_agreement.add(detect_visemes(s.samples, s.rate), truth_visemes);
+  totals.detector_cpu_seconds += cpu_seconds_since(d0);
+  double recognized_share = 0;
+  if (settings.recognize &&
+      !measure_recognition(settings, s, truth_visemes, totals, recognized_share, error)) {
+    std::fprintf(stderr, "%s\n", error.c_str());
+    return false;
+  }
+  std::printf(
+      "%s: %.2f s, %zu of %zu phonemes matched, median %.1f ms, p90 %.1f ms, cost %.2f, "
+      "heard %.2f%s; without text %.0f %% of viseme frames\n",
+      name, s.duration, matched, s.truth.size(), percentile(e, 0.5) * 1000,
+      percentile(e, 0.9) * 1000, alignment.relative_cost, alignment.heard_agreement,
+      alignment.problem == pfap::align::Problem::kNone ? "" : " (poor)", recognized_share * 100);
+  totals.poor += alignment.problem != pfap::align::Problem::kNone;
+  return true;
+}
+
+void print_boundary_summary(const Totals& t, int sentences) {
+  std::printf("\n%d sentences, %.1f s of audio, %zu boundaries (%zu of %zu phonemes matched)\n",
+              sentences, t.audio_seconds, t.aligned_errors.size(), t.matched, t.truth_phonemes);
+  std::printf("%-36s median %6.1f ms   p90 %6.1f ms\n", "aligned (pfapalign)",
+              percentile(t.aligned_errors, 0.5) * 1000, percentile(t.aligned_errors, 0.9) * 1000);
+  std::printf("%-36s median %6.1f ms   p90 %6.1f ms   max %6.1f ms\n", "first sound's start",
+              percentile(t.first_errors, 0.5) * 1000, percentile(t.first_errors, 0.9) * 1000,
+              percentile(t.first_errors, 1) * 1000);
+  std::printf("%-36s median %6.1f ms   p90 %6.1f ms\n", "baseline: equal-length phonemes",
+              percentile(t.equal_errors, 0.5) * 1000, percentile(t.equal_errors, 0.9) * 1000);
+  std::printf("%-36s median %6.1f ms   p90 %6.1f ms\n", "baseline: espeak-ng times stretched",
+              percentile(t.scaled_errors, 0.5) * 1000, percentile(t.scaled_errors, 0.9) * 1000);
+  std::printf("relative warp cost: min %.2f, median %.2f, max %.2f; %zu of %d flagged poor\n",
+              percentile(t.costs, 0), percentile(t.costs, 0.5), percentile(t.costs, 1), t.poor,
+              sentences);
+  std::printf("real-time factor: %.3f (%.2f s to align %.1f s, with espeak-ng's synthesis)\n",
+              t.align_seconds / t.audio_seconds, t.align_seconds, t.audio_seconds);
+}
+
+void print_viseme_summary(const Settings& settings, const Totals& t) {
+  // The baseline: the viseme most frames show, throughout, over all frames and over speech.
+  std::array<size_t, 15> count{}, speech_count{};
+  for (pfap::Viseme v : t.truth_frames) {
+    ++count[static_cast<size_t>(v)];
+    if (v != pfap::Viseme::kNone) ++speech_count[static_cast<size_t>(v)];
+  }
+  const size_t speech_total = t.truth_frames.size() - count[0];
+  std::printf("\nviseme agreement per 10 ms frame (%zu frames, %zu of them speech):\n",
+              t.truth_frames.size(), speech_total);
+  if (settings.recognize) t.recognized_agreement.print("without text (pocketsphinx phones)");
+  if (settings.recognize && settings.live) {
+    t.live_agreement.print("without text, live");
+    t.live_offline_agreement.print("live against offline (not Festival)");
+  }
+  t.aligned_agreement.print("with text (pfapalign)");
+  t.detector_agreement.print("frame-level viseme detector, live");
+  const auto commonest = std::max_element(count.begin(), count.end());
+  const auto commonest_speech = std::max_element(speech_count.begin(), speech_count.end());
+  std::printf("%-36s %5.1f %% of frames (viseme %zu), %5.1f %% of speech frames (viseme %zu)\n",
+              "baseline: one viseme throughout",
+              100.0 * static_cast<double>(*commonest) / std::max<size_t>(t.truth_frames.size(), 1),
+              static_cast<size_t>(commonest - count.begin()),
+              100.0 * static_cast<double>(*commonest_speech) / std::max<size_t>(speech_total, 1),
+              static_cast<size_t>(commonest_speech - speech_count.begin()));
+  std::printf("viseme detector: %.2f s of processor time for %.1f s, %.2f %% of a core\n",
+              t.detector_cpu_seconds, t.audio_seconds,
+              100 * t.detector_cpu_seconds / t.audio_seconds);
+  if (!settings.recognize) {
+    std::printf("without text: not measured (PFAP_ALIGN_EVAL_TEXT_ONLY, or no -Drecognition)\n");
+    return;
+  }
+  // The processor time too: on a shared machine the wall clock measures the others' load.
+  std::printf(
+      "real-time factor without text: %.3f (%.2f s to recognize %.1f s; %.2f s of "
+      "processor time, %.3f)\n",
+      t.recognize_seconds / t.audio_seconds, t.recognize_seconds, t.audio_seconds,
+      t.recognize_cpu_seconds, t.recognize_cpu_seconds / t.audio_seconds);
+  if (settings.live) {
+    std::printf(
+        "real-time factor without text, live: %.3f (%.2f s; %.2f s of processor time, %.3f); "
+        "at most %zu ms of audio not yet given out\n",
+        t.live_seconds / t.audio_seconds, t.live_seconds, t.live_cpu_seconds,
+        t.live_cpu_seconds / t.audio_seconds, t.live_lag_ms);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -250,219 +514,27 @@ int main(int argc, char** argv) {
   }
   if (argc < 3) return usage_error("wants a DIR and at least one NAME");
   const std::string dir = argv[1];
-  // PFAP_ALIGN_EVAL_VOICE: the espeak-ng voice to align with (pfapalign's voice property).
-  pfap::tts::VoiceSettings voice;
-  if (const char* v = std::getenv("PFAP_ALIGN_EVAL_VOICE")) voice.voice = v;
-  const pfap::PhonemeAlphabet& arpabet = *pfap::find_alphabet(pfap::kArpabetAlphabet);
-  std::vector<double> aligned_errors, first_errors, equal_errors, scaled_errors, costs;
-  size_t matched_total = 0, truth_total = 0, poor = 0;
-  double audio_seconds = 0, align_seconds = 0, recognize_seconds = 0, recognize_cpu_seconds = 0;
-  const bool recognize =
+  Settings settings;
+  if (const char* v = std::getenv("PFAP_ALIGN_EVAL_VOICE")) settings.voice.voice = v;
+  settings.recognize =
       pfap::align::recognition_available() && std::getenv("PFAP_ALIGN_EVAL_TEXT_ONLY") == nullptr;
-  const bool live = std::getenv("PFAP_ALIGN_EVAL_LIVE") != nullptr;
-  Agreement recognized_agreement, aligned_agreement, live_agreement, live_offline_agreement;
-  double live_seconds = 0, live_cpu_seconds = 0;
-  size_t live_lag = 0;                     // samples, at 16 kHz or the corpus's rate
-  std::vector<pfap::Viseme> truth_frames;  // every sentence's, for the baseline
-  Agreement detector_agreement;            // the frame-level viseme detector's
-  double detector_cpu_seconds = 0;
+  settings.live = std::getenv("PFAP_ALIGN_EVAL_LIVE") != nullptr;
+  settings.verbose = std::getenv("PFAP_ALIGN_EVAL_VERBOSE") != nullptr;
+  // PFAP_ALIGN_EVAL_WRONG_TEXT=k: each recording with the text k places on (default 1), to
+  // see the poor-match statistics of a text that does not match.
+  if (const char* wrong = std::getenv("PFAP_ALIGN_EVAL_WRONG_TEXT")) {
+    settings.wrong_text_shift = std::max(1, std::atoi(wrong));
+  }
+  const int sentences = argc - 2;
+  Totals totals;
   for (int a = 2; a < argc; ++a) {
-    const std::string base = dir + "/" + argv[a];
-    std::vector<int16_t> samples;
-    unsigned rate = 0;
-    if (!pfap::tools::read_wav(base + ".wav", samples, rate)) {
-      std::fprintf(stderr, "%s.wav: not 16-bit mono PCM\n", base.c_str());
+    Sentence s;
+    const char* text_name = argv[2 + (a - 2 + settings.wrong_text_shift) % sentences];
+    if (!read_sentence(dir, argv[a], text_name, s) || !evaluate(settings, argv[a], s, totals)) {
       return 1;
     }
-    // PFAP_ALIGN_EVAL_WRONG_TEXT=k: each recording with the text k places on (default 1), to
-    // see the poor-match statistics of a text that does not match.
-    const char* wrong = std::getenv("PFAP_ALIGN_EVAL_WRONG_TEXT");
-    const int shift = wrong != nullptr ? std::max(1, std::atoi(wrong)) : 0;
-    std::ifstream text_in(dir + "/" + argv[2 + (a - 2 + shift) % (argc - 2)] + ".txt");
-    std::stringstream text;
-    text << text_in.rdbuf();
-    std::vector<Phone> truth = read_segs(base + ".segs");
-    add_lead_in(samples, rate, truth);
-
-    std::vector<pfap::tts::BadBookmark> bad;
-    const pfap::tts::Utterance utterance = pfap::tts::parse_utterance(text.str(), bad);
-    pfap::align::Alignment alignment;
-    std::string error;
-    const auto t0 = std::chrono::steady_clock::now();
-    if (!(live ? align_live(utterance, voice, samples, rate, alignment, error)
-               : pfap::align::align(utterance, voice, samples, rate, alignment, error))) {
-      std::fprintf(stderr, "%s\n", error.c_str());
-      return 1;
-    }
-    align_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const double duration = static_cast<double>(samples.size()) / rate;
-    audio_seconds += duration;
-
-    // Ours; the baseline of equal-length phonemes; espeak-ng's own times stretched to the
-    // recording's length (what the warp adds to that).
-    std::vector<Phone> got, equal, scaled;
-    for (const pfap::tts::SpokenPhoneme& p : alignment.phonemes) {
-      got.push_back({lower(pfap::find_phoneme(arpabet, p.event.phoneme.symbol)->name),
-                     static_cast<double>(p.start) / rate});
-    }
-    pfap::tts::Speech syn;
-    pfap::tts::speak(utterance, voice, syn, error);
-    const double syn_duration = static_cast<double>(syn.samples.size()) / syn.sample_rate;
-    for (size_t k = 0; k < syn.phonemes.size(); ++k) {
-      const std::string name =
-          lower(pfap::find_phoneme(arpabet, syn.phonemes[k].event.phoneme.symbol)->name);
-      equal.push_back(
-          {name, duration * static_cast<double>(k) / static_cast<double>(syn.phonemes.size())});
-      scaled.push_back({name, static_cast<double>(syn.phonemes[k].start) / syn.sample_rate *
-                                  duration / syn_duration});
-    }
-    if (std::getenv("PFAP_ALIGN_EVAL_VERBOSE") != nullptr) {
-      for (const Phone& p : got) std::printf(" %s@%.0f", p.name.c_str(), p.start * 1000);
-      std::printf("\n");
-      for (const Phone& p : truth) std::printf(" %s@%.0f", p.name.c_str(), p.start * 1000);
-      std::printf("\n");
-    }
-    size_t matched = 0, unused = 0;
-    const std::vector<double> e = matched_errors(got, truth, matched);
-    aligned_errors.insert(aligned_errors.end(), e.begin(), e.end());
-    first_errors.push_back(first_sound_error(got, truth));
-    const std::vector<double> b1 = matched_errors(equal, truth, unused);
-    equal_errors.insert(equal_errors.end(), b1.begin(), b1.end());
-    const std::vector<double> b2 = matched_errors(scaled, truth, unused);
-    scaled_errors.insert(scaled_errors.end(), b2.begin(), b2.end());
-    matched_total += matched;
-    truth_total += truth.size();
-    costs.push_back(alignment.relative_cost);
-
-    std::vector<pfap::align::TimedSymbol> truth_symbols;
-    for (const Phone& p : truth) truth_symbols.push_back({p.start, festival_symbol(p.name)});
-    const std::vector<pfap::Viseme> truth_visemes =
-        pfap::align::viseme_frames(truth_symbols, duration);
-    truth_frames.insert(truth_frames.end(), truth_visemes.begin(), truth_visemes.end());
-    aligned_agreement.add(pfap::align::viseme_frames(timed(alignment.phonemes, rate), duration),
-                          truth_visemes);
-    const std::clock_t d0 = std::clock();
-    detector_agreement.add(detect_visemes(samples, rate), truth_visemes);
-    detector_cpu_seconds += static_cast<double>(std::clock() - d0) / CLOCKS_PER_SEC;
-    double recognized_share = 0;
-    if (recognize) {
-      pfap::align::Recognition recognition;
-      const auto r0 = std::chrono::steady_clock::now();
-      const std::clock_t c0 = std::clock();
-      if (!pfap::align::recognize(samples, rate, recognition, error)) {
-        std::fprintf(stderr, "%s\n", error.c_str());
-        return 1;
-      }
-      recognize_seconds +=
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
-      recognize_cpu_seconds += static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
-      const std::vector<pfap::Viseme> visemes =
-          pfap::align::viseme_frames(timed(recognition.phonemes, rate), duration);
-      recognized_agreement.add(visemes, truth_visemes);
-      recognized_share = pfap::align::viseme_agreement(visemes, truth_visemes);
-      if (live) {
-        pfap::align::Recognition live_recognition;
-        size_t lag = 0;
-        const auto l0 = std::chrono::steady_clock::now();
-        const std::clock_t lc0 = std::clock();
-        if (!recognize_live(samples, rate, live_recognition, lag, error)) {
-          std::fprintf(stderr, "%s\n", error.c_str());
-          return 1;
-        }
-        live_seconds +=
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - l0).count();
-        live_cpu_seconds += static_cast<double>(std::clock() - lc0) / CLOCKS_PER_SEC;
-        live_lag = std::max(live_lag, lag * 1000 / rate);
-        const std::vector<pfap::Viseme> live_visemes =
-            pfap::align::viseme_frames(timed(live_recognition.phonemes, rate), duration);
-        live_agreement.add(live_visemes, truth_visemes);
-        live_offline_agreement.add(live_visemes, visemes);
-        if (std::getenv("PFAP_ALIGN_EVAL_VERBOSE") != nullptr) {
-          for (const pfap::tts::SpokenPhoneme& p : live_recognition.phonemes) {
-            std::printf(
-                " %s@%zu",
-                std::string(pfap::find_phoneme(arpabet, p.event.phoneme.symbol)->name).c_str(),
-                p.start * 1000 / rate);
-          }
-          std::printf("\n");
-        }
-      }
-      if (std::getenv("PFAP_ALIGN_EVAL_VERBOSE") != nullptr) {
-        for (const pfap::tts::SpokenPhoneme& p : recognition.phonemes) {
-          std::printf(
-              " %s@%zu",
-              std::string(pfap::find_phoneme(arpabet, p.event.phoneme.symbol)->name).c_str(),
-              p.start * 1000 / rate);
-        }
-        std::printf("\n");
-      }
-    }
-    std::printf(
-        "%s: %.2f s, %zu of %zu phonemes matched, median %.1f ms, p90 %.1f ms, cost %.2f, "
-        "heard %.2f%s; without text %.0f %% of viseme frames\n",
-        argv[a], duration, matched, truth.size(), percentile(e, 0.5) * 1000,
-        percentile(e, 0.9) * 1000, alignment.relative_cost, alignment.heard_agreement,
-        alignment.problem == pfap::align::Problem::kNone ? "" : " (poor)", recognized_share * 100);
-    poor += alignment.problem != pfap::align::Problem::kNone;
   }
-  std::printf("\n%d sentences, %.1f s of audio, %zu boundaries (%zu of %zu phonemes matched)\n",
-              argc - 2, audio_seconds, aligned_errors.size(), matched_total, truth_total);
-  std::printf("%-36s median %6.1f ms   p90 %6.1f ms\n", "aligned (pfapalign)",
-              percentile(aligned_errors, 0.5) * 1000, percentile(aligned_errors, 0.9) * 1000);
-  std::printf("%-36s median %6.1f ms   p90 %6.1f ms   max %6.1f ms\n", "first sound's start",
-              percentile(first_errors, 0.5) * 1000, percentile(first_errors, 0.9) * 1000,
-              percentile(first_errors, 1) * 1000);
-  std::printf("%-36s median %6.1f ms   p90 %6.1f ms\n", "baseline: equal-length phonemes",
-              percentile(equal_errors, 0.5) * 1000, percentile(equal_errors, 0.9) * 1000);
-  std::printf("%-36s median %6.1f ms   p90 %6.1f ms\n", "baseline: espeak-ng times stretched",
-              percentile(scaled_errors, 0.5) * 1000, percentile(scaled_errors, 0.9) * 1000);
-  std::printf("relative warp cost: min %.2f, median %.2f, max %.2f; %zu of %d flagged poor\n",
-              percentile(costs, 0), percentile(costs, 0.5), percentile(costs, 1), poor, argc - 2);
-  std::printf("real-time factor: %.3f (%.2f s to align %.1f s, with espeak-ng's synthesis)\n",
-              align_seconds / audio_seconds, align_seconds, audio_seconds);
-
-  // The baseline: the viseme most frames show, throughout, over all frames and over speech.
-  std::array<size_t, 15> count{}, speech_count{};
-  for (pfap::Viseme v : truth_frames) {
-    ++count[static_cast<size_t>(v)];
-    if (v != pfap::Viseme::kNone) ++speech_count[static_cast<size_t>(v)];
-  }
-  const size_t speech_total = truth_frames.size() - count[0];
-  std::printf("\nviseme agreement per 10 ms frame (%zu frames, %zu of them speech):\n",
-              truth_frames.size(), speech_total);
-  if (recognize) recognized_agreement.print("without text (pocketsphinx phones)");
-  if (recognize && live) {
-    live_agreement.print("without text, live");
-    live_offline_agreement.print("live against offline (not Festival)");
-  }
-  aligned_agreement.print("with text (pfapalign)");
-  detector_agreement.print("frame-level viseme detector, live");
-  const auto commonest = std::max_element(count.begin(), count.end());
-  const auto commonest_speech = std::max_element(speech_count.begin(), speech_count.end());
-  std::printf("%-36s %5.1f %% of frames (viseme %zu), %5.1f %% of speech frames (viseme %zu)\n",
-              "baseline: one viseme throughout",
-              100.0 * static_cast<double>(*commonest) / std::max<size_t>(truth_frames.size(), 1),
-              static_cast<size_t>(commonest - count.begin()),
-              100.0 * static_cast<double>(*commonest_speech) / std::max<size_t>(speech_total, 1),
-              static_cast<size_t>(commonest_speech - speech_count.begin()));
-  std::printf("viseme detector: %.2f s of processor time for %.1f s, %.2f %% of a core\n",
-              detector_cpu_seconds, audio_seconds, 100 * detector_cpu_seconds / audio_seconds);
-  if (recognize) {
-    // The processor time too: on a shared machine the wall clock measures the others' load.
-    std::printf(
-        "real-time factor without text: %.3f (%.2f s to recognize %.1f s; %.2f s of "
-        "processor time, %.3f)\n",
-        recognize_seconds / audio_seconds, recognize_seconds, audio_seconds, recognize_cpu_seconds,
-        recognize_cpu_seconds / audio_seconds);
-    if (live) {
-      std::printf(
-          "real-time factor without text, live: %.3f (%.2f s; %.2f s of processor time, %.3f); "
-          "at most %zu ms of audio not yet given out\n",
-          live_seconds / audio_seconds, live_seconds, live_cpu_seconds,
-          live_cpu_seconds / audio_seconds, live_lag);
-    }
-  } else {
-    std::printf("without text: not measured (PFAP_ALIGN_EVAL_TEXT_ONLY, or no -Drecognition)\n");
-  }
+  print_boundary_summary(totals, sentences);
+  print_viseme_summary(settings, totals);
   return 0;
 }

@@ -115,9 +115,6 @@ struct Sender {
   uint32_t pfap_ts_offset = 0;
   int exit_status = 0;
 
-  // The level probe's (the audio's streaming thread before the queue).
-  GstClockTime level_start = GST_CLOCK_TIME_NONE;  // running time of the first level waiting
-  SpeechLevel level;
   int audio_packets = 0;  // the audio sink's thread
 
   // The appsink's thread: the loss, and the state as sent (every packet, before the loss,
@@ -153,39 +150,10 @@ uint32_t pfap_timestamp(const Sender& s, GstClockTime running) {
 
 // -- The level: the RMS of each ms by PFAP timestamp, sent as the audio enters the queue ------
 
-void send_levels(Sender& s) {
-  if (s.level.empty()) return;
-  const std::vector<int64_t> levels = s.level.take();
-  bool silent = true;
-  for (int64_t v : levels) silent = silent && v == 0;
-  if (!silent) {
-    std::string json = "{\"type\":\"level\",\"ssrc\":" + std::to_string(s.ssrc) +
-                       ",\"timestamp\":" + std::to_string(pfap_timestamp(s, s.level_start)) +
-                       ",\"rms\":[";
-    for (size_t i = 0; i < levels.size(); ++i) {
-      json += (i == 0 ? "" : ",") + std::to_string(levels[i]);
-    }
-    send_text(s, json + "]}");
-  }
-  s.level_start += levels.size() * GST_MSECOND;
-}
-
-GstPadProbeReturn on_speech(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
-  auto& s = *static_cast<Sender*>(data);
-  if ((info->type & GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM) != 0) {
-    if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) == GST_EVENT_EOS) send_levels(s);
-    return GST_PAD_PROBE_OK;
-  }
-  GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
-  if (s.level_start == GST_CLOCK_TIME_NONE) {
-    s.level_start = running_time_of(pad, buffer);
-    if (s.level_start == GST_CLOCK_TIME_NONE) return GST_PAD_PROBE_OK;
-  }
-  GstMapInfo map;
-  if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) return GST_PAD_PROBE_OK;
-  s.level.add({reinterpret_cast<const int16_t*>(map.data), map.size / 2}, [&] { send_levels(s); });
-  gst_buffer_unmap(buffer, &map);
-  return GST_PAD_PROBE_OK;
+void send_levels(Sender& s, GstClockTime start, const std::vector<int64_t>& levels) {
+  send_text(s, "{\"type\":\"level\",\"ssrc\":" + std::to_string(s.ssrc) +
+                   ",\"timestamp\":" + std::to_string(pfap_timestamp(s, start)) + ",\"level\":\"" +
+                   encode_levels(levels) + "\"}");
 }
 
 // -- The clock: the PFAP timestamp of the audio as it goes to the audio port -----------------
@@ -376,9 +344,11 @@ int main(int argc, char** argv) {
     gst_pad_add_probe(pad, type, callback, &s, nullptr);
     gst_object_unref(pad);
   };
-  probe("level", "sink",
-        GstPadProbeType(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM),
-        on_speech);
+  GstPad* level_pad = gst_element_get_static_pad(by_name("level"), "sink");
+  add_speech_level_probe(level_pad, 0, [&s](GstClockTime start, std::vector<int64_t> levels) {
+    send_levels(s, start, levels);
+  });
+  gst_object_unref(level_pad);
   probe("audiosink", "sink", GST_PAD_PROBE_TYPE_BUFFER, on_audio_packet);
   probe("pay", "sink", GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM, on_pfap_eos);
 

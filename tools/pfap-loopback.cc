@@ -2,7 +2,7 @@
 // pfap-loopback: sends a .pfap text file as PFAP RTP packets over loopback UDP and prints, as
 // .pfap text, what arrives. Sender and receiver run in this one process:
 //
-//   sender:   filesrc location=FILE ! pfapparse ! rtppfappay ! udpsink host=127.0.0.1 port=P
+//   sender:   filesrc location=FILE ! pfaptextparse ! rtppfappay ! udpsink host=127.0.0.1 port=P
 //   receiver: udpsrc address=127.0.0.1 port=P do-timestamp=false caps=application/x-rtp,...
 //             ! rtpjitterbuffer mode=none max-dropout-time=0 max-misorder-time=0
 //             ! rtppfapdepay ! pfaptextenc ! fdsink fd=1
@@ -87,7 +87,7 @@ int parse_options(int* argc, char*** argv, Options& options) {
       {}};
   if (const int status = parse_command_line(
           argc, argv, "FILE.pfap",
-          "Sends FILE through pfapparse ! rtppfappay ! udpsink to 127.0.0.1 and prints\n"
+          "Sends FILE through pfaptextparse ! rtppfappay ! udpsink to 127.0.0.1 and prints\n"
           "what udpsrc ! rtpjitterbuffer ! rtppfapdepay ! pfaptextenc receives.",
           entries, gst_init_get_option_group());
       status != 0) {
@@ -253,7 +253,7 @@ std::string depay_summary(GstElement* receiver) {
 int main(int argc, char** argv) {
   Options options;
   if (const int status = parse_options(&argc, &argv, options); status != 0) return status;
-  for (const char* name : {"pfapparse", "rtppfappay", "rtppfapdepay", "pfaptextenc"}) {
+  for (const char* name : {"pfaptextparse", "rtppfappay", "rtppfapdepay", "pfaptextenc"}) {
     GstElementFactory* factory = gst_element_factory_find(name);
     if (factory == nullptr) {
       std::fprintf(stderr,
@@ -279,7 +279,7 @@ int main(int argc, char** argv) {
       "fdsink fd=1 sync=false";
   lb.receiver = launch(receiver_description.c_str(), "receiver");
   lb.sender = launch(
-      "filesrc name=file ! pfapparse ! rtppfappay name=pay ! "
+      "filesrc name=file ! pfaptextparse ! rtppfappay name=pay ! "
       "udpsink name=udpsink host=127.0.0.1 sync=false",
       "sender");
   if (lb.receiver == nullptr || lb.sender == nullptr) return 1;

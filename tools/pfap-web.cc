@@ -3,8 +3,8 @@
 // uses pfap.js from web/src/) over HTTP and, for each browser that connects to its WebSocket,
 // runs a WebRTC session of its own:
 //
-//   audiotestsrc is-live wave=silence ! audiomixer ! opusenc ! rtpopuspay ! valve ! webrtcbin
-//   pfaptts ! audio ! ...................... ^ (one per text said, added while playing)
+//                       audiomixer force-live=true ! opusenc ! rtpopuspay ! valve ! webrtcbin
+//   pfaptts ! audio ! ^ (one per text said, added while playing)
 //           ! pfap  ! rtppfappay ! appsink ! data channel "pfap" (ordered=false,
 //                                                                 max-retransmits=0)
 //
@@ -49,7 +49,6 @@
 
 #include "command_line.h"
 #include "launch_value.h"
-#include "pad_time.h"
 #include "pfap-web-signal.h"
 #include "pfap-web-stun.h"
 #include "pfap/model.h"
@@ -387,50 +386,11 @@ GstPadProbeReturn on_sink_gap(GstPad*, GstPadProbeInfo* info, gpointer data) {
 // The speech's level, sent to the page as it leaves the speaker (up to a second before it is
 // played): the RMS of each millisecond at its running time, which the page finds again in the
 // audio it plays to learn which running time it is hearing (docs/web.md, Timing).
-struct Envelope {
-  std::weak_ptr<Session> session;
-  GstClockTime offset = 0;  // the speaker's pad offset: its running time in the pipeline's
-  GstClockTime start = GST_CLOCK_TIME_NONE;  // running time of the first level waiting
-  SpeechLevel level;
-};
-
-void send_envelope(Envelope& e) {
-  if (e.level.empty()) return;
-  const std::vector<int64_t> levels = e.level.take();
-  const bool silent = std::all_of(levels.begin(), levels.end(), [](int64_t v) { return v == 0; });
-  std::shared_ptr<Session> session = e.session.lock();
-  if (!silent && session != nullptr) {
-    post(session, [start = e.start, levels](Session& s) {
-      JsonBuilder* b = message("envelope");
-      member(b, "runningTimeNs", static_cast<int64_t>(start));
-      json_builder_set_member_name(b, "rms");
-      json_builder_begin_array(b);
-      for (int64_t v : levels) json_builder_add_int_value(b, v);
-      json_builder_end_array(b);
-      finish(s, b);
-    });
-  }
-  e.start += levels.size() * GST_MSECOND;
-}
-
-GstPadProbeReturn on_speech(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
-  auto& e = *static_cast<Envelope*>(data);
-  if ((info->type & GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM) != 0) {
-    if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) == GST_EVENT_EOS) send_envelope(e);
-    return GST_PAD_PROBE_OK;
-  }
-  GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
-  if (e.start == GST_CLOCK_TIME_NONE) {
-    const GstClockTime running = running_time_of(pad, buffer);
-    if (!GST_CLOCK_TIME_IS_VALID(running)) return GST_PAD_PROBE_OK;
-    e.start = running + e.offset;
-  }
-  GstMapInfo map;
-  if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) return GST_PAD_PROBE_OK;
-  e.level.add({reinterpret_cast<const int16_t*>(map.data), map.size / 2},
-              [&] { send_envelope(e); });
-  gst_buffer_unmap(buffer, &map);
-  return GST_PAD_PROBE_OK;
+void send_envelope(Session& s, GstClockTime start, const std::vector<int64_t>& levels) {
+  JsonBuilder* b = message("envelope");
+  member(b, "runningTimeNs", static_cast<int64_t>(start));
+  member(b, "level", encode_levels(levels).c_str());
+  finish(s, b);
 }
 
 // Starts saying `text` now, or after the text being said.
@@ -474,12 +434,15 @@ void say(Session& s, const std::string& text) {
   // Its level, as early as the speaker makes it (the queue before the mixer fills ahead).
   GstElement* queue = gst_bin_get_by_name(GST_BIN(speaker), "audio");
   GstPad* queue_sink = gst_element_get_static_pad(queue, "sink");
-  auto* envelope = new Envelope;
-  envelope->session = s.weak_from_this();
-  envelope->offset = now + kSpeakLead;
-  gst_pad_add_probe(
-      queue_sink, GstPadProbeType(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM),
-      on_speech, envelope, [](gpointer data) { delete static_cast<Envelope*>(data); });
+  add_speech_level_probe(
+      queue_sink, now + kSpeakLead,
+      [session = s.weak_from_this()](GstClockTime start, std::vector<int64_t> levels) {
+        if (std::shared_ptr<Session> locked = session.lock()) {
+          post(locked, [start, levels = std::move(levels)](Session& s) {
+            send_envelope(s, start, levels);
+          });
+        }
+      });
   gst_object_unref(queue_sink);
   gst_object_unref(queue);
 
@@ -660,106 +623,127 @@ gboolean on_connect_timeout(gpointer data) {
   return G_SOURCE_REMOVE;
 }
 
-std::shared_ptr<Session> open_session(Server& server, SoupWebsocketConnection* ws) {
-  auto s = std::make_shared<Session>();
-  s->id = ++server.sessions;
-  s->server = &server;
-  s->ws = SOUP_WEBSOCKET_CONNECTION(g_object_ref(ws));
-  s->drop = server.options.drop;
-  s->rng.seed(server.options.seed + static_cast<uint32_t>(s->id));
-  s->audio_ts_offset = g_random_int();
-  s->pfap_ts_offset = g_random_int();
+// One session's pipeline. The mixer makes the audio's pace alone (force-live: it mixes on the
+// clock with no live source upstream), silence between the texts, so no silent source runs
+// beside it. Opus frames of 20 ms at complexity 5: the encoder's instructions 0.59× those of
+// 10 ms at complexity 10, and half the packets to protect and send, for the same lip sync
+// (docs/performance.md, "pfap-web: sessions per server"); 5 is what libwebrtc gives Opus on
+// phones. The mixer's output buffers are one Opus frame each.
+constexpr const char* kSessionPipeline =
+    "webrtcbin name=webrtc bundle-policy=max-bundle "
+    "audiomixer name=mix force-live=true output-buffer-duration=20000000 "
+    "! audio/x-raw,format=S16LE,rate=48000,channels=1 ! opusenc frame-size=20 complexity=5 "
+    "! rtpopuspay name=apay pt=111 "
+    "! application/x-rtp,media=audio,encoding-name=OPUS,clock-rate=48000,payload=111 "
+    "! valve name=gate drop=true drop-mode=forward-sticky-events ! webrtc. "
+    "rtppfappay name=pay pt=96 ! application/x-rtp,clock-rate=44100 "
+    "! appsink name=pfapsink sync=true async=false";
+
+// The session's pipeline, its elements found and set: false if it cannot be made.
+bool make_pipeline(Session& s) {
   GError* error = nullptr;
-  s->pipeline = gst_parse_launch(
-      "webrtcbin name=webrtc bundle-policy=max-bundle "
-      "audiotestsrc is-live=true wave=silence samplesperbuffer=480 "
-      "! audio/x-raw,format=S16LE,rate=48000,channels=1 ! audiomixer name=mix "
-      "! audio/x-raw,format=S16LE,rate=48000,channels=1 ! opusenc frame-size=10 "
-      "! rtpopuspay name=apay pt=111 "
-      "! application/x-rtp,media=audio,encoding-name=OPUS,clock-rate=48000,payload=111 "
-      "! valve name=gate drop=true drop-mode=forward-sticky-events ! webrtc. "
-      "rtppfappay name=pay pt=96 ! application/x-rtp,clock-rate=44100 "
-      "! appsink name=pfapsink sync=true async=false",
-      &error);
-  if (s->pipeline == nullptr) {
+  s.pipeline = gst_parse_launch(kSessionPipeline, &error);
+  if (s.pipeline == nullptr) {
     g_printerr("pfap-web: %s\n", error->message);
     g_error_free(error);
-    g_object_unref(ws);
-    return nullptr;
+    return false;
   }
   auto by_name = [&](const char* name) {
-    GstElement* e = gst_bin_get_by_name(GST_BIN(s->pipeline), name);
+    GstElement* e = gst_bin_get_by_name(GST_BIN(s.pipeline), name);
     gst_object_unref(e);  // the pipeline keeps it
     return e;
   };
-  s->webrtc = by_name("webrtc");
-  s->mixer = by_name("mix");
-  s->pay = by_name("pay");
-  g_object_set(by_name("apay"), "timestamp-offset", s->audio_ts_offset, nullptr);
-  g_object_set(s->pay, "timestamp-offset", s->pfap_ts_offset, nullptr);
+  s.webrtc = by_name("webrtc");
+  s.mixer = by_name("mix");
+  s.pay = by_name("pay");
+  g_object_set(by_name("apay"), "timestamp-offset", s.audio_ts_offset, nullptr);
+  g_object_set(s.pay, "timestamp-offset", s.pfap_ts_offset, nullptr);
   GstElement* sink = by_name("pfapsink");
   g_object_set(sink, "ts-offset", -kPfapLead, nullptr);
   GstAppSinkCallbacks callbacks{};
   callbacks.new_sample = on_pfap_packet;
-  gst_app_sink_set_callbacks(GST_APP_SINK(sink), &callbacks, weak(s), free_weak_data);
+  gst_app_sink_set_callbacks(GST_APP_SINK(sink), &callbacks, weak(s.shared_from_this()),
+                             free_weak_data);
   GstPad* sink_pad = gst_element_get_static_pad(sink, "sink");
-  gst_pad_add_probe(sink_pad, GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM, on_sink_gap, weak(s),
-                    free_weak_data);
+  gst_pad_add_probe(sink_pad, GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM, on_sink_gap,
+                    weak(s.shared_from_this()), free_weak_data);
   gst_object_unref(sink_pad);
+  return true;
+}
 
-  // ICE on 127.0.0.1 only, as the HTTP server: the page is on this machine (a browser offers
-  // its loopback candidate with --allow-loopback-in-peer-connection, docs/web.md), and no
-  // packet goes to another address.
+// ICE on 127.0.0.1 only, as the HTTP server: the page is on this machine (a browser offers
+// its loopback candidate with --allow-loopback-in-peer-connection, docs/web.md), and no
+// packet goes to another address. Send only: the page has nothing to send but its answer.
+void configure_webrtc(Session& s) {
   GObject* ice = nullptr;
-  g_object_get(s->webrtc, "ice-agent", &ice, nullptr);
+  g_object_get(s.webrtc, "ice-agent", &ice, nullptr);
   gboolean added = FALSE;
   g_signal_emit_by_name(ice, "add-local-ip-address", "127.0.0.1", &added);
   g_object_unref(ice);
-  if (!added) g_printerr("pfap-web: session %d: ICE cannot use 127.0.0.1\n", s->id);
+  if (!added) g_printerr("pfap-web: session %d: ICE cannot use 127.0.0.1\n", s.id);
 
-  // Send only: the page has nothing to send but its answer.
   GArray* transceivers = nullptr;
-  g_signal_emit_by_name(s->webrtc, "get-transceivers", &transceivers);
+  g_signal_emit_by_name(s.webrtc, "get-transceivers", &transceivers);
   for (guint i = 0; transceivers != nullptr && i < transceivers->len; ++i) {
     g_object_set(g_array_index(transceivers, GstWebRTCRTPTransceiver*, i), "direction",
                  GST_WEBRTC_RTP_TRANSCEIVER_DIRECTION_SENDONLY, nullptr);
   }
   if (transceivers != nullptr) g_array_unref(transceivers);
 
-  g_signal_connect_data(s->webrtc, "on-negotiation-needed", G_CALLBACK(on_negotiation_needed),
-                        weak(s), free_weak, GConnectFlags(0));
-  g_signal_connect_data(s->webrtc, "on-ice-candidate", G_CALLBACK(on_ice_candidate), weak(s),
+  const std::shared_ptr<Session> session = s.shared_from_this();
+  g_signal_connect_data(s.webrtc, "on-negotiation-needed", G_CALLBACK(on_negotiation_needed),
+                        weak(session), free_weak, GConnectFlags(0));
+  g_signal_connect_data(s.webrtc, "on-ice-candidate", G_CALLBACK(on_ice_candidate), weak(session),
                         free_weak, GConnectFlags(0));
-  g_signal_connect(s->webrtc, "deep-element-added", G_CALLBACK(on_webrtc_element_added),
-                   nullptr);
-  gst_bus_add_watch_full(GST_ELEMENT_BUS(s->pipeline), G_PRIORITY_DEFAULT, on_bus, weak(s),
-                         free_weak_data);
+  g_signal_connect(s.webrtc, "deep-element-added", G_CALLBACK(on_webrtc_element_added), nullptr);
+}
 
-  gst_element_set_state(s->pipeline, GST_STATE_READY);
+// The "pfap" data channel, unordered and unreliable; made in READY, before the offer.
+void create_data_channel(Session& s) {
   GstStructure* options = gst_structure_new("options", "ordered", G_TYPE_BOOLEAN, FALSE,
                                             "max-retransmits", G_TYPE_INT, 0, nullptr);
-  g_signal_emit_by_name(s->webrtc, "create-data-channel", "pfap", options, &s->channel);
+  g_signal_emit_by_name(s.webrtc, "create-data-channel", "pfap", options, &s.channel);
   gst_structure_free(options);
-  if (s->channel == nullptr) {
-    g_printerr("pfap-web: session %d: webrtcbin made no data channel\n", s->id);
-  } else {
-    g_signal_connect_data(s->channel, "on-open", G_CALLBACK(on_channel_open), weak(s), free_weak,
-                          GConnectFlags(0));
+  if (s.channel == nullptr) {
+    g_printerr("pfap-web: session %d: webrtcbin made no data channel\n", s.id);
+    return;
   }
+  g_signal_connect_data(s.channel, "on-open", G_CALLBACK(on_channel_open),
+                        weak(s.shared_from_this()), free_weak, GConnectFlags(0));
+}
+
+// What the page needs to map the audio it plays to PFAP time (docs/web.md, Timing).
+void send_timing(Session& s) {
+  JsonBuilder* b = message("timing");
+  member(b, "audioClockRate", kAudioClockRate);
+  member(b, "audioTimestampOffset", s.audio_ts_offset);
+  member(b, "pfapClockRate", kPfapClockRate);
+  member(b, "pfapTimestampOffset", s.pfap_ts_offset);
+  member(b, "drop", static_cast<int64_t>(s.server->options.drop * 1000));
+  member(b, "stunPort", s.server->stun_port);
+  finish(s, b);
+}
+
+std::shared_ptr<Session> open_session(Server& server, SoupWebsocketConnection* ws) {
+  auto s = std::make_shared<Session>();
+  s->id = ++server.sessions;
+  s->server = &server;
+  s->drop = server.options.drop;
+  s->rng.seed(server.options.seed + static_cast<uint32_t>(s->id));
+  s->audio_ts_offset = g_random_int();
+  s->pfap_ts_offset = g_random_int();
+  if (!make_pipeline(*s)) return nullptr;
+  s->ws = SOUP_WEBSOCKET_CONNECTION(g_object_ref(ws));
+  configure_webrtc(*s);
+  gst_bus_add_watch_full(GST_ELEMENT_BUS(s->pipeline), G_PRIORITY_DEFAULT, on_bus, weak(s),
+                         free_weak_data);
+  gst_element_set_state(s->pipeline, GST_STATE_READY);
+  create_data_channel(*s);
   s->pending_text = server.options.text;
   s->connect_timer = g_timeout_add_full(
       G_PRIORITY_DEFAULT, static_cast<guint>(std::lround(server.options.connect_timeout_s * 1000)),
       on_connect_timeout, weak(s), free_weak_data);
-
-  JsonBuilder* b = message("timing");
-  member(b, "audioClockRate", kAudioClockRate);
-  member(b, "audioTimestampOffset", s->audio_ts_offset);
-  member(b, "pfapClockRate", kPfapClockRate);
-  member(b, "pfapTimestampOffset", s->pfap_ts_offset);
-  member(b, "drop", static_cast<int64_t>(server.options.drop * 1000));
-  member(b, "stunPort", server.stun_port);
-  finish(*s, b);
-
+  send_timing(*s);
   gst_element_set_state(s->pipeline, GST_STATE_PLAYING);
   g_print("pfap-web: session %d opened\n", s->id);
   return s;

@@ -1,15 +1,23 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // The speech's level that a page finds in the audio it plays to know which time it hears
 // (docs/web.md, Timing): the RMS of each millisecond of 48 kHz S16 mono, in S16 units. Sent by
-// pfap-web (on its WebSocket) and pfap-broadcast (on Janus's data stream).
+// pfap-web (on its WebSocket) and pfap-broadcast (on Janus's data stream), each in its own
+// message; add_speech_level_probe() takes it from a pad for both.
 #pragma once
 
+#include <gst/gst.h>
+
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
+#include <string>
 #include <utility>
 #include <vector>
+
+#include "pad_time.h"
 
 class SpeechLevel {
  public:
@@ -40,3 +48,73 @@ class SpeechLevel {
   double sum_ = 0.0;
   int count_ = 0;
 };
+
+// The levels as the pages read them (web/live/clock.js, decodeLevels): one byte a level, the
+// code round(kLevelCodesPerOctave × log2(1 + rms)) (at most 240 for S16's 32767; a step is
+// 4.4 % of the level, well within what the page's correlation tells apart), in base64. Half
+// the bytes of the levels as a JSON array of integers, whose numbers run to 4 and 5 digits.
+constexpr double kLevelCodesPerOctave = 16.0;
+
+inline std::string encode_levels(std::span<const int64_t> levels) {
+  std::vector<guchar> codes;
+  codes.reserve(levels.size());
+  for (int64_t rms : levels) {
+    const double code =
+        std::round(kLevelCodesPerOctave * std::log2(1.0 + std::max<int64_t>(rms, 0)));
+    codes.push_back(static_cast<guchar>(std::min(code, 255.0)));
+  }
+  gchar* base64 = g_base64_encode(codes.data(), codes.size());
+  std::string out = base64;
+  g_free(base64);
+  return out;
+}
+
+// What the probe gives on: `levels[i]` is the RMS of the ms from running time start + i ms.
+using SpeechLevelSend = std::function<void(GstClockTime start, std::vector<int64_t> levels)>;
+
+// Takes the level of the S16 mono 48 kHz audio passing `pad` and calls `send` on its streaming
+// thread with each kLevelsPerMessage ms of it, and the rest at EOS; silent batches are not
+// sent. The running times are the pad's plus `offset` (a pad offset further downstream).
+inline void add_speech_level_probe(GstPad* pad, GstClockTime offset, SpeechLevelSend send) {
+  struct Probe {
+    SpeechLevelSend send;
+    GstClockTime offset = 0;
+    GstClockTime start = GST_CLOCK_TIME_NONE;  // running time of the first level waiting
+    SpeechLevel level;
+
+    void send_waiting() {
+      if (level.empty()) return;
+      std::vector<int64_t> levels = level.take();
+      const GstClockTime batch_start = start;
+      start += levels.size() * GST_MSECOND;
+      if (std::any_of(levels.begin(), levels.end(), [](int64_t v) { return v != 0; })) {
+        send(batch_start, std::move(levels));
+      }
+    }
+  };
+  auto on_buffer_or_eos = [](GstPad* pad, GstPadProbeInfo* info, gpointer data) {
+    auto& p = *static_cast<Probe*>(data);
+    if ((info->type & GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM) != 0) {
+      if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) == GST_EVENT_EOS) p.send_waiting();
+      return GST_PAD_PROBE_OK;
+    }
+    GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
+    if (p.start == GST_CLOCK_TIME_NONE) {
+      const GstClockTime running = running_time_of(pad, buffer);
+      if (running == GST_CLOCK_TIME_NONE) return GST_PAD_PROBE_OK;
+      p.start = running + p.offset;
+    }
+    GstMapInfo map;
+    if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) return GST_PAD_PROBE_OK;
+    p.level.add({reinterpret_cast<const int16_t*>(map.data), map.size / 2},
+                [&] { p.send_waiting(); });
+    gst_buffer_unmap(buffer, &map);
+    return GST_PAD_PROBE_OK;
+  };
+  auto* probe = new Probe;
+  probe->send = std::move(send);
+  probe->offset = offset;
+  gst_pad_add_probe(
+      pad, GstPadProbeType(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM),
+      on_buffer_or_eos, probe, [](gpointer data) { delete static_cast<Probe*>(data); });
+}

@@ -57,7 +57,7 @@ def main():
 
     Gst.init(None)
     if args.file:
-        pipeline = Gst.parse_launch("filesrc name=src ! pfapparse ! appsink name=sink sync=true")
+        pipeline = Gst.parse_launch("filesrc name=src ! pfaptextparse ! appsink name=sink sync=true")
         pipeline.get_by_name("src").set_property("location", args.file)
     else:
         pipeline = Gst.parse_launch(

@@ -9,7 +9,7 @@ docs/security.md, "Floods").
 Each application/x-pfap buffer from appsink is read with GstPfap.Event (libgstpfap through
 GObject-Introspection), phoneme symbols named with the stream's alphabet. Send it something:
 
-    gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfapparse alphabet=x-pfap-arpabet ! \\
+    gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfaptextparse alphabet=x-pfap-arpabet ! \\
         rtppfappay ! udpsink host=127.0.0.1 port=5004
 
 It runs until Ctrl-C (or --idle-exit). From a build tree, point GI_TYPELIB_PATH and

@@ -4,7 +4,7 @@
 /**
  * SECTION:element-pfapface
  * @title: pfapface
- * @see_also: pfapparse, rtppfapdepay
+ * @see_also: pfaptextparse, rtppfapdepay
  *
  * Renders a phoneme / facial animation parameter (PFAP) stream as a talking head: an
  * application/x-pfap stream in, raw video out, one frame per frame time of the negotiated
@@ -36,11 +36,11 @@
  *
  * ## Example pipelines
  * |[
- * gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfapparse alphabet=x-pfap-arpabet ! pfapface ! videoconvert ! autovideosink
+ * gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfaptextparse alphabet=x-pfap-arpabet ! pfapface ! videoconvert ! autovideosink
  * ]| Shows a talking head saying "Hello there. How are you?" (drawn as fast as it can go,
  * the sink paces it).
  * |[
- * gst-launch-1.0 -e filesrc location=docs/examples/face.pfap ! pfapparse alphabet=x-pfap-arpabet ! pfapface style=line debug-overlay=true ! video/x-raw,width=320,height=240 ! videoconvert ! vp8enc deadline=1 ! webmmux ! filesink location=face.webm
+ * gst-launch-1.0 -e filesrc location=docs/examples/face.pfap ! pfaptextparse alphabet=x-pfap-arpabet ! pfapface style=line debug-overlay=true ! video/x-raw,width=320,height=240 ! videoconvert ! vp8enc deadline=1 ! webmmux ! filesink location=face.webm
  * ]| Renders the session to a 320x240 video file with the phoneme and active FAPs written on
  * each frame.
  */
@@ -352,14 +352,14 @@ static gboolean gst_pfap_face_sink_event(GstAggregator* agg, GstAggregatorPad* p
       reset(self);
       break;
     case GST_EVENT_SEGMENT: {
-      // Bytes (filesrc without pfapparse) have no times to draw at.
+      // Bytes (filesrc without pfaptextparse) have no times to draw at.
       const GstSegment* segment;
       gst_event_parse_segment(event, &segment);
       if (segment->format != GST_FORMAT_TIME) {
         self->stream->untimed_input = true;
         GST_ELEMENT_ERROR(self, STREAM, WRONG_TYPE,
                           ("The input is not a timed PFAP stream: read .pfap files through "
-                           "pfapparse (filesrc ! pfapparse ! pfapface)."),
+                           "pfaptextparse (filesrc ! pfaptextparse ! pfapface)."),
                           ("%s segment: x-pfap streams have TIME segments",
                            gst_format_get_name(segment->format)));
         gst_event_unref(event);

@@ -2,9 +2,9 @@
 // The example pipelines stay on one line, to be copied.
 // clang-format off
 /**
- * SECTION:element-fapparse
- * @title: fapparse
- * @see_also: pfapfapenc, pfapparse, rtppfappay, pfapface
+ * SECTION:element-pfapfapparse
+ * @title: pfapfapparse
+ * @see_also: pfapfapenc, pfaptextparse, rtppfappay, pfapface
  *
  * Reads an MPEG-4 FAP file (.fap, the FBA text format of Xface, Greta and other MPEG-4 face
  * players; docs/fap-files.md) and outputs its animation as application/x-pfap events, which
@@ -22,7 +22,7 @@
  * The output is a TIME segment from 0 with the first frame at 0; a sink with sync=true plays
  * the animation in real time. The caps carry `alphabet` (#GstFapParse:alphabet).
  *
- * With the request pad `speech` linked to a phoneme stream (pfaptts, pfapparse), the file's
+ * With the request pad `speech` linked to a phoneme stream (pfaptts, pfaptextparse), the file's
  * bookmarks go on the speech's phonemes instead (pfap::merge_with_speech): a phoneme that
  * spans a frame with changes is split there into pieces of the same symbol, and silence
  * phonemes carry only the frames where no one speaks. Both are timed from their segment's
@@ -39,13 +39,13 @@
  *
  * ## Example pipelines
  * |[
- * gst-launch-1.0 filesrc location=joy.fap ! fapparse ! pfapface ! videoconvert ! autovideosink
+ * gst-launch-1.0 filesrc location=joy.fap ! pfapfapparse ! pfapface ! videoconvert ! autovideosink
  * ]| Plays joy.fap on the pfapface face.
  * |[
- * gst-launch-1.0 filesrc location=joy.fap ! fapparse ! rtppfappay ! udpsink host=127.0.0.1 port=5004
+ * gst-launch-1.0 filesrc location=joy.fap ! pfapfapparse ! rtppfappay ! udpsink host=127.0.0.1 port=5004
  * ]| Sends joy.fap as PFAP RTP packets to port 5004, in real time.
  * |[
- * gst-launch-1.0 pfaptts text="Hello world." name=t t.pfap ! p.speech filesrc location=joy.fap ! fapparse name=p ! pfapface ! videoconvert ! autovideosink
+ * gst-launch-1.0 pfaptts text="Hello world." name=t t.pfap ! p.speech filesrc location=joy.fap ! pfapfapparse name=p ! pfapface ! videoconvert ! autovideosink
  * ]| Smiles joy.fap's smile on the phonemes of a spoken sentence.
  */
 // clang-format on
@@ -82,10 +82,7 @@ struct Stream {
   pfap::FapFileReader reader;
   std::optional<pfap::FapFileMarkup> markup;  // once the header is read
   pfap::NotCarried reported;                  // what was already warned about
-  std::string tail;                           // the start of a line whose end has not come yet
-  bool failed = false;                        // an error was posted: the rest is dropped
   std::vector<pfap::TextEvent> events;
-  std::string file;  // the upstream location, for messages; empty when unknown
 };
 
 // With a speech pad: both inputs kept until both have ended, then merged
@@ -131,7 +128,7 @@ static GstStaticPadTemplate src_template =
     GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
 
 G_DEFINE_TYPE(GstFapParse, gst_fap_parse, GST_TYPE_PFAP_BASE_PARSE)
-GST_ELEMENT_REGISTER_DEFINE(fapparse, "fapparse", GST_RANK_NONE, GST_TYPE_FAP_PARSE)
+GST_ELEMENT_REGISTER_DEFINE(pfapfapparse, "pfapfapparse", GST_RANK_NONE, GST_TYPE_FAP_PARSE)
 
 // Back to the start of a file (READY to PAUSED, FLUSH_STOP).
 static void gst_fap_parse_reset(GstPfapBaseParse* parse) {
@@ -149,20 +146,10 @@ static bool merging(GstFapParse* self) {
   return speech;
 }
 
-// The upstream file's name for messages, asked once: filesrc answers the URI query.
-static const std::string& file_name(GstFapParse* self) {
-  Stream& s = *self->stream;
-  if (!s.file.empty()) return s.file;
-  GstQuery* query = gst_query_new_uri();
-  gchar* uri = nullptr;
-  GstPad* sinkpad = gst_pfap_base_parse_sinkpad(GST_PFAP_BASE_PARSE(self));
-  if (gst_pad_peer_query(sinkpad, query)) gst_query_parse_uri(query, &uri);
-  gst_query_unref(query);
-  gchar* path = uri != nullptr ? g_filename_from_uri(uri, nullptr, nullptr) : nullptr;
-  s.file = path != nullptr ? path : uri != nullptr ? uri : "the FAP file";
-  g_free(path);
-  g_free(uri);
-  return s.file;
+// The upstream file's name for messages.
+static const char* file_name(GstFapParse* self) {
+  const std::string& source = gst_pfap_base_parse_source(GST_PFAP_BASE_PARSE(self));
+  return source.empty() ? "the FAP file" : source.c_str();
 }
 
 static GstCaps* gst_fap_parse_output_caps(GstPfapBaseParse* parse) {
@@ -182,12 +169,11 @@ static GstCaps* gst_fap_parse_output_caps(GstPfapBaseParse* parse) {
   return caps;
 }
 
+// A FAP file's frames depend on the lines before: there is nothing to skip to.
 static GstFlowReturn bad_file(GstFapParse* self, const pfap::FapFileResult& result) {
-  self->stream->failed = true;
-  GST_ELEMENT_ERROR(
-      self, STREAM, DECODE,
-      ("Bad FAP file %s, %s", file_name(self).c_str(), pfap::describe(result).c_str()),
-      ("docs/fap-files.md describes what is read"));
+  GST_ELEMENT_ERROR(self, STREAM, DECODE,
+                    ("Bad FAP file %s, %s", file_name(self), pfap::describe(result).c_str()),
+                    ("docs/fap-files.md describes what is read"));
   return GST_FLOW_ERROR;
 }
 
@@ -206,7 +192,7 @@ static void report_not_carried(GstFapParse* self, const pfap::FapFrame& frame) {
         self, STREAM, FORMAT,
         ("%s frame %u sets FAP 1 (viseme), which PFAP does not carry: visemes "
          "are phonemes here",
-         file_name(self).c_str(), frame.number),
+         file_name(self), frame.number),
         ("%" G_GUINT64_FORMAT " such frames so far (warned at the 1st, 2nd, 4th, ...)",
          now.visemes));
   }
@@ -214,13 +200,13 @@ static void report_not_carried(GstFapParse* self, const pfap::FapFrame& frame) {
     GST_ELEMENT_WARNING(self, STREAM, FORMAT,
                         ("%s frame %u sets FAP 2's init_face or expression_def, which PFAP does "
                          "not carry; its expressions are carried",
-                         file_name(self).c_str(), frame.number),
+                         file_name(self), frame.number),
                         ("%" G_GUINT64_FORMAT " such frames so far", now.expression_flags));
   }
   if (passed_warning(s.reported.rounded_values, now.rounded_values)) {
     GST_ELEMENT_WARNING(self, STREAM, FORMAT,
                         ("%s frame %u has values with a fraction, rounded to whole FAP units",
-                         file_name(self).c_str(), frame.number),
+                         file_name(self), frame.number),
                         ("%" G_GUINT64_FORMAT " such values so far", now.rounded_values));
   }
   s.reported = now;
@@ -347,61 +333,26 @@ static bool end_of_input(GstFapParse* self, bool file) {
   return true;
 }
 
-static GstFlowReturn read_line(GstFapParse* self, std::string_view line) {
-  Stream& s = *self->stream;
+static GstFlowReturn gst_fap_parse_read_line(GstPfapBaseParse* parse, std::string_view line) {
+  GstFapParse* self = GST_FAP_PARSE(parse);
   pfap::FapFrame frame;
   bool has_frame = false;
-  const pfap::FapFileResult result = s.reader.read_line(line, frame, has_frame);
+  const pfap::FapFileResult result = self->stream->reader.read_line(line, frame, has_frame);
   if (!result.ok()) return bad_file(self, result);
   return has_frame ? push_frame(self, frame) : GST_FLOW_OK;
 }
 
-// Splits `data` into lines, completing the tail kept from the chunks before.
-static GstFlowReturn gst_fap_parse_read_chunk(GstPfapBaseParse* parse, std::string_view data) {
+static GstFlowReturn gst_fap_parse_line_too_long(GstPfapBaseParse* parse) {
   GstFapParse* self = GST_FAP_PARSE(parse);
-  Stream& s = *self->stream;
-  if (s.failed) return GST_FLOW_ERROR;
-  while (!data.empty()) {
-    const size_t end = data.find('\n');
-    const std::string_view piece = data.substr(0, end);
-    // + 1: a '\r' the reader drops. The reader refuses the line; no need to keep it whole.
-    if (s.tail.size() + piece.size() > pfap::kMaxFapFileLineBytes + 1) {
-      return bad_file(self, {pfap::FapFileStatus::kLineTooLong, s.reader.line() + 1, 0, 0});
-    }
-    if (end == std::string_view::npos) {
-      s.tail.append(piece);
-      return GST_FLOW_OK;
-    }
-    GstFlowReturn ret;
-    if (s.tail.empty()) {
-      ret = read_line(self, piece);
-    } else {
-      s.tail.append(piece);
-      ret = read_line(self, s.tail);
-      s.tail.clear();
-    }
-    if (ret != GST_FLOW_OK) return ret;
-    data.remove_prefix(end + 1);
-  }
-  return GST_FLOW_OK;
+  return bad_file(self, {pfap::FapFileStatus::kLineTooLong, self->stream->reader.line() + 1, 0, 0});
 }
 
-// At EOS: the last line may have no line end; then the file must be whole. Merging, EOS goes
-// once the speech has ended too.
+// At EOS, after the last line: the file must be whole. Merging, EOS goes once the speech has
+// ended too.
 static GstFlowReturn gst_fap_parse_finish(GstPfapBaseParse* parse) {
   GstFapParse* self = GST_FAP_PARSE(parse);
-  Stream& s = *self->stream;
-  if (s.failed) return GST_FLOW_OK;
-  GstFlowReturn ret = GST_FLOW_OK;
-  if (!s.tail.empty()) {
-    ret = read_line(self, s.tail);
-    s.tail.clear();
-  }
-  if (ret == GST_FLOW_OK) {
-    const pfap::FapFileResult result = s.reader.finish();
-    if (!result.ok()) ret = bad_file(self, result);
-  }
-  if (ret == GST_FLOW_ERROR) return ret;
+  const pfap::FapFileResult result = self->stream->reader.finish();
+  if (!result.ok()) return bad_file(self, result);
   if (merging(self)) {
     end_of_input(self, true);
     return GST_PFAP_BASE_PARSE_FLOW_EOS_HELD;
@@ -555,7 +506,7 @@ static void gst_fap_parse_class_init(GstFapParseClass* klass) {
   GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
   GstPfapBaseParseClass* parse_class = GST_PFAP_BASE_PARSE_CLASS(klass);
 
-  GST_DEBUG_CATEGORY_INIT(fapparse_debug, "fapparse", 0, "MPEG-4 FAP file parser");
+  GST_DEBUG_CATEGORY_INIT(fapparse_debug, "pfapfapparse", 0, "MPEG-4 FAP file parser");
 
   gobject_class->set_property = gst_fap_parse_set_property;
   gobject_class->get_property = gst_fap_parse_get_property;
@@ -598,7 +549,9 @@ static void gst_fap_parse_class_init(GstFapParseClass* klass) {
       "Reads MPEG-4 facial animation parameter (.fap) files as application/x-pfap events",
       "gst-pfap developers");
 
-  parse_class->read_chunk = gst_fap_parse_read_chunk;
+  parse_class->max_line_bytes = pfap::kMaxFapFileLineBytes;
+  parse_class->read_line = gst_fap_parse_read_line;
+  parse_class->line_too_long = gst_fap_parse_line_too_long;
   parse_class->finish = gst_fap_parse_finish;
   parse_class->reset = gst_fap_parse_reset;
   parse_class->output_caps = gst_fap_parse_output_caps;

@@ -8,6 +8,6 @@ G_BEGIN_DECLS
 #define GST_TYPE_FAP_PARSE (gst_fap_parse_get_type())
 G_DECLARE_FINAL_TYPE(GstFapParse, gst_fap_parse, GST, FAP_PARSE, GstPfapBaseParse)
 
-GST_ELEMENT_REGISTER_DECLARE(fapparse);
+GST_ELEMENT_REGISTER_DECLARE(pfapfapparse);
 
 G_END_DECLS

@@ -4,14 +4,14 @@
 /**
  * SECTION:element-pfapfapenc
  * @title: pfapfapenc
- * @see_also: fapparse, pfaptextenc, rtppfapdepay
+ * @see_also: pfapfapparse, pfaptextenc, rtppfapdepay
  *
  * Writes a phoneme / facial animation parameter (PFAP) stream as an MPEG-4 FAP file (.fap,
  * version 2.1, the format Xface, Greta and other MPEG-4 face players read;
  * docs/fap-files.md): the receiver's FAP state, built from the application/x-pfap events as
  * pfapface builds it (phoneme FAPs at their start, recovered entries at their time, a
  * complete state replacing everything), sampled at #GstPfapFapEnc:frame-rate. Frame 0 is
- * stream time 0, as every writer's times count (docs/elements.md), so that fapparse's frames
+ * stream time 0, as every writer's times count (docs/elements.md), so that pfapfapparse's frames
  * come back as the same frames even when the first events are lost; a stream whose first
  * event comes later starts with neutral frames, the receiver's state until then. Frame k is k / frame rate seconds
  * after frame 0, rounded to the ms; the file ends with the last frame before the end of the
@@ -59,7 +59,8 @@ namespace {
 
 enum { PROP_0, PROP_FRAME_RATE, PROP_NAME, PROP_MAX_FRAMES };
 
-constexpr double kDefaultFrameRate = 25.0;
+constexpr int kDefaultFrameRateN = 25;  // frames a second, as a fraction
+constexpr int kDefaultFrameRateD = 1;
 constexpr const char* kDefaultName = "gst-pfap";
 // The file's text goes out in buffers of about this size.
 constexpr size_t kPieceBytes = 64 * 1024;
@@ -76,7 +77,8 @@ struct Stream {
 
 struct _GstPfapFapEnc {
   GstPfapBaseEnc parent;
-  gdouble frame_rate;  // under the object lock
+  gint frame_rate_n;   // under the object lock
+  gint frame_rate_d;   // under the object lock
   gchar* name;         // under the object lock
   guint max_frames;    // under the object lock
   Stream* stream;
@@ -103,7 +105,8 @@ static GstFlowReturn gst_pfap_fap_enc_handle_event(GstPfapBaseEnc* enc, GstBuffe
   Stream& s = *self->stream;
   if (!s.recorder) {
     GST_OBJECT_LOCK(self);
-    s.recorder.emplace(self->frame_rate, self->max_frames);
+    s.recorder.emplace(static_cast<double>(self->frame_rate_n) / self->frame_rate_d,
+                       self->max_frames);
     GST_OBJECT_UNLOCK(self);
   }
   // The recorder adds the frames of transitions still running at the end.
@@ -189,7 +192,8 @@ static void gst_pfap_fap_enc_set_property(GObject* object, guint prop_id, const 
   GST_OBJECT_LOCK(self);
   switch (prop_id) {
     case PROP_FRAME_RATE:
-      self->frame_rate = g_value_get_double(value);
+      self->frame_rate_n = gst_value_get_fraction_numerator(value);
+      self->frame_rate_d = gst_value_get_fraction_denominator(value);
       break;
     case PROP_NAME:
       g_free(self->name);
@@ -211,7 +215,7 @@ static void gst_pfap_fap_enc_get_property(GObject* object, guint prop_id, GValue
   GST_OBJECT_LOCK(self);
   switch (prop_id) {
     case PROP_FRAME_RATE:
-      g_value_set_double(value, self->frame_rate);
+      gst_value_set_fraction(value, self->frame_rate_n, self->frame_rate_d);
       break;
     case PROP_NAME:
       g_value_set_string(value, self->name);
@@ -246,15 +250,18 @@ static void gst_pfap_fap_enc_class_init(GstPfapFapEncClass* klass) {
   /**
    * GstPfapFapEnc:frame-rate:
    *
-   * Frames a second of the file: the FAP state is sampled at this rate. From 1 to 1000 (the
-   * draft's times are whole ms).
+   * Frames a second of the file: the FAP state is sampled at this rate. A fraction, as
+   * GStreamer's framerates are (`frame-rate=30000/1001`; `frame-rate=25` is 25/1), from 1 to
+   * 1000 (the draft's times are whole ms); the file's header holds it as a decimal number.
    */
   g_object_class_install_property(
       gobject_class, PROP_FRAME_RATE,
-      g_param_spec_double("frame-rate", "Frame rate", "Frames a second of the FAP file",
-                          pfap::kMinFapFileFrameRate, pfap::kMaxFapFileFrameRate, kDefaultFrameRate,
-                          static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
-                                                   GST_PARAM_MUTABLE_READY)));
+      gst_param_spec_fraction("frame-rate", "Frame rate", "Frames a second of the FAP file",
+                              static_cast<int>(pfap::kMinFapFileFrameRate), 1,
+                              static_cast<int>(pfap::kMaxFapFileFrameRate), 1, kDefaultFrameRateN,
+                              kDefaultFrameRateD,
+                              static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+                                                       GST_PARAM_MUTABLE_READY)));
 
   /**
    * GstPfapFapEnc:name-in-file:
@@ -272,7 +279,7 @@ static void gst_pfap_fap_enc_class_init(GstPfapFapEncClass* klass) {
   /**
    * GstPfapFapEnc:max-frames:
    *
-   * The most frames kept for the file (it is written at EOS): at most fapparse's limit,
+   * The most frames kept for the file (it is written at EOS): at most pfapfapparse's limit,
    * 360000 (4 hours at 25 frames a second).
    */
   g_object_class_install_property(
@@ -297,7 +304,8 @@ static void gst_pfap_fap_enc_class_init(GstPfapFapEncClass* klass) {
 
 static void gst_pfap_fap_enc_init(GstPfapFapEnc* self) {
   self->stream = new Stream{};
-  self->frame_rate = kDefaultFrameRate;
+  self->frame_rate_n = kDefaultFrameRateN;
+  self->frame_rate_d = kDefaultFrameRateD;
   self->name = g_strdup(kDefaultName);
   self->max_frames = pfap::kMaxFapFileFrames;
 }

@@ -30,10 +30,10 @@
  *
  * ## Example pipelines
  * |[
- * gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfapparse alphabet=x-pfap-arpabet ! pfapmarksenc format=polly ! filesink location=hello.marks
+ * gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfaptextparse alphabet=x-pfap-arpabet ! pfapmarksenc format=polly ! filesink location=hello.marks
  * ]| Writes hello.pfap as Polly speech marks.
  * |[
- * gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfapparse alphabet=x-pfap-arpabet ! pfapmarksenc format=arkit-csv frame-rate=60 ! filesink location=hello.csv
+ * gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfaptextparse alphabet=x-pfap-arpabet ! pfapmarksenc format=arkit-csv frame-rate=60 ! filesink location=hello.csv
  * ]| Writes ARKit blendshape weights at 60 frames per second.
  */
 // clang-format on
@@ -54,12 +54,13 @@ namespace {
 enum { PROP_0, PROP_FORMAT, PROP_FRAME_RATE };
 
 constexpr pfap::MarksFormat kDefaultFormat = pfap::MarksFormat::kPolly;
-constexpr int kDefaultFrameRate = 30;
+constexpr int kDefaultFrameRateN = 30;  // frames a second, as a fraction
+constexpr int kDefaultFrameRateD = 1;
 
 // What the streaming thread keeps between buffers, made at READY to PAUSED from the
 // properties. GObject runs no C++ constructors, so it lives behind a pointer.
 struct Stream {
-  Stream(pfap::MarksFormat format, int frame_rate) : writer(format, frame_rate) {}
+  Stream(pfap::MarksFormat format, int rate_n, int rate_d) : writer(format, rate_n, rate_d) {}
 
   pfap::MarksWriter writer;
   uint64_t unknown_warned = 0;  // unknown phonemes already counted in a warning
@@ -73,7 +74,8 @@ struct Stream {
 struct _GstPfapMarksEnc {
   GstPfapBaseEnc parent;
   pfap::MarksFormat format;  // under the object lock
-  int frame_rate;            // under the object lock
+  int frame_rate_n;          // under the object lock
+  int frame_rate_d;          // under the object lock
   Stream* stream;
 };
 
@@ -112,7 +114,8 @@ static void gst_pfap_marks_enc_reset(GstPfapBaseEnc* enc) {
   GstPfapMarksEnc* self = GST_PFAP_MARKS_ENC(enc);
   GST_OBJECT_LOCK(self);
   const pfap::MarksFormat format = self->format;
-  const int frame_rate = self->frame_rate;
+  const int rate_n = self->frame_rate_n;
+  const int rate_d = self->frame_rate_d;
   GST_OBJECT_UNLOCK(self);
   const pfap::PhonemeAlphabet* alphabet = nullptr;
   if (self->stream != nullptr) {
@@ -125,7 +128,7 @@ static void gst_pfap_marks_enc_reset(GstPfapBaseEnc* enc) {
     }
   }
   delete self->stream;
-  self->stream = new Stream(format, frame_rate);
+  self->stream = new Stream(format, rate_n, rate_d);
   self->stream->writer.set_alphabet(alphabet);
 }
 
@@ -172,7 +175,7 @@ static GstFlowReturn gst_pfap_marks_enc_handle_event(GstPfapBaseEnc* enc, GstBuf
                          "half-open mouth.",
                          unknown),
                         ("set the alphabet field of the input caps to a known alphabet, e.g. "
-                         "pfapparse alphabet=x-pfap-arpabet"));
+                         "pfaptextparse alphabet=x-pfap-arpabet"));
   }
   return s.flow;
 }
@@ -202,7 +205,8 @@ static void gst_pfap_marks_enc_set_property(GObject* object, guint prop_id, cons
       self->format = static_cast<pfap::MarksFormat>(g_value_get_enum(value));
       break;
     case PROP_FRAME_RATE:
-      self->frame_rate = g_value_get_int(value);
+      self->frame_rate_n = gst_value_get_fraction_numerator(value);
+      self->frame_rate_d = gst_value_get_fraction_denominator(value);
       break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
@@ -220,7 +224,7 @@ static void gst_pfap_marks_enc_get_property(GObject* object, guint prop_id, GVal
       g_value_set_enum(value, static_cast<int>(self->format));
       break;
     case PROP_FRAME_RATE:
-      g_value_set_int(value, self->frame_rate);
+      gst_value_set_fraction(value, self->frame_rate_n, self->frame_rate_d);
       break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
@@ -259,13 +263,15 @@ static void gst_pfap_marks_enc_class_init(GstPfapMarksEncClass* klass) {
   /**
    * GstPfapMarksEnc:frame-rate:
    *
-   * Frames per second of the arkit-json and arkit-csv formats; the other formats ignore it.
+   * Frames per second of the arkit-json and arkit-csv formats, a fraction as GStreamer's
+   * framerates are (`frame-rate=30000/1001`; `frame-rate=30` is 30/1); the other formats
+   * ignore it.
    */
   g_object_class_install_property(
       gobject_class, PROP_FRAME_RATE,
-      g_param_spec_int("frame-rate", "Frame rate",
-                       "Blendshape frames per second (arkit-json, arkit-csv)", 1, 240,
-                       kDefaultFrameRate, flags));
+      gst_param_spec_fraction("frame-rate", "Frame rate",
+                              "Blendshape frames per second (arkit-json, arkit-csv)", 1, 1, 240, 1,
+                              kDefaultFrameRateN, kDefaultFrameRateD, flags));
 
   gst_element_class_add_static_pad_template(element_class, &sink_template);
   gst_element_class_add_static_pad_template(element_class, &src_template);
@@ -284,7 +290,8 @@ static void gst_pfap_marks_enc_class_init(GstPfapMarksEncClass* klass) {
 
 static void gst_pfap_marks_enc_init(GstPfapMarksEnc* self) {
   self->format = kDefaultFormat;
-  self->frame_rate = kDefaultFrameRate;
+  self->frame_rate_n = kDefaultFrameRateN;
+  self->frame_rate_d = kDefaultFrameRateD;
   self->stream = nullptr;
   gst_pfap_marks_enc_reset(GST_PFAP_BASE_ENC(self));
 }

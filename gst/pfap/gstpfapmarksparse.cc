@@ -4,7 +4,7 @@
 /**
  * SECTION:element-pfapmarksparse
  * @title: pfapmarksparse
- * @see_also: pfapmarksenc, pfapparse, rtppfappay
+ * @see_also: pfapmarksenc, pfaptextparse, rtppfappay
  *
  * Reads the visemes of a TTS service or lip-sync tool and outputs them as application/x-pfap
  * phoneme events, so that a stream from a service we do not run becomes PFAP
@@ -24,9 +24,9 @@
  * viseme's time from the start of the input. The output is a TIME segment from 0.
  *
  * A bad line (not JSON, a missing field, an unknown viseme, time going back, more than 64 KiB)
- * is an error naming its line, its column (bytes, from 1) and what is wrong; with
- * #GstPfapMarksParse:skip-bad-lines it is a warning (rate-limited: the 1st, 2nd, 4th, ...) and
- * reading goes on. In a Rhubarb JSON document the bad item is a cue: skipped, every other cue
+ * is an error naming its line, its column (bytes, from 1), the file when upstream reads one,
+ * and what is wrong; with #GstPfapMarksParse:skip-bad-lines it is a warning (rate-limited: the
+ * 1st, 2nd, 4th, ...) and reading goes on. In a Rhubarb JSON document the bad item is a cue: skipped, every other cue
  * is kept (the time it held is a rest); a document past 16 MiB is one bad item. A UTF-8 byte
  * order mark at the start of the input is skipped.
  *
@@ -45,14 +45,11 @@
 
 #include "pfap/speech_marks.h"
 #include "markupbuffer.h"
-#include "ratelimit.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapmarksparse_debug);
 #define GST_CAT_DEFAULT pfapmarksparse_debug
 
 namespace {
-
-constexpr size_t kMaxLineBytes = 64 * 1024;
 
 enum { PROP_0, PROP_FORMAT, PROP_SKIP_BAD_LINES };
 
@@ -62,11 +59,9 @@ struct Stream {
   explicit Stream(pfap::MarksInput input) : reader(input) {}
 
   pfap::MarksReader reader;
-  std::string tail;       // a line whose end has not come yet, or a whole JSON document
-  uint64_t line = 1;      // the line being read, from 1
-  bool skipping = false;  // dropping the rest of an over-long line
-  bool started = false;   // the first non-blank byte has been seen
-  bool document = false;  // Rhubarb JSON: the input is kept whole until EOS
+  std::string text;        // Rhubarb JSON: the document so far
+  bool started = false;    // the first non-blank byte has been seen
+  bool document = false;   // Rhubarb JSON: the input is kept whole until EOS
   bool oversized = false;  // the document grew past its limit: one bad item, the rest dropped
   std::vector<pfap::TextEvent> events;
 };
@@ -76,7 +71,6 @@ struct Stream {
 struct _GstPfapMarksParse {
   GstPfapBaseParse parent;
   pfap::MarksInput format;  // under the object lock
-  gboolean skip_bad_lines;  // under the object lock
   Stream* stream;
 };
 
@@ -134,34 +128,12 @@ static GstFlowReturn push_events(GstPfapMarksParse* self) {
   return ret;
 }
 
-// An error, or with skip-bad-lines a rate-limited warning and reading goes on. `cue`: a cue
-// of a Rhubarb JSON document, not the whole document.
-static GstFlowReturn bad_input(GstPfapMarksParse* self, size_t column, const std::string& what,
-                               bool cue = false) {
-  GST_OBJECT_LOCK(self);
-  const bool skip = self->skip_bad_lines;
-  GST_OBJECT_UNLOCK(self);
-  Stream& s = *self->stream;
-  const char* kind = !s.document ? "line"
-                     : cue       ? "cue of Rhubarb JSON document"
-                                 : "Rhubarb JSON document";
-  const uint64_t line = s.document ? 1 : s.line;
-  if (skip) {
-    const guint64 bad_lines = gst_pfap_base_parse_count_bad_line(GST_PFAP_BASE_PARSE(self));
-    if (pfap_warn_at(bad_lines)) {
-      GST_ELEMENT_WARNING(self, STREAM, DECODE,
-                          ("Skipped %s %" G_GUINT64_FORMAT ", column %zu: %s (%" G_GUINT64_FORMAT
-                           " bad so far)",
-                           kind, line, column + 1, what.c_str(), bad_lines),
-                          (nullptr));
-    }
-    return GST_FLOW_OK;
-  }
-  GST_ELEMENT_ERROR(self, STREAM, DECODE,
-                    ("Bad %s %" G_GUINT64_FORMAT ", column %zu: %s", kind, line, column + 1,
-                     what.c_str()),
-                    ("set skip-bad-lines to warn and go on"));
-  return GST_FLOW_ERROR;
+// A bad part of a Rhubarb JSON document: `cue` one of its cues, else the whole document.
+static GstFlowReturn bad_document(GstPfapMarksParse* self, size_t column, const std::string& what,
+                                  bool cue = false) {
+  return gst_pfap_base_parse_bad_item(
+      GST_PFAP_BASE_PARSE(self), cue ? "cue of Rhubarb JSON document 1" : "Rhubarb JSON document 1",
+      column, what);
 }
 
 static std::string describe(const pfap::MarksResult& result) {
@@ -170,123 +142,95 @@ static std::string describe(const pfap::MarksResult& result) {
   return what;
 }
 
-static GstFlowReturn read_line(GstPfapMarksParse* self, std::string_view line) {
+static GstFlowReturn gst_pfap_marks_parse_read_line(GstPfapBaseParse* parse,
+                                                    std::string_view line) {
+  GstPfapMarksParse* self = GST_PFAP_MARKS_PARSE(parse);
   Stream& s = *self->stream;
-  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
   const pfap::MarksResult result = s.reader.read_line(line, s.events);
-  if (!result.ok()) return bad_input(self, result.column, describe(result));
+  if (!result.ok()) return gst_pfap_base_parse_bad_line(parse, result.column, describe(result));
   return push_events(self);
 }
 
+// Lines, but for a Rhubarb JSON document, which is kept whole to be read at EOS.
 static GstFlowReturn gst_pfap_marks_parse_read_chunk(GstPfapBaseParse* parse,
                                                      std::string_view data) {
   GstPfapMarksParse* self = GST_PFAP_MARKS_PARSE(parse);
   Stream& s = *self->stream;
   if (!s.started) {
     const size_t first = data.find_first_not_of(" \t\r\n");
-    if (first == std::string_view::npos) return GST_FLOW_OK;
+    // Blank lines still count (a document's are only white space before it).
+    if (first == std::string_view::npos) return gst_pfap_base_parse_read_lines(parse, data);
     s.started = true;
     s.document = data[first] == '{' && s.reader.alphabet() == pfap::kRhubarbShapeAlphabet;
   }
-  if (s.document) {
-    if (s.oversized) return GST_FLOW_OK;
-    if (s.tail.size() + data.size() > pfap::MarksReader::kMaxDocumentBytes) {
-      s.oversized = true;
-      s.tail.clear();
-      return bad_input(self, pfap::MarksReader::kMaxDocumentBytes, "larger than 16 MiB");
-    }
-    s.tail.append(data);
-    return GST_FLOW_OK;
+  if (!s.document) return gst_pfap_base_parse_read_lines(parse, data);
+  if (s.oversized) return GST_FLOW_OK;
+  if (s.text.size() + data.size() > pfap::MarksReader::kMaxDocumentBytes) {
+    s.oversized = true;
+    s.text.clear();
+    return bad_document(self, pfap::MarksReader::kMaxDocumentBytes, "larger than 16 MiB");
   }
-  while (!data.empty()) {
-    const size_t end = data.find('\n');
-    const std::string_view piece = data.substr(0, end);
-    GstFlowReturn ret = GST_FLOW_OK;
-    if (s.skipping) {
-      // Reported when it grew too long.
-    } else if (s.tail.size() + piece.size() > kMaxLineBytes) {
-      s.tail.clear();
-      s.skipping = true;
-      ret = bad_input(self, kMaxLineBytes, "longer than 65536 bytes");
-    } else if (end == std::string_view::npos) {
-      s.tail.append(piece);
-    } else if (s.tail.empty()) {
-      ret = read_line(self, piece);
-    } else {
-      s.tail.append(piece);
-      ret = read_line(self, s.tail);
-      s.tail.clear();
-    }
-    if (ret != GST_FLOW_OK || end == std::string_view::npos) return ret;
-    ++s.line;
-    s.skipping = false;
-    data.remove_prefix(end + 1);
-  }
+  s.text.append(data);
   return GST_FLOW_OK;
 }
 
-// At EOS: the last line, or the whole Rhubarb document, then the last viseme.
+// At EOS, after the last line: the whole Rhubarb document, or the last viseme.
 static GstFlowReturn gst_pfap_marks_parse_finish(GstPfapBaseParse* parse) {
   GstPfapMarksParse* self = GST_PFAP_MARKS_PARSE(parse);
   Stream& s = *self->stream;
-  GstFlowReturn ret = GST_FLOW_OK;
-  if (s.document && !s.oversized) {
-    GST_OBJECT_LOCK(self);
-    const bool skip = self->skip_bad_lines;
-    GST_OBJECT_UNLOCK(self);
-    // A bad cue is skipped with a warning, or stops the document after the cues before it.
-    const pfap::MarksResult result =
-        s.reader.read_document(s.tail, s.events, [&](const pfap::MarksResult& bad) {
-          if (skip) bad_input(self, bad.column, describe(bad), true);
-          return skip;
-        });
-    ret = push_events(self);
-    if (!result.ok() && ret == GST_FLOW_OK) ret = bad_input(self, result.column, describe(result));
-  } else if (!s.document) {
-    if (!s.skipping && !s.tail.empty()) ret = read_line(self, s.tail);
-    if (ret == GST_FLOW_OK) {
-      s.reader.finish(s.events);
-      ret = push_events(self);
-    }
+  if (!s.document) {
+    s.reader.finish(s.events);
+    return push_events(self);
   }
-  s.tail.clear();
+  if (s.oversized) return GST_FLOW_OK;
+  const bool skip = gst_pfap_base_parse_skips_bad_lines(parse);
+  // A bad cue is skipped with a warning, or stops the document after the cues before it.
+  const pfap::MarksResult result =
+      s.reader.read_document(s.text, s.events, [&](const pfap::MarksResult& bad) {
+        if (skip) bad_document(self, bad.column, describe(bad), true);
+        return skip;
+      });
+  s.text.clear();
+  const GstFlowReturn ret = push_events(self);
+  if (!result.ok() && ret == GST_FLOW_OK)
+    return bad_document(self, result.column, describe(result));
   return ret;
 }
 
-static void gst_pfap_marks_parse_set_property(GObject* object, guint prop_id,
-                                              const GValue* value, GParamSpec* pspec) {
+static void gst_pfap_marks_parse_set_property(GObject* object, guint prop_id, const GValue* value,
+                                              GParamSpec* pspec) {
   GstPfapMarksParse* self = GST_PFAP_MARKS_PARSE(object);
-  GST_OBJECT_LOCK(self);
   switch (prop_id) {
     case PROP_FORMAT:
+      GST_OBJECT_LOCK(self);
       self->format = static_cast<pfap::MarksInput>(g_value_get_enum(value));
+      GST_OBJECT_UNLOCK(self);
       break;
     case PROP_SKIP_BAD_LINES:
-      self->skip_bad_lines = g_value_get_boolean(value);
+      gst_pfap_base_parse_set_skip_bad_lines(GST_PFAP_BASE_PARSE(self), g_value_get_boolean(value));
       break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
       break;
   }
-  GST_OBJECT_UNLOCK(self);
 }
 
 static void gst_pfap_marks_parse_get_property(GObject* object, guint prop_id, GValue* value,
                                               GParamSpec* pspec) {
   GstPfapMarksParse* self = GST_PFAP_MARKS_PARSE(object);
-  GST_OBJECT_LOCK(self);
   switch (prop_id) {
     case PROP_FORMAT:
+      GST_OBJECT_LOCK(self);
       g_value_set_enum(value, static_cast<int>(self->format));
+      GST_OBJECT_UNLOCK(self);
       break;
     case PROP_SKIP_BAD_LINES:
-      g_value_set_boolean(value, self->skip_bad_lines);
+      g_value_set_boolean(value, gst_pfap_base_parse_skips_bad_lines(GST_PFAP_BASE_PARSE(self)));
       break;
     default:
       G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
       break;
   }
-  GST_OBJECT_UNLOCK(self);
 }
 
 static void gst_pfap_marks_parse_finalize(GObject* object) {
@@ -322,12 +266,8 @@ static void gst_pfap_marks_parse_class_init(GstPfapMarksParseClass* klass) {
    * FALSE (the default): a bad line is an error that stops the stream; TRUE: a warning, the
    * line is dropped and reading goes on.
    */
-  g_object_class_install_property(
-      gobject_class, PROP_SKIP_BAD_LINES,
-      g_param_spec_boolean("skip-bad-lines", "Skip bad lines",
-                           "Warn about a bad line and go on, instead of an error", FALSE,
-                           static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
-                                                    GST_PARAM_MUTABLE_PLAYING)));
+  g_object_class_install_property(gobject_class, PROP_SKIP_BAD_LINES,
+                                  gst_pfap_base_parse_skip_bad_lines_spec());
 
   gst_element_class_add_static_pad_template(element_class, &sink_template);
   gst_element_class_add_static_pad_template(element_class, &src_template);
@@ -337,6 +277,7 @@ static void gst_pfap_marks_parse_class_init(GstPfapMarksParseClass* klass) {
       "application/x-pfap viseme events",
       "gst-pfap developers");
 
+  parse_class->read_line = gst_pfap_marks_parse_read_line;
   parse_class->read_chunk = gst_pfap_marks_parse_read_chunk;
   parse_class->finish = gst_pfap_marks_parse_finish;
   parse_class->reset = gst_pfap_marks_parse_reset;
@@ -346,7 +287,6 @@ static void gst_pfap_marks_parse_class_init(GstPfapMarksParseClass* klass) {
 
 static void gst_pfap_marks_parse_init(GstPfapMarksParse* self) {
   self->format = kDefaultFormat;
-  self->skip_bad_lines = FALSE;
   self->stream = nullptr;
   gst_pfap_marks_parse_reset(GST_PFAP_BASE_PARSE(self));
 }

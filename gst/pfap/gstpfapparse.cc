@@ -2,8 +2,8 @@
 // The example pipelines stay on one line, to be copied.
 // clang-format off
 /**
- * SECTION:element-pfapparse
- * @title: pfapparse
+ * SECTION:element-pfaptextparse
+ * @title: pfaptextparse
  * @see_also: pfaptextenc, rtppfappay
  *
  * Reads the .pfap text format (docs/text-format.md: UTF-8, one phoneme or FAP state event per
@@ -20,10 +20,11 @@
  * lines give nothing.
  *
  * A bad line (a field that does not parse, time going back, bad bookmarks, invalid UTF-8,
- * more than 65536 bytes, or a time past about 292 years) is an
- * error naming its line, its column (in bytes, from 1) and what is wrong; with
- * #GstPfapParse:skip-bad-lines it is a warning instead (at the 1st, 2nd, 4th, ... bad line,
- * all counted in the stats property's bad-lines), and the lines after it are read as usual. Input
+ * more than 65536 bytes without its line end, or a time past about 292 years) is an error
+ * naming its line, its column (in bytes, from 1) and what is wrong, and nothing after it is
+ * read; with #GstPfapParse:skip-bad-lines it is a warning instead (at the 1st, 2nd, 4th, ...
+ * bad line, all counted in the stats property's bad-lines), and the lines after it are read
+ * as usual. Input
  * that arrives from sources without caps (filesrc, fdsrc) is taken as .pfap text; caps, when
  * given, must be text/x-pfap (the typefinder's, for decodebin) or text/x-raw,format=utf8.
  *
@@ -33,16 +34,15 @@
  *
  * ## Example pipelines
  * |[
- * gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfapparse ! rtppfappay ! udpsink host=127.0.0.1 port=5004
+ * gst-launch-1.0 filesrc location=docs/examples/hello.pfap ! pfaptextparse ! rtppfappay ! udpsink host=127.0.0.1 port=5004
  * ]| Sends the phonemes and FAPs of hello.pfap as PFAP RTP packets to port 5004, in real time.
  * |[
- * cat docs/examples/hello.pfap | gst-launch-1.0 fdsrc ! pfapparse skip-bad-lines=true ! fakesink dump=true
+ * cat docs/examples/hello.pfap | gst-launch-1.0 fdsrc ! pfaptextparse skip-bad-lines=true ! fakesink dump=true
  * ]| Reads .pfap text from standard input, warns about bad lines and dumps each event.
  */
 // clang-format on
 #include "gstpfapparse.h"
 
-#include <cstdint>
 #include <string>
 #include <string_view>
 
@@ -50,35 +50,22 @@
 #include "pfap/text.h"
 #include "gstpfaptypefind.h"
 #include "markupbuffer.h"
-#include "ratelimit.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapparse_debug);
 #define GST_CAT_DEFAULT pfapparse_debug
 
 namespace {
 
-// Far above any real line (a state listing every FAP is about 2 KiB); bounds the memory a
-// stream without line ends takes, and the FAPs of one event to what x-pfap holds.
-constexpr size_t kMaxLineBytes = 64 * 1024;
-
 enum { PROP_0, PROP_SKIP_BAD_LINES, PROP_ALPHABET, PROP_BAD_LINES };
-
-// What the streaming thread keeps between buffers. GObject runs no C++ constructors, so it
-// lives behind a pointer made in init and deleted in finalize.
-struct Stream {
-  pfap::TextReader reader;
-  std::string tail;       // the start of a line whose end has not come yet
-  uint64_t line = 1;      // the number of the line being read, from 1
-  bool skipping = false;  // dropping the rest of an over-long line
-};
 
 }  // namespace
 
 struct _GstPfapParse {
   GstPfapBaseParse parent;
-  gboolean skip_bad_lines;  // under the object lock
-  gchar* alphabet;          // under the object lock; NULL when unset
-  Stream* stream;
+  gchar* alphabet;  // under the object lock; NULL when unset
+  // The streaming thread's. GObject runs no C++ constructors, so it lives behind a pointer
+  // made in init and deleted in finalize.
+  pfap::TextReader* reader;
 };
 
 // No caps from filesrc and fdsrc: the template only matters to sources that send caps.
@@ -93,11 +80,11 @@ static GstStaticPadTemplate src_template =
 
 G_DEFINE_TYPE(GstPfapParse, gst_pfap_parse, GST_TYPE_PFAP_BASE_PARSE)
 // A rank, so that decodebin plugs it for text/x-pfap (gst-play-1.0 file.pfap).
-GST_ELEMENT_REGISTER_DEFINE(pfapparse, "pfapparse", GST_RANK_SECONDARY, GST_TYPE_PFAP_PARSE)
+GST_ELEMENT_REGISTER_DEFINE(pfaptextparse, "pfaptextparse", GST_RANK_SECONDARY, GST_TYPE_PFAP_PARSE)
 
 // Back to the start of a stream (READY to PAUSED, FLUSH_STOP).
 static void gst_pfap_parse_reset(GstPfapBaseParse* parse) {
-  *GST_PFAP_PARSE(parse)->stream = Stream{};
+  GST_PFAP_PARSE(parse)->reader->reset();
 }
 
 static GstCaps* gst_pfap_parse_output_caps(GstPfapBaseParse* parse) {
@@ -112,121 +99,23 @@ static GstCaps* gst_pfap_parse_output_caps(GstPfapBaseParse* parse) {
   return caps;
 }
 
-// Where the text comes from, for messages: ` of file "PATH"` when upstream reads a file
-// (filesrc answers the URI query), ` of "URI"` for another URI, else nothing (appsrc, fdsrc).
-static std::string source_name(GstPfapParse* self) {
-  std::string name;
-  GstQuery* query = gst_query_new_uri();
-  gchar* uri = nullptr;
-  GstPad* sinkpad = gst_pfap_base_parse_sinkpad(GST_PFAP_BASE_PARSE(self));
-  if (gst_pad_peer_query(sinkpad, query)) gst_query_parse_uri(query, &uri);
-  gst_query_unref(query);
-  if (uri == nullptr) return name;
-  if (gchar* path = g_filename_from_uri(uri, nullptr, nullptr)) {
-    gchar* display = g_filename_display_name(path);
-    name = std::string(" of file \"") + display + "\"";
-    g_free(display);
-    g_free(path);
-  } else {
-    name = std::string(" of \"") + uri + "\"";
-  }
-  g_free(uri);
-  return name;
-}
-
-// A line that cannot be read: an error, or with skip-bad-lines a warning and reading goes on.
-// `column` is a byte offset in the line.
-static GstFlowReturn bad_line(GstPfapParse* self, size_t column, const std::string& what) {
-  GST_OBJECT_LOCK(self);
-  const bool skip = self->skip_bad_lines;
-  GST_OBJECT_UNLOCK(self);
-  const uint64_t line = self->stream->line;
-  const std::string source = source_name(self);
-  if (skip) {
-    const guint64 count = gst_pfap_base_parse_count_bad_line(GST_PFAP_BASE_PARSE(self));
-    GST_DEBUG_OBJECT(self, "skipped line %" G_GUINT64_FORMAT ", column %zu%s: %s", line,
-                     column + 1, source.c_str(), what.c_str());
-    // Random bytes are a bad line every few hundred bytes: warn at the 1st, 2nd, 4th, ...
-    if (pfap_warn_at(count)) {
-      GST_ELEMENT_WARNING(self, STREAM, DECODE,
-                          ("Skipped .pfap line %" G_GUINT64_FORMAT ", column %zu%s: %s", line,
-                           column + 1, source.c_str(), what.c_str()),
-                          ("%" G_GUINT64_FORMAT
-                           " bad lines skipped so far (warned at the 1st, 2nd, 4th, 8th, ...; "
-                           "the stats property's bad-lines counts them)",
-                           count));
-    }
-    return GST_FLOW_OK;
-  }
-  GST_ELEMENT_ERROR(self, STREAM, DECODE,
-                    ("Bad .pfap line %" G_GUINT64_FORMAT ", column %zu%s: %s", line, column + 1,
-                     source.c_str(), what.c_str()),
-                    ("set skip-bad-lines to warn and go on"));
-  return GST_FLOW_ERROR;
-}
-
-// Reads one whole line, without its '\n' (TextReader drops the '\r' of a "\r\n").
-static GstFlowReturn read_line(GstPfapParse* self, std::string_view line) {
+static GstFlowReturn gst_pfap_parse_read_line(GstPfapBaseParse* parse, std::string_view line) {
   const gchar* valid_end = nullptr;
   if (!g_utf8_validate(line.data(), static_cast<gssize>(line.size()), &valid_end)) {
-    return bad_line(self, static_cast<size_t>(valid_end - line.data()), "not UTF-8");
+    return gst_pfap_base_parse_bad_line(parse, static_cast<size_t>(valid_end - line.data()),
+                                        "not UTF-8");
   }
   pfap::TextEvent event;
   bool has_event = false;
-  const pfap::TextResult result = self->stream->reader.read_line(line, event, has_event);
+  const pfap::TextResult result = GST_PFAP_PARSE(parse)->reader->read_line(line, event, has_event);
   if (!result.ok()) {
     std::string what = pfap::to_string(result.status);
     if (result.status == pfap::TextStatus::kBadBookmark) {
       what.append(": ").append(pfap::to_string(result.bookmark));
     }
-    return bad_line(self, result.column, what);
+    return gst_pfap_base_parse_bad_line(parse, result.column, what);
   }
-  if (!has_event) return GST_FLOW_OK;
-  GST_LOG_OBJECT(self, "line %" G_GUINT64_FORMAT, self->stream->line);
-  return gst_pfap_base_parse_push(GST_PFAP_BASE_PARSE(self), event);
-}
-
-// Splits `data` into lines, completing the tail kept from the chunks before and keeping the
-// new incomplete one.
-static GstFlowReturn gst_pfap_parse_read_chunk(GstPfapBaseParse* parse, std::string_view data) {
-  GstPfapParse* self = GST_PFAP_PARSE(parse);
-  Stream& s = *self->stream;
-  while (!data.empty()) {
-    const size_t end = data.find('\n');
-    const std::string_view piece = data.substr(0, end);
-    GstFlowReturn ret = GST_FLOW_OK;
-    if (s.skipping) {
-      // Nothing: the line was reported when it grew too long.
-    } else if (s.tail.size() + piece.size() > kMaxLineBytes) {
-      s.tail.clear();
-      s.skipping = true;
-      ret =
-          bad_line(self, kMaxLineBytes, "longer than " + std::to_string(kMaxLineBytes) + " bytes");
-    } else if (end == std::string_view::npos) {
-      s.tail.append(piece);
-    } else if (s.tail.empty()) {
-      ret = read_line(self, piece);  // whole in this chunk: no copy
-    } else {
-      s.tail.append(piece);
-      ret = read_line(self, s.tail);
-      s.tail.clear();
-    }
-    if (ret != GST_FLOW_OK || end == std::string_view::npos) return ret;
-    ++s.line;
-    s.skipping = false;
-    data.remove_prefix(end + 1);
-  }
-  return GST_FLOW_OK;
-}
-
-// At EOS: the last line may have no line end.
-static GstFlowReturn gst_pfap_parse_finish(GstPfapBaseParse* parse) {
-  GstPfapParse* self = GST_PFAP_PARSE(parse);
-  Stream& s = *self->stream;
-  GstFlowReturn ret = GST_FLOW_OK;
-  if (!s.skipping && !s.tail.empty()) ret = read_line(self, s.tail);
-  s.tail.clear();
-  return ret;
+  return has_event ? gst_pfap_base_parse_push(parse, event) : GST_FLOW_OK;
 }
 
 static void gst_pfap_parse_set_property(GObject* object, guint prop_id, const GValue* value,
@@ -234,9 +123,7 @@ static void gst_pfap_parse_set_property(GObject* object, guint prop_id, const GV
   GstPfapParse* self = GST_PFAP_PARSE(object);
   switch (prop_id) {
     case PROP_SKIP_BAD_LINES:
-      GST_OBJECT_LOCK(self);
-      self->skip_bad_lines = g_value_get_boolean(value);
-      GST_OBJECT_UNLOCK(self);
+      gst_pfap_base_parse_set_skip_bad_lines(GST_PFAP_BASE_PARSE(self), g_value_get_boolean(value));
       break;
     case PROP_ALPHABET:
       GST_OBJECT_LOCK(self);
@@ -255,9 +142,7 @@ static void gst_pfap_parse_get_property(GObject* object, guint prop_id, GValue* 
   GstPfapParse* self = GST_PFAP_PARSE(object);
   switch (prop_id) {
     case PROP_SKIP_BAD_LINES:
-      GST_OBJECT_LOCK(self);
-      g_value_set_boolean(value, self->skip_bad_lines);
-      GST_OBJECT_UNLOCK(self);
+      g_value_set_boolean(value, gst_pfap_base_parse_skips_bad_lines(GST_PFAP_BASE_PARSE(self)));
       break;
     case PROP_ALPHABET:
       GST_OBJECT_LOCK(self);
@@ -274,7 +159,7 @@ static void gst_pfap_parse_get_property(GObject* object, guint prop_id, GValue* 
 }
 
 static void gst_pfap_parse_finalize(GObject* object) {
-  delete GST_PFAP_PARSE(object)->stream;
+  delete GST_PFAP_PARSE(object)->reader;
   g_free(GST_PFAP_PARSE(object)->alphabet);
   G_OBJECT_CLASS(gst_pfap_parse_parent_class)->finalize(object);
 }
@@ -284,7 +169,7 @@ static void gst_pfap_parse_class_init(GstPfapParseClass* klass) {
   GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
   GstPfapBaseParseClass* parse_class = GST_PFAP_BASE_PARSE_CLASS(klass);
 
-  GST_DEBUG_CATEGORY_INIT(pfapparse_debug, "pfapparse", 0, "PFAP text parser");
+  GST_DEBUG_CATEGORY_INIT(pfapparse_debug, "pfaptextparse", 0, "PFAP text parser");
 
   gobject_class->set_property = gst_pfap_parse_set_property;
   gobject_class->get_property = gst_pfap_parse_get_property;
@@ -297,12 +182,8 @@ static void gst_pfap_parse_class_init(GstPfapParseClass* klass) {
    * posts a warning naming the line and what is wrong with it (at the 1st, 2nd, 4th, 8th,
    * ... bad line only), drops the line and reads on.
    */
-  g_object_class_install_property(
-      gobject_class, PROP_SKIP_BAD_LINES,
-      g_param_spec_boolean("skip-bad-lines", "Skip bad lines",
-                           "Warn about a bad line and go on, instead of an error", FALSE,
-                           static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
-                                                    GST_PARAM_MUTABLE_PLAYING)));
+  g_object_class_install_property(gobject_class, PROP_SKIP_BAD_LINES,
+                                  gst_pfap_base_parse_skip_bad_lines_spec());
 
   /**
    * GstPfapParse:alphabet:
@@ -345,14 +226,13 @@ static void gst_pfap_parse_class_init(GstPfapParseClass* klass) {
       "application/x-pfap events",
       "gst-pfap developers");
 
-  parse_class->read_chunk = gst_pfap_parse_read_chunk;
-  parse_class->finish = gst_pfap_parse_finish;
+  parse_class->line_name = ".pfap line";
+  parse_class->read_line = gst_pfap_parse_read_line;
   parse_class->reset = gst_pfap_parse_reset;
   parse_class->output_caps = gst_pfap_parse_output_caps;
 }
 
 static void gst_pfap_parse_init(GstPfapParse* self) {
-  self->skip_bad_lines = FALSE;
   self->alphabet = nullptr;
-  self->stream = new Stream{};
+  self->reader = new pfap::TextReader{};
 }

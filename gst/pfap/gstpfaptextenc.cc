@@ -4,15 +4,15 @@
 /**
  * SECTION:element-pfaptextenc
  * @title: pfaptextenc
- * @see_also: pfapparse, rtppfapdepay
+ * @see_also: pfaptextparse, rtppfapdepay
  *
  * Writes a phoneme / facial animation parameter (PFAP) stream as .pfap text, the format
- * pfapparse reads (pfap/text.h): each application/x-pfap buffer becomes one output buffer
+ * pfaptextparse reads (pfap/text.h): each application/x-pfap buffer becomes one output buffer
  * holding its canonical line and a newline, with the input's PTS and duration. Written to a
- * file, the lines read back with pfapparse as the same phonemes, FAPs and state events.
+ * file, the lines read back with pfaptextparse as the same phonemes, FAPs and state events.
  *
  * A line's time is the event's stream time, in ms rounded to the nearest: a file read by
- * pfapparse and written again keeps its times, and a received stream's times count from the
+ * pfaptextparse and written again keeps its times, and a received stream's times count from the
  * receiver's segment start (docs/elements.md, "Times in the files written").
  *
  * An event without a PTS starts where the previous one ended (a phoneme lasts its duration,
@@ -31,7 +31,7 @@
  * |[
  * gst-launch-1.0 udpsrc port=5004 caps="application/x-rtp,media=application,clock-rate=44100,encoding-name=PFAP" ! rtpjitterbuffer ! rtppfapdepay ! pfaptextenc ! filesink location=received.pfap
  * ]| Receives a PFAP stream on UDP port 5004 and writes it to received.pfap, which
- * `filesrc location=received.pfap ! pfapparse` reads back.
+ * `filesrc location=received.pfap ! pfaptextparse` reads back.
  */
 // clang-format on
 #include "gstpfaptextenc.h"
@@ -80,7 +80,7 @@ static GstFlowReturn gst_pfap_text_enc_handle_event(GstPfapBaseEnc* enc, GstBuff
   s.text.time_ms = (time_ns + pfap::kNsPerMs / 2) / pfap::kNsPerMs;
   s.line.clear();
   pfap::format_text_line(s.text, s.line);
-  // The format has no flag for it; a comment tells the reader and pfapparse skips it.
+  // The format has no flag for it; a comment tells the reader and pfaptextparse skips it.
   if (s.text.event.uncertain) s.line += " # uncertain";
   GST_LOG_OBJECT(self, "%s", s.line.c_str());
   s.line += '\n';

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // The typefinder of .pfap text: decodebin (playbin, gst-play-1.0 file.pfap) learns from it
-// that a file is .pfap text, text/x-pfap, and plugs pfapparse for it. The rule of what reads
+// that a file is .pfap text, text/x-pfap, and plugs pfaptextparse for it. The rule of what reads
 // as .pfap is pfap::count_text_events (lib/src/text.cc).
 #include "gstpfaptypefind.h"
 

@@ -6,7 +6,7 @@
 G_BEGIN_DECLS
 
 // The media type of .pfap text (docs/text-format.md), found by the typefinder "pfap" and read
-// by pfapparse.
+// by pfaptextparse.
 #define PFAP_TEXT_CAPS "text/x-pfap"
 
 GST_TYPE_FIND_REGISTER_DECLARE(pfap);

@@ -335,6 +335,70 @@ static pfap::DecodeResult decode(GstRtpPfapDepay* self, GstRTPBuffer* rtp, size_
   return pfap::decode_payload({payload, size}, self->stream->packet);
 }
 
+// The packet through the stream's receiver. A new SSRC is a new sender, or one restarted:
+// its sequence numbers and FAP state owe nothing to the last one's.
+static pfap::ReceiveResult receive(GstRtpPfapDepay* self, guint32 ssrc, guint16 seqnum,
+                                   GstClockTime packet_pts) {
+  Stream& stream = *self->stream;
+  if (stream.ssrc != ssrc) {
+    GST_DEBUG_OBJECT(self, "new stream, SSRC %08x", ssrc);
+    stream.receiver.reset(/*joined_mid_stream=*/true);
+    stream.ssrc = ssrc;
+  }
+  return stream.receiver.receive(
+      stream.packet, seqnum,
+      GST_CLOCK_TIME_IS_VALID(packet_pts) ? static_cast<int64_t>(packet_pts) : 0);
+}
+
+// Counts a received packet, in one update of the stats.
+static void count_received(GstRtpPfapDepay* self, const pfap::ReceiveResult& r, bool recovered,
+                           bool complete_changed) {
+  const pfap::Packet& packet = self->stream->packet;
+  update_stats(self, [&](Stats& s) {
+    ++s.packets;
+    s.phonemes += packet.phonemes.size();
+    s.faps += packet.faps.size();
+    s.lost += r.lost;
+    s.gaps += r.lost > 0;
+    s.recovered += recovered;
+    s.faps_recovered += recovered ? packet.recovery.size() : 0;
+    s.complete_states += r.recovery == pfap::ReceiveResult::Recovery::kComplete;
+    s.complete_changes += complete_changed;
+  });
+}
+
+// Pushes the decoded packet's events: the state event of `state_kind` (if any) first, before
+// the phonemes and the one that carries the DISCONT after a gap, then each phoneme, the first
+// a sentence start if the RTP marker is set. A lone buffer (every packet at max-delay=0) is
+// pushed without a list, which would cost an allocation and the base class's walk over it;
+// nothing at all when there is no loss to repair, no change and no phoneme.
+static void push_events(GstRtpPfapDepay* self, std::optional<PfapEventKind> state_kind,
+                        bool uncertain, bool marker, GstClockTime packet_pts) {
+  const pfap::Packet& packet = self->stream->packet;
+  const size_t n_out = packet.phonemes.size() + (state_kind ? 1 : 0);
+  GstBufferList* list = n_out > 1 ? gst_buffer_list_new_sized(static_cast<guint>(n_out)) : nullptr;
+  GstBuffer* lone = nullptr;
+  auto output = [&](GstBuffer* buffer) {
+    if (list != nullptr) {
+      gst_buffer_list_add(list, buffer);
+    } else {
+      lone = buffer;
+    }
+  };
+  if (state_kind) output(state_buffer(self, *state_kind, uncertain, packet_pts));
+  packet.for_each_phoneme(0, [&](size_t i, int64_t offset_ns) {
+    const GstClockTime pts =
+        GST_CLOCK_TIME_IS_VALID(packet_pts) ? packet_pts + offset_ns : GST_CLOCK_TIME_NONE;
+    output(phoneme_buffer(self, i, i == 0 && marker, uncertain, pts));
+  });
+  GstRTPBaseDepayload* depay = GST_RTP_BASE_DEPAYLOAD(self);
+  if (list != nullptr) {
+    gst_rtp_base_depayload_push_list(depay, list);
+  } else if (lone != nullptr) {
+    gst_rtp_base_depayload_push(depay, lone);
+  }
+}
+
 static GstBuffer* gst_rtp_pfap_depay_process_rtp_packet(GstRTPBaseDepayload* depay,
                                                         GstRTPBuffer* rtp) {
   GstRtpPfapDepay* self = GST_RTP_PFAP_DEPAY(depay);
@@ -351,72 +415,25 @@ static GstBuffer* gst_rtp_pfap_depay_process_rtp_packet(GstRTPBaseDepayload* dep
     return nullptr;
   }
 
-  // A new SSRC is a new sender, or one restarted: its sequence numbers and FAP state owe
-  // nothing to the last one's.
-  const guint32 ssrc = gst_rtp_buffer_get_ssrc(rtp);
-  if (self->stream->ssrc != ssrc) {
-    GST_DEBUG_OBJECT(self, "new stream, SSRC %08x", ssrc);
-    self->stream->receiver.reset(/*joined_mid_stream=*/true);
-    self->stream->ssrc = ssrc;
-  }
-  const pfap::Packet& packet = self->stream->packet;
   // The base class derives no time from the RTP timestamp: the PTS comes from upstream
   // (rtpjitterbuffer), and DISCONT after a gap is set on our first buffer by the base class.
   // A source that gives only a DTS (pcapparse) means the packet's time by it.
   const GstClockTime packet_pts = GST_BUFFER_PTS_IS_VALID(rtp->buffer)
                                       ? GST_BUFFER_PTS(rtp->buffer)
                                       : GST_BUFFER_DTS(rtp->buffer);
-  const pfap::ReceiveResult r = self->stream->receiver.receive(
-      packet, seqnum, GST_CLOCK_TIME_IS_VALID(packet_pts) ? static_cast<int64_t>(packet_pts) : 0);
-  const bool uncertain = !r.state_whole;
+  const pfap::ReceiveResult r = receive(self, gst_rtp_buffer_get_ssrc(rtp), seqnum, packet_pts);
 
   using Recovery = pfap::ReceiveResult::Recovery;
   const bool recovered = r.recovery == Recovery::kRecovered;
   // An unchanged complete state changes nothing downstream; left out, a stream without loss
   // comes out as it was sent.
   const bool complete_changed = r.recovery == Recovery::kComplete && r.changed;
-  // The state event goes first: before the phonemes, and the one that carries the DISCONT
-  // after a gap. A lone buffer (every packet at max-delay=0) is pushed without a list, which
-  // would cost an allocation and the base class's walk over it.
-  const bool state_event = recovered || complete_changed;
-  const size_t n_out = packet.phonemes.size() + (state_event ? 1 : 0);
-  GstBufferList* list = n_out > 1 ? gst_buffer_list_new_sized(static_cast<guint>(n_out)) : nullptr;
-  GstBuffer* lone = nullptr;
-  auto output = [&](GstBuffer* buffer) {
-    if (list != nullptr) {
-      gst_buffer_list_add(list, buffer);
-    } else {
-      lone = buffer;
-    }
-  };
-  if (state_event) {
-    output(state_buffer(self, recovered ? PFAP_EVENT_RECOVERED : PFAP_EVENT_COMPLETE, uncertain,
-                        packet_pts));
-  }
-  const bool marker = gst_rtp_buffer_get_marker(rtp);
-  packet.for_each_phoneme(0, [&](size_t i, int64_t offset_ns) {
-    const GstClockTime pts =
-        GST_CLOCK_TIME_IS_VALID(packet_pts) ? packet_pts + offset_ns : GST_CLOCK_TIME_NONE;
-    output(phoneme_buffer(self, i, i == 0 && marker, uncertain, pts));
-  });
-  update_stats(self, [&](Stats& s) {
-    ++s.packets;
-    s.phonemes += packet.phonemes.size();
-    s.faps += packet.faps.size();
-    s.lost += r.lost;
-    s.gaps += r.lost > 0;
-    s.recovered += recovered;
-    s.faps_recovered += recovered ? packet.recovery.size() : 0;
-    s.complete_states += r.recovery == Recovery::kComplete;
-    s.complete_changes += complete_changed;
-  });
-
-  // Nothing at all when there is no loss to repair, no change and no phoneme.
-  if (list != nullptr) {
-    gst_rtp_base_depayload_push_list(depay, list);
-  } else if (lone != nullptr) {
-    gst_rtp_base_depayload_push(depay, lone);
-  }
+  std::optional<PfapEventKind> state_kind;
+  if (recovered) state_kind = PFAP_EVENT_RECOVERED;
+  if (complete_changed) state_kind = PFAP_EVENT_COMPLETE;
+  count_received(self, r, recovered, complete_changed);
+  push_events(self, state_kind, /*uncertain=*/!r.state_whole, gst_rtp_buffer_get_marker(rtp),
+              packet_pts);
   if (r.request_complete && g_atomic_int_get(&self->request_recovery)) {
     request_complete_state(self, seqnum);
   }

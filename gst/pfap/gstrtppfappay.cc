@@ -17,7 +17,7 @@
  * #GstRTPBasePayload:mtu unless one phoneme's FAPs alone do not fit (then that phoneme goes
  * alone in a larger packet, with a warning), and no phoneme waits longer than
  * #GstRtpPfapPay:max-delay of stream time for its packet. A pending packet goes out when a
- * later phoneme shows it is complete, or at EOS, GAP, new caps or a new segment; FLUSH
+ * later phoneme shows it is finished, or at EOS, GAP, new caps or a new segment; FLUSH
  * drops it. A live source that goes quiet should therefore send GAP events. The element
  * reports max-delay as its latency, so that sinks which sync send every packet on time.
  *
@@ -66,7 +66,7 @@
  *
  * ## Example pipeline
  * |[
- * gst-launch-1.0 filesrc location=hello.pfap ! pfapparse ! rtppfappay ! udpsink host=127.0.0.1
+ * gst-launch-1.0 filesrc location=hello.pfap ! pfaptextparse ! rtppfappay ! udpsink host=127.0.0.1
  * port=5004
  * ]| Sends the phonemes and FAPs of hello.pfap as PFAP RTP packets to port 5004.
  */

@@ -303,8 +303,8 @@ void write_marks(MarksFormat format, const std::vector<Spoken>& phonemes, std::s
   }
 }
 
-MarksWriter::MarksWriter(MarksFormat format, int frames_per_second)
-    : format_(format), fps_(std::max(1, frames_per_second)) {}
+MarksWriter::MarksWriter(MarksFormat format, int rate_num, int rate_den)
+    : format_(format), rate_num_(std::max(1, rate_num)), rate_den_(std::max(1, rate_den)) {}
 
 void MarksWriter::reset() {
   utterance_.clear();
@@ -346,14 +346,23 @@ VisemeMouth MarksWriter::mouth(int64_t time_ns) const {
       VisemeMouth{}, ease(static_cast<double>(time_ns - s.end_ns) / kMouthEaseNs));
 }
 
-// Frame k is at k / fps s, computed without overflow for any time an int64 of ns holds.
+// Frame k (k >= 0) is at k * den / num s, rounded down to the ns. Computed in three parts,
+// none of which overflows for num and den up to INT_MAX, for any time an int64 of ns holds.
 int64_t MarksWriter::frame_time(int64_t k) const {
-  return k / fps_ * kNsPerSecond + k % fps_ * kNsPerSecond / fps_;
+  const int64_t whole = k / rate_num_ * rate_den_;  // seconds from whole cycles of num frames
+  const int64_t part = k % rate_num_ * rate_den_;   // < num * den < 2^62
+  return (whole + part / rate_num_) * kNsPerSecond + part % rate_num_ * kNsPerSecond / rate_num_;
 }
 
+// The first frame at or after `ns`: an estimate in double, off by a frame at most, then
+// corrected with the exact frame_time().
 int64_t MarksWriter::first_frame_from(int64_t ns) const {
-  const int64_t k = ns / kNsPerSecond * fps_ + ns % kNsPerSecond * fps_ / kNsPerSecond;
-  return frame_time(k) < ns ? k + 1 : k;
+  const double frames = static_cast<double>(ns) / kNsPerSecond * static_cast<double>(rate_num_) /
+                        static_cast<double>(rate_den_);
+  int64_t k = std::max<int64_t>(0, static_cast<int64_t>(frames));
+  while (k > 0 && frame_time(k - 1) >= ns) --k;
+  while (frame_time(k) < ns) ++k;
+  return k;
 }
 
 bool MarksWriter::frames_until(int64_t end_ns, const Sink& sink) {

@@ -643,16 +643,17 @@ void readers_and_writers() {
     std::string pipeline;
   } cases[] = {
       {"nothing read (the process's own)", "", "fakesrc num-buffers=1 ! fakesink name=out"},
-      {"fapparse, a FAP file at the frame limit", fap,
-       "filesrc location=" + fap + " ! fapparse ! fakesink name=out"},
-      {"fapparse with the speech pad, the same file", fap,
-       "filesrc location=" + fap + " ! fapparse name=p ! fakesink name=out filesrc location=" +
-           speech + " ! pfapparse ! p.speech"},
+      {"pfapfapparse, a FAP file at the frame limit", fap,
+       "filesrc location=" + fap + " ! pfapfapparse ! fakesink name=out"},
+      {"pfapfapparse with the speech pad, the same file", fap,
+       "filesrc location=" + fap + " ! pfapfapparse name=p ! fakesink name=out filesrc location=" +
+           speech + " ! pfaptextparse ! p.speech"},
       {"pfapfapenc at its frame limit (66 FAPs, an event 4 h late)", late,
-       "filesrc location=" + late + " ! pfapparse ! pfapfapenc ! fakesink name=out"},
+       "filesrc location=" + late + " ! pfaptextparse ! pfapfapenc ! fakesink name=out"},
       {"pfapmarksenc arkit-json 240 frames/s, 2,000 phonemes 11.6 days apart", far,
        "filesrc location=" + far +
-           " ! pfapparse alphabet=x-pfap-arpabet ! pfapmarksenc format=arkit-json frame-rate=240 "
+           " ! pfaptextparse alphabet=x-pfap-arpabet ! pfapmarksenc format=arkit-json "
+           "frame-rate=240 "
            "! fakesink name=out"},
   };
   std::printf("\nReaders and writers: peak RSS of a process running one pipeline to EOS\n");

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// pfap::read_fap_file on arbitrary bytes (what fapparse reads). An error must name a line of
+// pfap::read_fap_file on arbitrary bytes (what pfapfapparse reads). An error must name a line of
 // the input and keep nothing; a file read must respect the limits, write back as a file that
 // reads the same, and its PFAP events (fap_animation.h) must be valid and give back every
 // frame's values when applied to a FapState and sampled at the frame times.

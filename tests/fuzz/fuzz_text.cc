@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// pfap::TextReader on arbitrary text, read line by line as pfapparse does. Each event read
+// pfap::TextReader on arbitrary text, read line by line as pfaptextparse does. Each event read
 // must hold valid values, and its canonical line (format_text_line) must read back to the same
 // event; an error must point inside the line and keep nothing from it.
 #include <cstddef>

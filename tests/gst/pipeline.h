@@ -3,6 +3,7 @@
 // one place. Methods that can fail return "" when fine, else what went wrong.
 #pragma once
 
+#include <gst/base/gstbasesink.h>
 #include <gst/gst.h>
 #include <gtest/gtest.h>
 
@@ -89,7 +90,9 @@ class Pipeline {
     GstMessage* m = gst_bus_timed_pop_filtered(
         bus_, static_cast<GstClockTime>(timeout.count()) * GST_MSECOND,
         static_cast<GstMessageType>(GST_MESSAGE_EOS | failures(warnings)));
-    if (m == nullptr) return "no EOS within " + std::to_string(timeout.count()) + " ms";
+    if (m == nullptr) {
+      return "no EOS within " + std::to_string(timeout.count()) + " ms (" + sinks() + ")";
+    }
     std::string text;
     if (GST_MESSAGE_TYPE(m) != GST_MESSAGE_EOS) text = describe(m);
     gst_message_unref(m);
@@ -113,6 +116,35 @@ class Pipeline {
   }
 
  private:
+  // Where each sink is: whether it has EOS and its position, so that a missing EOS says which
+  // branch stopped and where.
+  std::string sinks() const {
+    std::string text;
+    GstIterator* it = gst_bin_iterate_sinks(GST_BIN(pipeline_));
+    GValue item = G_VALUE_INIT;
+    while (gst_iterator_next(it, &item) == GST_ITERATOR_OK) {
+      GstElement* e = GST_ELEMENT(g_value_get_object(&item));
+      gint64 position = -1;
+      gst_element_query_position(e, GST_FORMAT_TIME, &position);
+      bool eos = false;
+      if (GST_IS_BASE_SINK(e)) {
+        GST_OBJECT_LOCK(e);
+        eos = GST_BASE_SINK(e)->eos;
+        GST_OBJECT_UNLOCK(e);
+      }
+      gchar* name = gst_element_get_name(e);
+      if (!text.empty()) text += "; ";
+      text += std::string(name) + (eos ? " at EOS" : " not at EOS") + ", position " +
+              (position < 0 ? std::string("none")
+                            : std::to_string(position / static_cast<gint64>(GST_MSECOND)) + " ms");
+      g_free(name);
+      g_value_reset(&item);
+    }
+    g_value_unset(&item);
+    gst_iterator_free(it);
+    return text;
+  }
+
   static GstMessageType failures(bool warnings) {
     return static_cast<GstMessageType>(GST_MESSAGE_ERROR |
                                        (warnings ? GST_MESSAGE_WARNING : GST_MESSAGE_UNKNOWN));

@@ -3,7 +3,7 @@
 // RTSP server example and the commands of docs/elements.md, "Text markup: sending and
 // receiving a session".
 //  - ExampleFiles.*: every docs/examples/*.pfap parses without a warning, reads back the same
-//    through pfapparse ! pfaptextenc, and is described in docs/examples/README.md.
+//    through pfaptextparse ! pfaptextenc, and is described in docs/examples/README.md.
 //  - Loopback.*: pfap-loopback returns every round-trip sample (all files without comments
 //    or state lines) byte for byte, at several MTUs, and reports bad input.
 //  - Rtsp.*: pfap-rtsp-server as a subprocess and an rtspsrc client: the SDP and the caps
@@ -74,7 +74,7 @@ using pfap::testing::replace_all;
 using pfap::testing::source_path;
 
 // The plugin's elements the examples use.
-constexpr const char* kElements[] = {"pfapparse", "pfaptextenc", "rtppfappay", "rtppfapdepay"};
+constexpr const char* kElements[] = {"pfaptextparse", "pfaptextenc", "rtppfappay", "rtppfapdepay"};
 constexpr const char* kSection = "## Text markup: sending and receiving a session";
 constexpr const char* kAlphabet = "x-pfap-arpabet";
 // rtpbin and rtspsrc time phonemes from arrival times and RTCP; they may move a line by a ms
@@ -402,12 +402,12 @@ TEST(ExampleFiles, EveryFileParses) {
   ASSERT_TRUE(plugin_available(kElements));
   for (const std::string& file : example_files()) {
     SCOPED_TRACE(file);
-    Pipeline p("filesrc name=file ! pfapparse name=parse ! fakesink");
+    Pipeline p("filesrc name=file ! pfaptextparse name=parse ! fakesink");
     ASSERT_TRUE(p.error().empty()) << p.error();
     GstElement* filesrc = p.find("filesrc");
     g_object_set(filesrc, "location", file.c_str(), nullptr);
     Tap events;
-    events.attach(p.find("pfapparse"));
+    events.attach(p.find("pfaptextparse"));
     ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
     EXPECT_EQ(p.wait_eos(std::chrono::seconds(5), /*warnings=*/true), "");
     EXPECT_EQ(events.count(), count_events(read_file(file)));
@@ -419,7 +419,7 @@ TEST(ExampleFiles, ReadBackThroughTextEnc) {
   ASSERT_TRUE(plugin_available(kElements));
   for (const std::string& file : example_files()) {
     SCOPED_TRACE(file);
-    Pipeline p("filesrc name=file ! pfapparse ! pfaptextenc ! fakesink");
+    Pipeline p("filesrc name=file ! pfaptextparse ! pfaptextenc ! fakesink");
     ASSERT_TRUE(p.error().empty()) << p.error();
     g_object_set(p.find("filesrc"), "location", file.c_str(), nullptr);
     Tap text;
@@ -1441,7 +1441,7 @@ TEST(PlayStream, PlaybinShowsTheTalkingHeadInSyncWithTheAudio) {
               starts.size());
 }
 
-// gst-play-1.0 file.pfap: the typefinder names the file text/x-pfap, decodebin plugs pfapparse
+// gst-play-1.0 file.pfap: the typefinder names the file text/x-pfap, decodebin plugs pfaptextparse
 // and pfapface, and the face plays to the end of the session.
 TEST(PlayStream, PlaybinShowsAPfapFile) {
   ASSERT_TRUE(plugin_available(kElements));
@@ -1455,13 +1455,13 @@ TEST(PlayStream, PlaybinShowsAPfapFile) {
   ASSERT_EQ(player.pipeline().set_state(GST_STATE_PLAYING), "");
   ASSERT_EQ(player.pipeline().wait_eos(15s), "");
   player.pipeline().set_state(GST_STATE_NULL);
-  EXPECT_TRUE(player.has("pfapparse"));
+  EXPECT_TRUE(player.has("pfaptextparse"));
   EXPECT_TRUE(player.has("pfapface"));
   // The last phoneme ends at 1.73 s, its expression's transition at 2.33 s: 59 frames at 25 fps.
   EXPECT_EQ(face.frames.size(), 59u);
 }
 
-// Where it should not win: a text file that is not .pfap is not given to pfapparse.
+// Where it should not win: a text file that is not .pfap is not given to pfaptextparse.
 TEST(PlayStream, OtherTextIsNotTakenForPfap) {
   ASSERT_TRUE(plugin_available(kElements));
   gchar* uri = gst_filename_to_uri(source_path("README.md").c_str(), nullptr);
@@ -1471,7 +1471,7 @@ TEST(PlayStream, OtherTextIsNotTakenForPfap) {
   player.pipeline().wait_eos(5s);  // an error: nothing plays text/plain to a video sink
   player.pipeline().set_state(GST_STATE_NULL);
   EXPECT_TRUE(player.has("typefind"));
-  EXPECT_FALSE(player.has("pfapparse"));
+  EXPECT_FALSE(player.has("pfaptextparse"));
   EXPECT_FALSE(player.has("pfapface"));
 }
 

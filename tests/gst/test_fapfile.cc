@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// fapparse and pfapfapenc (docs/fap-files.md, docs/elements.md "MPEG-4 FAP files"):
-//  - FapParse.*: each real file in ../shared/fap (or $PFAP_FAP_DIR) through fapparse, fed in
+// pfapfapparse and pfapfapenc (docs/fap-files.md, docs/elements.md "MPEG-4 FAP files"):
+//  - FapParse.*: each real file in ../shared/fap (or $PFAP_FAP_DIR) through pfapfapparse, fed in
 //    odd-sized chunks: the events applied to a FapState and sampled at the frame times give
 //    back every value of the file; bad files are errors naming the file and line.
-//  - FapRoundTrip.*: fapparse ! rtppfappay ! (seeded 10 % loss) ! rtppfapdepay ! pfapfapenc:
+//  - FapRoundTrip.*: pfapfapparse ! rtppfappay ! (seeded 10 % loss) ! rtppfapdepay ! pfapfapenc:
 //    the written file has every frame of the original whose phoneme the receiver got whole
 //    (not flagged uncertain), and, without loss, every frame.
 //  - FapDocumented.*: the commands of docs/elements.md, "MPEG-4 FAP files", run as written
@@ -19,13 +19,14 @@
 #include <iostream>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "documented_commands.h"
+#include "element_harness.h"
 #include "pfap/fap_animation.h"
 #include "pfap/fap_file.h"
 #include "pfap/fap_state.h"
-#include "documented_commands.h"
-#include "element_harness.h"
 #include "pfap_buffers.h"
 #include "pipeline.h"
 #include "temp_dir.h"
@@ -41,7 +42,7 @@ using pfap::testing::read_file;
 using pfap::testing::replace_all;
 using pfap::testing::TempDir;
 
-constexpr const char* kElements[] = {"fapparse", "pfapfapenc", "rtppfappay", "rtppfapdepay"};
+constexpr const char* kElements[] = {"pfapfapparse", "pfapfapenc", "rtppfappay", "rtppfapdepay"};
 
 fs::path shared_dir() {
   const char* env = std::getenv("PFAP_FAP_DIR");
@@ -92,7 +93,7 @@ TEST(FapParse, EachRealFileGivesBackEveryValueAtItsFrameTimes) {
     pfap::FapFile file;
     ASSERT_TRUE(pfap::read_fap_file(bytes, file).ok());
 
-    GstHarness* h = gst_harness_new("fapparse");
+    GstHarness* h = gst_harness_new("pfapfapparse");
     push_file(h, bytes);
     GstCaps* caps = gst_pad_get_current_caps(h->sinkpad);
     ASSERT_NE(caps, nullptr);
@@ -127,12 +128,12 @@ TEST(FapParse, EachRealFileGivesBackEveryValueAtItsFrameTimes) {
   }
 }
 
-// Runs `text` through filesrc ! fapparse ! fakesink; returns the bus error.
+// Runs `text` through filesrc ! pfapfapparse ! fakesink; returns the bus error.
 std::string error_of(const std::string& text, const TempDir& dir) {
   const std::string path = dir.file("bad.fap");
   EXPECT_TRUE(
       g_file_set_contents(path.c_str(), text.data(), static_cast<gssize>(text.size()), nullptr));
-  Pipeline p("filesrc location=" + path + " ! fapparse ! fakesink");
+  Pipeline p("filesrc location=" + path + " ! pfapfapparse ! fakesink");
   EXPECT_TRUE(p.ok()) << p.error();
   EXPECT_EQ(p.set_state(GST_STATE_PLAYING), "");
   return p.wait_eos(std::chrono::seconds(10));
@@ -186,7 +187,7 @@ TEST(FapParse, VisemesAreReportedNotSilentlyLost) {
   for (int k = 0; k < 3; ++k) text += mask + "\n" + std::to_string(k) + " 1 0 0 0 5\n";
   const std::string path = dir.file("visemes.fap");
   ASSERT_TRUE(g_file_set_contents(path.c_str(), text.data(), -1, nullptr));
-  Pipeline p("filesrc location=" + path + " ! fapparse ! fakesink");
+  Pipeline p("filesrc location=" + path + " ! pfapfapparse ! fakesink");
   ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
   // Warned at the 1st and 2nd frame that sets FAP 1, not at the 3rd; then EOS.
   int warnings = 0;
@@ -208,7 +209,7 @@ TEST(FapParse, RoundedValuesAreWarnedAbout) {
   const std::string text = "2.1 t 25 1\n" + mask + "\n0 1.5 2.25 -3.5\n";
   const std::string path = dir.file("fractions.fap");
   ASSERT_TRUE(g_file_set_contents(path.c_str(), text.data(), -1, nullptr));
-  Pipeline p("filesrc location=" + path + " ! fapparse ! fakesink");
+  Pipeline p("filesrc location=" + path + " ! pfapfapparse ! fakesink");
   ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
   const std::string message = p.wait_eos(std::chrono::seconds(10), true);
   EXPECT_NE(message.find("frame 0 has values with a fraction, rounded to whole FAP units"),
@@ -229,7 +230,7 @@ TEST(FapParse, MergedWithASpeechStreamKeepsTheFileValuesAndTheSpeechPhonemes) {
   ASSERT_TRUE(pfap::read_fap_file(text, file).ok());
   for (const bool speech_ends_first : {true, false}) {
     SCOPED_TRACE(speech_ends_first ? "speech ends first" : "file ends first");
-    GstHarness* h = gst_harness_new_with_padnames("fapparse", "sink", "src");
+    GstHarness* h = gst_harness_new_with_padnames("pfapfapparse", "sink", "src");
     GstHarness* speech = gst_harness_new_with_element(h->element, "speech", nullptr);
     ASSERT_NE(speech, nullptr);
     gst_harness_set_src_caps_str(speech, "application/x-pfap,alphabet=x-sampa");
@@ -281,10 +282,10 @@ TEST(FapParse, MergedWithASpeechStreamKeepsTheFileValuesAndTheSpeechPhonemes) {
   }
 }
 
-// Runs `text`, a FAP file, through fapparse with `speech` on its speech pad; expects `want`.
+// Runs `text`, a FAP file, through pfapfapparse with `speech` on its speech pad; expects `want`.
 void expect_whole_merge(const std::string& text, const std::vector<pfap::TextEvent>& speech,
                         const std::vector<pfap::TextEvent>& want) {
-  GstHarness* h = gst_harness_new_with_padnames("fapparse", "sink", "src");
+  GstHarness* h = gst_harness_new_with_padnames("pfapfapparse", "sink", "src");
   GstHarness* speech_pad = gst_harness_new_with_element(h->element, "speech", nullptr);
   ASSERT_NE(speech_pad, nullptr);
   gst_harness_set_src_caps_str(speech_pad, "application/x-pfap");
@@ -314,7 +315,7 @@ void expect_whole_merge(const std::string& text, const std::vector<pfap::TextEve
   }
 }
 
-// Issue 27: merged, fapparse held the file's events, merge_with_speech's copy of their FAPs
+// Issue 27: merged, pfapfapparse held the file's events, merge_with_speech's copy of their FAPs
 // and its output at once (760 MB for a 261 MB file); it now merges in windows of at least
 // 4096 file events, which must give what the whole merge gives.
 TEST(FapParse, MergedInWindowsIsTheWholeMerge) {
@@ -387,7 +388,7 @@ GstPadProbeReturn keep_event(GstPad*, GstPadProbeInfo* info, gpointer data) {
 RoundTrip round_trip(const std::string& bytes, double loss, uint32_t seed) {
   RoundTrip out;
   GstHarness* h = gst_harness_new_parse(
-      "fapparse ! rtppfappay name=pay recovery-depth=4 ! rtppfapdepay name=depay ! "
+      "pfapfapparse ! rtppfappay name=pay recovery-depth=4 ! rtppfapdepay name=depay ! "
       "pfapfapenc name=enc");
   DropState drops{std::mt19937(seed), loss};
   GstElement* depay = gst_bin_get_by_name(GST_BIN(h->element), "depay");
@@ -508,6 +509,28 @@ GstBuffer* phoneme_at(GstClockTime pts, uint16_t duration_ms, std::vector<pfap::
   return pfap::testing::markup_buffer(e, pts);
 }
 
+// frame-rate is a fraction, as GStreamer's framerates are; "25" typed in a pipeline is still
+// 25/1 (1.22 refuses a decimal: 12.5 is typed 25/2). The file's header holds a decimal number.
+TEST(PfapFapEnc, FrameRateIsAFractionAndWholeNumbersStillParse) {
+  ASSERT_TRUE(plugin_available(kElements));
+  for (const auto& [typed, rate] :
+       {std::pair{"25", 25.0}, std::pair{"25/2", 12.5}, std::pair{"30000/1001", 29.97002997}}) {
+    const Encoded out = encode(std::string("frame-rate=") + typed,
+                               {phoneme_at(0, 100, {{3, 50, 0, pfap::Curve::kLinear}})});
+    pfap::FapFile file;
+    const pfap::FapFileResult result = pfap::read_fap_file(out.text, file);
+    ASSERT_TRUE(result.ok()) << typed << ": " << pfap::describe(result) << "\n" << out.text;
+    EXPECT_EQ(file.header.frame_rate, rate) << typed;
+    EXPECT_TRUE(out.warnings.empty()) << typed;
+  }
+  GstElement* enc = gst_element_factory_make("pfapfapenc", nullptr);
+  ASSERT_NE(enc, nullptr);
+  GParamSpec* spec = g_object_class_find_property(G_OBJECT_GET_CLASS(enc), "frame-rate");
+  ASSERT_NE(spec, nullptr);
+  EXPECT_EQ(spec->value_type, GST_TYPE_FRACTION);
+  gst_object_unref(enc);
+}
+
 TEST(PfapFapEnc, MalformedEventsAreDroppedWithAWarningAndTheFileGoesOn) {
   ASSERT_TRUE(plugin_available(kElements));
   const char junk[] = "not an event";
@@ -610,7 +633,7 @@ TEST(PfapFapEnc, NoEventsNoFileAndAWarning) {
 TEST(FapDocumented, EveryCommandRunsToEos) {
   const auto files = shared_files();
   SKIP_WITHOUT_SHARED_FILES(files);
-  const char* used[] = {"fapparse", "pfapfapenc", "pfaptts", "pfapface", "netsim"};
+  const char* used[] = {"pfapfapparse", "pfapfapenc", "pfaptts", "pfapface", "netsim"};
   ASSERT_TRUE(plugin_available(used));
   const std::vector<std::string> commands =
       launch_descriptions(doc_section("docs/elements.md", "## MPEG-4 FAP files"));

@@ -148,7 +148,33 @@ struct FloodResult {
   std::string eos;            // why the receiver did not reach EOS after it ("": it did)
   std::string missing;        // which of those sent after the flood did not arrive (0: the first)
   unsigned long kernel_drops = 0;  // datagrams the kernel dropped, the socket's queue full
+  std::string jitterbuffers;  // each rtpjitterbuffer's stats when the wait ended: what it dropped
 };
+
+// The stats of every rtpjitterbuffer in the pipeline (rtpbin holds one per source), so that a
+// failure says whether the good packets were dropped as late, lost, or still held.
+std::string jitterbuffer_stats(GstElement* pipeline) {
+  std::string stats;
+  GstIterator* it = gst_bin_iterate_recurse(GST_BIN(pipeline));
+  GValue item = G_VALUE_INIT;
+  while (gst_iterator_next(it, &item) == GST_ITERATOR_OK) {
+    GstElement* e = GST_ELEMENT(g_value_get_object(&item));
+    GstElementFactory* factory = gst_element_get_factory(e);
+    if (factory != nullptr &&
+        g_strcmp0(gst_plugin_feature_get_name(GST_PLUGIN_FEATURE(factory)), "rtpjitterbuffer") == 0) {
+      GstStructure* s = nullptr;
+      g_object_get(e, "stats", &s, nullptr);
+      gchar* text = gst_structure_to_string(s);
+      stats += std::string(" ") + text;
+      g_free(text);
+      gst_structure_free(s);
+    }
+    g_value_reset(&item);
+  }
+  g_value_unset(&item);
+  gst_iterator_free(it);
+  return stats;
+}
 
 // The receiving socket's queue (bytes) and the datagrams the kernel dropped at it, from
 // /proc/net/udp: what the kernel drops never reaches udpsrc, whatever the receiver does.
@@ -264,6 +290,7 @@ FloodResult flood_through(const std::string& receiver, const FloodOptions& optio
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   result.after_received = received.count_of(after);
+  result.jitterbuffers = jitterbuffer_stats(p.get());
   result.missing = received.missing(after);
   result.kernel_drops = socket_queue(port).drops - drops_before;
   const std::vector<Packet> tail(after.begin() + 25, after.end());
@@ -310,7 +337,8 @@ void report(const FloodResult& f) {
               << f.after_received << "/" << f.after_sent << " after the flood, "
               << f.tail_received << "/" << f.tail_sent << " from 1 s on, heap "
               << f.heap_growth / 1024 << " KiB, EOS: " << (f.eos.empty() ? "yes" : f.eos)
-              << ", kernel drops " << f.kernel_drops << ", missing:" << f.missing << "\n";
+              << ", kernel drops " << f.kernel_drops << ", missing:" << f.missing
+              << ", jitterbuffers:" << f.jitterbuffers << "\n";
   }
 }
 
@@ -323,7 +351,8 @@ void expect_survives(const std::string& receiver, const FloodOptions& options) {
   report(f);
   EXPECT_EQ(f.tail_received, f.tail_sent)
       << "good packets sent 1 s or more after the flood; " << f.after_received << " of "
-      << f.after_sent << " after it";
+      << f.after_sent << " after it; missing:" << f.missing << "; the kernel dropped "
+      << f.kernel_drops << "; jitterbuffers:" << f.jitterbuffers;
   EXPECT_EQ(f.eos, "");
   EXPECT_LT(f.heap_growth, 32l << 20) << "bytes of heap after the flood";
 }
@@ -335,7 +364,7 @@ void expect_loses_nothing_after(const std::string& receiver, const FloodOptions&
   report(f);
   EXPECT_EQ(f.after_received, f.after_sent)
       << "good packets sent after the flood; missing:" << f.missing << "; the kernel dropped "
-      << f.kernel_drops;
+      << f.kernel_drops << "; jitterbuffers:" << f.jitterbuffers;
   EXPECT_EQ(f.eos, "");
   EXPECT_LT(f.heap_growth, 32l << 20) << "bytes of heap after the flood";
 }
@@ -378,7 +407,7 @@ TEST(StateChanges, EveryElementGoesThroughEveryStateAndBack) {
   const GstState down[] = {GST_STATE_PAUSED, GST_STATE_READY, GST_STATE_NULL};
   std::mt19937 random(22);
   for (const char* name :
-       {"rtppfappay", "rtppfapdepay", "pfapparse", "pfaptextenc", "pfaptts", "pfapface"}) {
+       {"rtppfappay", "rtppfapdepay", "pfaptextparse", "pfaptextenc", "pfaptts", "pfapface"}) {
     SCOPED_TRACE(name);
     GstElement* element = gst_element_factory_make(name, nullptr);
     ASSERT_NE(element, nullptr);

@@ -9,12 +9,13 @@
 #include <chrono>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
-#include "pfap/markup.h"
-#include "pfap/markup_event.h"
 #include "documented_commands.h"
 #include "element_harness.h"
+#include "pfap/markup.h"
+#include "pfap/markup_event.h"
 #include "pfap_buffers.h"
 #include "pipeline.h"
 #include "temp_dir.h"
@@ -31,7 +32,7 @@ using pfap::testing::source_path;
 using pfap::testing::TempDir;
 
 constexpr GstClockTime kMs = GST_MSECOND;
-constexpr std::array<const char*, 5> kElements{"pfapmarksenc", "pfapmarksparse", "pfapparse",
+constexpr std::array<const char*, 5> kElements{"pfapmarksenc", "pfapmarksparse", "pfaptextparse",
                                                "rtppfappay", "pfapface"};
 
 // The messages of the bus's warnings (or errors), taken off it.
@@ -150,6 +151,35 @@ TEST_F(MarksEnc, ArkitFramesAtTheFrameRateEndAfterTheLastTransition) {
   EXPECT_EQ(std::count(rows[2].begin(), rows[2].end(), ','), 55);
 }
 
+// frame-rate is a fraction, as GStreamer's framerates are; a whole number typed in a pipeline
+// still parses (1.22 reads "30" as 30/1; a decimal it refuses, docs/elements.md).
+TEST_F(MarksEnc, FrameRateIsAFractionAndWholeNumbersStillParse) {
+  for (const auto& [typed, n, d] : {std::tuple{"30", 30, 1}, std::tuple{"30000/1001", 30000, 1001},
+                                    std::tuple{"2997/100", 2997, 100}}) {
+    GError* error = nullptr;
+    GstElement* enc = gst_parse_launch(
+        (std::string("pfapmarksenc format=arkit-csv frame-rate=") + typed).c_str(), &error);
+    ASSERT_NE(enc, nullptr) << typed << ": " << (error ? error->message : "");
+    EXPECT_EQ(error, nullptr) << typed << ": " << error->message;
+    g_clear_error(&error);
+    GValue rate = G_VALUE_INIT;
+    g_value_init(&rate, GST_TYPE_FRACTION);
+    g_object_get_property(G_OBJECT(enc), "frame-rate", &rate);
+    EXPECT_EQ(gst_value_get_fraction_numerator(&rate), n) << typed;
+    EXPECT_EQ(gst_value_get_fraction_denominator(&rate), d) << typed;
+    g_value_unset(&rate);
+    gst_object_unref(enc);
+  }
+  // At 30000/1001 the frames are 33.367 ms apart, not 33.333.
+  make("pfapmarksenc format=arkit-csv frame-rate=30000/1001");
+  gst_harness_set_src_caps_str(h_, PFAP_MARKUP_CAPS ",alphabet=x-pfap-arpabet");
+  gst_harness_push(h_, pfap::testing::phoneme_buffer(phoneme(22, 100), {}, 0, true));
+  gst_harness_push_event(h_, gst_event_new_eos());
+  const std::string csv = pull_text(h_);
+  EXPECT_NE(csv.find("\n33.367,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\n100.100,"), std::string::npos) << csv;
+}
+
 // Issue 27: 2,000 phonemes 11.6 days apart made 4.5 MB of arkit-json each at 240 frames/s.
 TEST_F(MarksEnc, ArkitLongRestIsCutWithAWarning) {
   make("pfapmarksenc format=arkit-csv frame-rate=240");
@@ -226,6 +256,30 @@ TEST_F(MarksParse, BadLineIsAnErrorNamingLineAndColumn) {
   const std::vector<std::string> errors = messages(bus_, GST_MESSAGE_ERROR);
   ASSERT_EQ(errors.size(), 1u);
   EXPECT_EQ(errors[0], "Bad line 2, column 34: not a viseme of this format");
+}
+
+// Blank lines before the first mark count however they come: they were left uncounted when a
+// buffer held nothing else.
+TEST_F(MarksParse, BlankLinesInBuffersOfTheirOwnAreCounted) {
+  make("pfapmarksparse format=azure");
+  for (const std::string piece : {"\n", "  \r\n", "{\"audioOffset\":0,\"visemeId\":99}\n"}) {
+    gst_harness_push(h_, gst_buffer_new_memdup(piece.data(), piece.size()));
+  }
+  const std::vector<std::string> errors = messages(bus_, GST_MESSAGE_ERROR);
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_EQ(errors[0], "Bad line 3, column 29: not a viseme of this format");
+}
+
+// White space in buffers of its own before a Rhubarb JSON document is no line of TSV.
+TEST_F(MarksParse, RhubarbJsonAfterBuffersOfWhiteSpaceIsADocument) {
+  make("pfapmarksparse format=rhubarb");
+  const std::string doc = "{\"mouthCues\":[{\"start\":0.0,\"end\":0.1,\"value\":\"A\"}]}";
+  for (const std::string& piece : {std::string("\n"), std::string("  "), doc}) {
+    ASSERT_EQ(gst_harness_push(h_, gst_buffer_new_memdup(piece.data(), piece.size())), GST_FLOW_OK);
+  }
+  gst_harness_push_event(h_, gst_event_new_eos());
+  EXPECT_EQ(pull_events(h_).size(), 1u);
+  EXPECT_TRUE(messages(bus_, GST_MESSAGE_ERROR).empty());
 }
 
 TEST_F(MarksParse, SkipBadLinesWarnsRateLimitedAndGoesOn) {

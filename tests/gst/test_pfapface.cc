@@ -428,7 +428,7 @@ TEST(PfapFace, BytesWithoutPfapparseAreAnErrorNamingTheParserWithoutCriticals) {
   ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
   const std::string error = p.wait_eos(std::chrono::seconds(10));
   EXPECT_NE(error.find("error from pfapface"), std::string::npos) << error;
-  EXPECT_NE(error.find("pfapparse"), std::string::npos) << error;
+  EXPECT_NE(error.find("pfaptextparse"), std::string::npos) << error;
   EXPECT_NE(error.find("bytes segment"), std::string::npos) << error;
   EXPECT_EQ(frames, 0);
   ASSERT_EQ(p.set_state(GST_STATE_NULL), "");
@@ -615,11 +615,11 @@ TEST(PfapFacePictures, DebugOverlayWritesAtTheTop) {
 // ---------------------------------------------------------------------------------------------
 // Golden frames
 
-// Frames of `session` through pfapparse and pfapface at 160x120, 25 fps.
+// Frames of `session` through pfaptextparse and pfapface at 160x120, 25 fps.
 std::vector<Picture> render_session(const std::string& session, const char* style,
                                     const std::vector<int>& indexes) {
   GstHarness* h = gst_harness_new_parse(
-      ("pfapparse alphabet=x-pfap-arpabet ! pfapface style=" + std::string(style)).c_str());
+      ("pfaptextparse alphabet=x-pfap-arpabet ! pfapface style=" + std::string(style)).c_str());
   gst_harness_set_sink_caps_str(h, kSmallCaps);
   gst_harness_set_src_caps_str(h, "text/x-raw, format=(string)utf8");
   gchar* text = nullptr;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// pfapparse: .pfap text in, one application/x-pfap buffer per event out.
+// pfaptextparse: .pfap text in, one application/x-pfap buffer per event out.
 #include <glib/gstdio.h>
 #include <gst/check/gstharness.h>
 #include <gtest/gtest.h>
@@ -11,6 +11,7 @@
 #include <random>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <vector>
 
 #include "element_harness.h"
@@ -51,7 +52,7 @@ GstBuffer* text_buffer(std::string_view text) {
 
 class Parser : public pfap::testing::ElementHarness {
  public:
-  explicit Parser(bool skip_bad_lines = false) : ElementHarness("pfapparse") {
+  explicit Parser(bool skip_bad_lines = false) : ElementHarness("pfaptextparse") {
     g_object_set(h_->element, "skip-bad-lines", skip_bad_lines, nullptr);
     gst_harness_set_src_caps_str(h_, "text/x-raw, format=(string)utf8");
   }
@@ -177,7 +178,7 @@ TEST(PfapParse, SrcCapsQueryAnswersXPfap) {
 }
 
 TEST(PfapParse, AlphabetPropertyBecomesACapsField) {
-  GstHarness* h = gst_harness_new("pfapparse");
+  GstHarness* h = gst_harness_new("pfaptextparse");
   g_object_set(h->element, "alphabet", "x-pfap-arpabet", nullptr);
   gst_harness_set_src_caps_str(h, "text/x-raw, format=(string)utf8");
   const char line[] = "0 20 60 120 W\n";
@@ -474,14 +475,14 @@ TEST(PfapParsePipeline, FilesrcReadsAFileOfManyBlocks) {
   }
   ASSERT_GT(text.size(), 3 * 4096u);
   gchar* path = nullptr;
-  const gint fd = g_file_open_tmp("pfapparse-XXXXXX.pfap", &path, nullptr);
+  const gint fd = g_file_open_tmp("pfaptextparse-XXXXXX.pfap", &path, nullptr);
   ASSERT_GE(fd, 0);
   close(fd);
   ASSERT_TRUE(g_file_set_contents(path, text.data(), static_cast<gssize>(text.size()), nullptr));
 
   const std::string description =
       std::string("filesrc location=\"") + path +
-      "\" ! pfapparse ! fakesink name=sink sync=false signal-handoffs=true";
+      "\" ! pfaptextparse ! fakesink name=sink sync=false signal-handoffs=true";
   GstElement* pipeline = gst_parse_launch(description.c_str(), nullptr);
   ASSERT_NE(pipeline, nullptr);
   GstElement* sink = gst_bin_get_by_name(GST_BIN(pipeline), "sink");
@@ -512,10 +513,10 @@ TEST(PfapParsePipeline, FilesrcReadsAFileOfManyBlocks) {
   }
 }
 
-// Runs `filesrc location=PATH ! pfapparse ... ! fakesink` to its end: the first error's or
+// Runs `filesrc location=PATH ! pfaptextparse ... ! fakesink` to its end: the first error's or
 // warning's message (with `skip`: skip-bad-lines=true), or "" at EOS.
 std::string run_file(const std::string& path, bool skip) {
-  pfap::testing::Pipeline p("filesrc location=\"" + path + "\" ! pfapparse skip-bad-lines=" +
+  pfap::testing::Pipeline p("filesrc location=\"" + path + "\" ! pfaptextparse skip-bad-lines=" +
                             (skip ? "true" : "false") + " ! fakesink sync=false");
   if (!p.ok()) return p.error();
   if (std::string e = p.set_state(GST_STATE_PLAYING); !e.empty()) return e;
@@ -542,6 +543,64 @@ TEST(PfapParsePipeline, ByteOrderMarkAtTheStartOfAFileIsSkipped) {
   ASSERT_TRUE(g_file_set_contents(path.c_str(), text.data(), static_cast<gssize>(text.size()),
                                   nullptr));
   EXPECT_EQ(run_file(path, false), "");
+}
+
+// Runs a gst-launch description to its end: "" at EOS, else the first error or warning.
+std::string run(const std::string& description) {
+  pfap::testing::Pipeline p(description);
+  if (!p.ok()) return p.error();
+  if (std::string e = p.set_state(GST_STATE_PLAYING); !e.empty()) return e;
+  return p.wait_eos(std::chrono::seconds(10), /*warnings=*/true);
+}
+
+// The readers' names from before they were named pfap<format>parse, as the writers are
+// pfap<format>enc (docs/elements.md, "Names"), still make the same element: rank none, so
+// that autoplugging takes the new name, a description that names it, and the same text
+// from the same file.
+TEST(DeprecatedNames, OldReaderNamesMakeTheSameElement) {
+  pfap::testing::TempDir dir;
+  const std::string text = "0 1 20 100 W <FAP 3 100 20 1>\n20 2 30 100 E <FAP 3 0 30 1>\n";
+  const std::string pfap = dir.file("in.pfap"), fap = dir.file("in.fap");
+  ASSERT_TRUE(
+      g_file_set_contents(pfap.c_str(), text.data(), static_cast<gssize>(text.size()), nullptr));
+  ASSERT_EQ(run("filesrc location=\"" + pfap + "\" ! pfaptextparse ! pfapfapenc ! filesink " +
+                "location=\"" + fap + "\""),
+            "");
+  for (const auto& [old_name, name, input] : {std::tuple{"pfapparse", "pfaptextparse", pfap},
+                                              std::tuple{"fapparse", "pfapfapparse", fap}}) {
+    GstElementFactory* old_factory = gst_element_factory_find(old_name);
+    GstElementFactory* factory = gst_element_factory_find(name);
+    ASSERT_NE(old_factory, nullptr) << old_name;
+    ASSERT_NE(factory, nullptr) << name;
+    EXPECT_EQ(gst_plugin_feature_get_rank(GST_PLUGIN_FEATURE(old_factory)), GST_RANK_NONE);
+    EXPECT_EQ(std::string(
+                  gst_element_factory_get_metadata(old_factory, GST_ELEMENT_METADATA_DESCRIPTION)),
+              std::string("Deprecated name of ") + name +
+                  ": the same element with rank none; use " + name);
+    GstElement* element = gst_element_factory_create(old_factory, nullptr);
+    ASSERT_NE(element, nullptr) << old_name;
+    EXPECT_TRUE(g_type_is_a(G_OBJECT_TYPE(element), gst_element_factory_get_element_type(factory)))
+        << old_name;
+    EXPECT_EQ(gst_element_get_factory(element), old_factory) << old_name;
+    gst_object_unref(element);
+
+    std::string out[2];
+    for (int i = 0; i < 2; ++i) {
+      const std::string path = dir.file(std::string("out-") + (i ? name : old_name));
+      EXPECT_EQ(run("filesrc location=\"" + input + "\" ! " + (i ? name : old_name) +
+                    " ! pfaptextenc ! filesink location=\"" + path + "\""),
+                "")
+          << (i ? name : old_name);
+      gchar* contents = nullptr;
+      ASSERT_TRUE(g_file_get_contents(path.c_str(), &contents, nullptr, nullptr)) << path;
+      out[i] = contents;
+      g_free(contents);
+    }
+    EXPECT_FALSE(out[1].empty()) << name;
+    EXPECT_EQ(out[0], out[1]) << old_name;
+    gst_object_unref(old_factory);
+    gst_object_unref(factory);
+  }
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // pfaptextenc: x-pfap buffers in, .pfap text lines out, checked as exact strings and read
-// back with pfap::TextReader, the reader pfapparse uses.
+// back with pfap::TextReader, the reader pfaptextparse uses.
 #include <gst/check/gstharness.h>
 #include <gtest/gtest.h>
 
@@ -35,7 +35,7 @@ MarkupEvent state_event(PfapEventKind kind, std::vector<Fap> faps) {
   return event;
 }
 
-// Reads `lines` (each ending in '\n') as pfapparse does; a line that does not read fails.
+// Reads `lines` (each ending in '\n') as pfaptextparse does; a line that does not read fails.
 std::vector<pfap::TextEvent> read_back(const std::vector<std::string>& lines) {
   pfap::TextReader reader;
   std::vector<pfap::TextEvent> events;

@@ -470,14 +470,32 @@ TEST(GstInspect, Depayloader) {
   check_element_inspect(kDepay, "request-recovery");
 }
 
+// The readers' deprecated names (docs/elements.md, "Names") are inspected as the element they
+// name: its pads and properties, a description that names the new name.
+TEST(GstInspect, DeprecatedNamesShowTheElementTheyName) {
+  ASSERT_TRUE(plugin_available(kElements));
+  for (const auto& [old_name, name, property] :
+       {std::tuple{"pfapparse", "pfaptextparse", "skip-bad-lines"},
+        std::tuple{"fapparse", "pfapfapparse", "silence-symbol"}}) {
+    const Inspect r = gst_inspect(old_name);
+    ASSERT_EQ(r.exit_status, 0) << r.err;
+    SCOPED_TRACE(std::string("gst-inspect-1.0 ") + old_name + ":\n" + r.out);
+    EXPECT_NE(r.out.find(std::string("Deprecated name of ") + name), std::string::npos);
+    EXPECT_NE(r.out.find(std::string("  ") + property), std::string::npos);
+    EXPECT_NE(r.out.find("Rank                     none (0)"), std::string::npos);
+  }
+}
+
 // Each plugin needs only what its elements use (docs/elements.md): the RTP and text elements
 // in pfap, the espeak-ng speaker in pfaptts, the cairo head in pfapface.
 TEST(GstInspect, EachPluginListsItsElements) {
   ASSERT_TRUE(plugin_available(kElements));
   // And its typefinders: .pfap text's in pfap.
   const std::vector<std::tuple<const char*, std::vector<const char*>, int>> plugins = {
-      {"pfap", {kPay, kDepay, "pfapparse", "pfaptextenc", "fapparse", "pfapfapenc",
-        "pfapmarksenc", "pfapmarksparse"}, 1},
+      {"pfap",
+       {kPay, kDepay, "pfaptextparse", "pfaptextenc", "pfapfapparse", "pfapfapenc", "pfapmarksenc",
+        "pfapmarksparse", "pfapparse", "fapparse"},
+       1},
       {"pfaptts", {"pfaptts"}, 0},
       {"pfapface", {"pfapface"}, 0},
       {"pfapalign", {"pfapalign"}, 0},

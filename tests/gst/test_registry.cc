@@ -72,6 +72,10 @@ std::string value_summary(GParamSpec* pspec) {
       out << (i ? ", " : " ") << e->values[i].value_nick << " (" << e->values[i].value << ")";
     }
     out << " }, default " << g_enum_get_value(e, g_value_get_enum(def))->value_nick;
+  } else if (GST_IS_PARAM_SPEC_FRACTION(pspec)) {
+    const auto* p = GST_PARAM_SPEC_FRACTION(pspec);
+    out << "fraction " << p->min_num << "/" << p->min_den << ".." << p->max_num << "/" << p->max_den
+        << ", default " << p->def_num << "/" << p->def_den;
   } else {
     out << g_type_name(pspec->value_type);
   }
@@ -207,8 +211,8 @@ TEST(RegistryReference, DocsSayWhatTheRegistryHolds) {
 // The reference checks what it should: every element and the typefinder are in it.
 TEST(RegistryReference, CoversEveryElementAndTheTypefinder) {
   const std::string registry = registry_reference();
-  for (const char* name : {"rtppfappay", "rtppfapdepay", "pfapparse", "pfaptextenc", "pfaptts",
-                           "pfapface"}) {
+  for (const char* name :
+       {"rtppfappay", "rtppfapdepay", "pfaptextparse", "pfaptextenc", "pfaptts", "pfapface"}) {
     EXPECT_NE(registry.find(std::string("\nelement ") + name + ":"), std::string::npos) << name;
   }
   EXPECT_NE(registry.find("\ntypefinder text/x-pfap:"), std::string::npos);

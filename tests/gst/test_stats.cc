@@ -52,7 +52,7 @@ guint64 counter(const GstStructure* stats, const char* field) {
 // hello.pfap through the payloader and depayloader to the text writer.
 TEST(Stats, PayloaderAndDepayloaderAddTheirCountersToTheBaseClassStatistics) {
   Pipeline p("filesrc location=" + source_path("docs/examples/hello.pfap") +
-             " ! pfapparse name=parse ! rtppfappay name=pay ! rtppfapdepay name=depay ! "
+             " ! pfaptextparse name=parse ! rtppfappay name=pay ! rtppfapdepay name=depay ! "
              "pfaptextenc name=enc ! fakesink");
   ASSERT_TRUE(p.ok()) << p.error();
   ASSERT_EQ(p.set_state(GST_STATE_PLAYING), "");
@@ -99,8 +99,8 @@ TEST(Stats, EveryCountingElementHasStatsWithTheSharedNames) {
       {"pfaptextenc", {"events", "malformed", "earlier"}},
       {"pfapfapenc", {"events", "malformed", "earlier"}},
       {"pfapmarksenc", {"events", "malformed", "earlier"}},
-      {"pfapparse", {"events", "bad-lines"}},
-      {"fapparse", {"events", "bad-lines"}},
+      {"pfaptextparse", {"events", "bad-lines"}},
+      {"pfapfapparse", {"events", "bad-lines"}},
       {"pfapmarksparse", {"events", "bad-lines"}},
       {"rtppfappay", {"packets", "malformed"}},
       {"rtppfapdepay", {"packets", "malformed"}},
@@ -127,7 +127,7 @@ TEST(Stats, DeprecatedCounterPropertiesStillCount) {
   ASSERT_TRUE(
       g_file_set_contents(bad.c_str(), "0 16 60 118 W\nnot a line\n60 3 70 124 -\n", -1, nullptr));
   Pipeline parse("filesrc location=" + bad +
-                 " ! pfapparse name=parse skip-bad-lines=true ! fakesink");
+                 " ! pfaptextparse name=parse skip-bad-lines=true ! fakesink");
   ASSERT_TRUE(parse.ok()) << parse.error();
   ASSERT_EQ(parse.set_state(GST_STATE_PLAYING), "");
   ASSERT_EQ(parse.wait_eos(10s), "");

@@ -30,7 +30,7 @@ using pfap::testing::source_path;
 using pfap::testing::TempDir;
 
 constexpr std::array<const char*, 6> kElements{"pfaptts",      "pfaptextenc",    "pfapfapenc",
-                                               "pfapmarksenc", "pfapmarksparse", "pfapparse"};
+                                               "pfapmarksenc", "pfapmarksparse", "pfaptextparse"};
 
 // Every writer, and pfapmarksenc in every format.
 constexpr std::array<const char*, 9> kWriters{
@@ -110,7 +110,7 @@ std::string seconds_later(const std::string& text, const char* pattern) {
 }
 
 const std::array<Conversion, 5> kConversions{{
-    {"hello.pfap", "pfapparse", "pfaptextenc",
+    {"hello.pfap", "pfaptextparse", "pfaptextenc",
      [](const std::string& t) { return integers_later(t, "(?:^|\n)(\\d+) ", 500); }},
     {"marks/hello.polly.jsonl", "pfapmarksparse format=polly", "pfapmarksenc format=polly",
      [](const std::string& t) { return integers_later(t, "\"time\":(\\d+)", 500); }},

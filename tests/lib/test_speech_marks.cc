@@ -32,8 +32,9 @@ std::vector<TextEvent> read_pfap(const std::string& name) {
   return events;
 }
 
-std::string write(MarksFormat format, const std::vector<TextEvent>& events, int fps = 30) {
-  MarksWriter writer(format, fps);
+std::string write(MarksFormat format, const std::vector<TextEvent>& events, int fps = 30,
+                  int fps_den = 1) {
+  MarksWriter writer(format, fps, fps_den);
   writer.set_alphabet(&arpabet());
   std::string out;
   const MarksWriter::Sink sink = [&out](std::string_view text) {
@@ -236,6 +237,27 @@ TEST(SpeechMarks, AVisemeFarAheadCostsNoMoreThanItsCap) {
   ASSERT_EQ(events.size(), 17u);  // X cut at 16 pieces of 4095 ms, then A far ahead
   EXPECT_EQ(events[15].time_ms, 15 * 4095);
   EXPECT_EQ(events[16].time_ms, 9'000'000'000'000);
+}
+
+// A fractional rate (NTSC's 30000/1001) puts frame k at k * 1001 / 30000 s, to the ns rounded
+// down, also after a rest cut 11.6 days long, where the first frame is found from the time.
+TEST(SpeechMarks, ArkitFramesAtAFractionalRateAreExact) {
+  const std::string csv =
+      write(MarksFormat::kArkitCsv,
+            {event(0, phoneme(1, 100), true), event(1'000'000'000, phoneme(1, 100))}, 30000, 1001);
+  std::istringstream lines(csv);
+  std::string line;
+  std::vector<std::string> rows;
+  while (std::getline(lines, line)) rows.push_back(line.substr(0, line.find(',')));
+  ASSERT_GE(rows.size(), 5u);
+  EXPECT_EQ(rows[1], "0.000");
+  EXPECT_EQ(rows[2], "33.367");  // 33,366,666 ns
+  EXPECT_EQ(rows[3], "66.733");
+  EXPECT_EQ(rows[4], "100.100");
+  // Frame 29,970,030 is the first at or after 1e9 ms: 30,000,000,030 / 30,000 s.
+  const auto far = std::find(rows.begin(), rows.end(), "1000000001.000");
+  ASSERT_NE(far, rows.end());
+  EXPECT_LT(std::stod(*(far - 1)), 2000.0);  // the frame before it is the rest's last
 }
 
 TEST(SpeechMarks, ArkitFramesOfALongRestAreLeftOut) {

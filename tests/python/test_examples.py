@@ -32,8 +32,8 @@ needs_gjs = pytest.mark.skipif(shutil.which("gjs") is None, reason="gjs is not i
 
 
 def phoneme_names(path):
-    """The phonemes of a .pfap file, read with pfapparse and named with GstPfap."""
-    pipeline = Gst.parse_launch("filesrc name=src ! pfapparse ! appsink name=sink sync=false")
+    """The phonemes of a .pfap file, read with pfaptextparse and named with GstPfap."""
+    pipeline = Gst.parse_launch("filesrc name=src ! pfaptextparse ! appsink name=sink sync=false")
     pipeline.get_by_name("src").set_property("location", str(path))
     sink = pipeline.get_by_name("sink")
     pipeline.set_state(Gst.State.PLAYING)
@@ -61,7 +61,7 @@ def receive(command):
     try:
         assert receiver.stdout.readline().startswith("listening on 127.0.0.1:%d" % port)
         sender = Gst.parse_launch(
-            "filesrc name=src ! pfapparse alphabet=" + GstPfap.ALPHABET_ARPABET +
+            "filesrc name=src ! pfaptextparse alphabet=" + GstPfap.ALPHABET_ARPABET +
             " ! rtppfappay ! udpsink host=127.0.0.1 port=%d" % port)
         sender.get_by_name("src").set_property("location", str(HELLO))
         sender.set_state(Gst.State.PLAYING)

@@ -343,8 +343,8 @@ def rss_kib(pid, field):
 
 
 def skip_opus_decoding():
-    """aiortc 1.4's Opus decoder takes only 20 ms frames and fails on pfap-web's 10 ms ones:
-    the audio is counted in RTP packets (the receiver's stats), not decoded."""
+    """The audio is counted in RTP packets (the receiver's stats), not decoded: decoding would
+    spend the CPU the load generator shares with the server it measures."""
     from aiortc.codecs import opus
     opus.OpusDecoder.decode = lambda self, frame: []
 

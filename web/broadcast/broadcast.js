@@ -15,6 +15,7 @@
 //
 // window.pfapStats holds the figures the browser test reads.
 import { PfapReceiver, Viseme, parseRtp } from '../src/index.js';
+import { decodeLevels } from '../live/clock.js';
 import { lipSyncErrors } from '../live/live.js';
 import { DrawnPhonemes, PlayoutClock, drawInTime, showCounts } from '../live/playout.js';
 
@@ -83,9 +84,11 @@ export function start({ canvas, audio, status, janusServer }) {
   const onMessage = (bytes) => {
     if (bytes[0] === JSON_FIRST_BYTE) {
       let m;
+      let levels = null;
       try {
         m = JSON.parse(decoder.decode(bytes));
         if (!Number.isInteger(m.ssrc)) throw new Error('no ssrc');
+        if (m.type === 'level') levels = decodeLevels(m.level);
       } catch (e) {
         // Dropped whole and counted; the stream goes on.
         if ((++stats.malformed & (stats.malformed - 1)) === 0) console.warn(`dropped malformed message ${stats.malformed}: ${e.message}`);
@@ -93,7 +96,7 @@ export function start({ canvas, audio, status, janusServer }) {
       }
       streamOf(m.ssrc, m.timestamp ?? 0);
       if (m.type === 'level') {
-        clock.sent.add(msOf(m.timestamp) * 1e6, m.rms);
+        clock.sent.add(msOf(m.timestamp) * 1e6, levels);
       } else if (m.type === 'clock') {
         stream.clocks.push({ arrived: performance.now(), ms: msOf(m.timestamp) });
         if (stream.clocks.length > 100) stream.clocks.splice(0, 50);

@@ -13,6 +13,7 @@
 //
 // window.pfapStats holds the figures the browser test reads.
 import { PfapReceiver, Viseme, parseRtp } from '../src/index.js';
+import { decodeLevels } from './clock.js';
 import { DrawnPhonemes, PlayoutClock, drawInTime, showCounts } from './playout.js';
 
 /**
@@ -199,7 +200,7 @@ export function start({ canvas, audio, form, input, status, saying }) {
     } else if (m.type === 'ice') {
       await pc.addIceCandidate({ candidate: m.candidate, sdpMLineIndex: m.sdpMLineIndex });
     } else if (m.type === 'envelope') {
-      clock.sent.add(m.runningTimeNs, m.rms);
+      clock.sent.add(m.runningTimeNs, decodeLevels(m.level));
     } else if (m.type === 'saying') {
       ++stats.texts;
       stats.sender = null;

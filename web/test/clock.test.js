@@ -4,7 +4,7 @@
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 
-import { SentLevel, matchLevels } from '../live/clock.js';
+import { SentLevel, decodeLevels, matchLevels } from '../live/clock.js';
 
 // "pa. pa. pa.": a sharp onset every 337 ms, a vowel that decays, silence between (S16 RMS).
 function speech(ms) {
@@ -66,4 +66,33 @@ test('matchLevels says nothing in silence, nor beyond its search range', () => {
   assert.equal(matchLevels(heardOf(levels, 0, 564, 714, 80), (ms) => sent.at(ms)), null);
   // Nothing sent there: no match.
   assert.equal(matchLevels(heardOf(levels, 0, 564, 714, 5), () => 0), null);
+});
+
+// The sender's code (tools/speech_level.h, encode_levels), for the round trip below.
+function encodeLevels(levels) {
+  const codes = levels.map((rms) => Math.min(255, Math.round(16 * Math.log2(1 + Math.max(rms, 0)))));
+  return Buffer.from(codes).toString('base64');
+}
+
+test('decodeLevels: one byte a millisecond, 16 codes an octave, base64', () => {
+  // Codes 0, 16, 160, 240 and 255: RMS 0, 1, 1023, 32767 and 2^(255/16) - 1.
+  assert.deepEqual(Array.from(decodeLevels('ABCg8P8=')), [0, 1, 1023, 32767, 2 ** (255 / 16) - 1]);
+  assert.deepEqual(Array.from(decodeLevels('')), []);
+  for (const rms of [1, 7, 100, 2500, 8000, 32767]) {
+    const back = decodeLevels(encodeLevels([rms]))[0];
+    assert.ok(Math.abs(back - rms) <= 0.022 * rms + 0.5, `${rms}: ${back}`);
+  }
+  assert.throws(() => decodeLevels([1, 2, 3]), TypeError);
+  assert.throws(() => decodeLevels(undefined), TypeError);
+  assert.throws(() => decodeLevels('not base64!'));
+});
+
+test('matchLevels finds the same lag in the level as the sender codes it', () => {
+  const levels = speech(2000);
+  const sent = new SentLevel();
+  sent.add(1000e6, decodeLevels(encodeLevels(levels)));
+  for (const lag of [-37.5, -12.3, 0, 4.6, 21]) {
+    const found = matchLevels(heardOf(levels, 1000, 1000 + 674 - 110, 1000 + 674 + 40, lag), (ms) => sent.at(ms));
+    assert.ok(found !== null && Math.abs(found - lag) < 0.5, `lag ${lag}: found ${found}`);
+  }
 });

@@ -31,7 +31,7 @@ namespace pfap {
 // The amplitude of each PFAP FAP index 3..74 in one frame; [0..2] unused.
 using FapAmplitudes = std::array<int32_t, kFapCount>;
 
-// The silence symbol of x-pfap-arpabet (phoneme_table.h), which fapparse announces.
+// The silence symbol of x-pfap-arpabet (phoneme_table.h), which pfapfapparse announces.
 inline constexpr uint8_t kSilenceSymbol = 0;
 
 // The start of frame `frame` in whole ms: frame / rate seconds, rounded to the nearest ms

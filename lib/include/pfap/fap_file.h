@@ -100,7 +100,7 @@ struct FapFile {
 class FapFileReader {
  public:
   // Reads one line, without its "\n" (a final '\r' is dropped). `has_frame` says whether the
-  // line completed a frame, now in `out`. On error the reader stays where it was.
+  // line finished a frame, now in `out`. On error the reader stays where it was.
   FapFileResult read_line(std::string_view line, FapFrame& out, bool& has_frame);
   // At the end of the input: an error if frames are missing.
   FapFileResult finish() const;

@@ -39,7 +39,7 @@ std::string_view to_string(MarksFormat format);
 // once at finish() for Rhubarb JSON (one document), per batch of frames for ARKit.
 class MarksWriter {
  public:
-  // Receives each piece of text as it is complete; returns false to stop writing.
+  // Receives each piece of text once it is written; returns false to stop writing.
   using Sink = std::function<bool(std::string_view)>;
 
   static constexpr size_t kMaxUtterancePhonemes = 4096;
@@ -56,7 +56,9 @@ class MarksWriter {
   // this half-open mouth, the nearest to pfapface's generic mouth.
   static constexpr VisemeSet kUnknownVisemes{Viseme::kE, OculusViseme::kE, 4, 14, 3};
 
-  MarksWriter(MarksFormat format, int frames_per_second);
+  // ARKit frames go at `rate_num` / `rate_den` frames a second (GStreamer's fractions, so
+  // that 30000/1001 is exact); the other formats have no frames.
+  MarksWriter(MarksFormat format, int rate_num, int rate_den = 1);
 
   // The alphabet of the phoneme symbols; nullptr when not known.
   void set_alphabet(const PhonemeAlphabet* alphabet) { alphabet_ = alphabet; }
@@ -93,7 +95,8 @@ class MarksWriter {
   int64_t first_frame_from(int64_t ns) const;
 
   MarksFormat format_;
-  int fps_;
+  int64_t rate_num_;
+  int64_t rate_den_;
   const PhonemeAlphabet* alphabet_ = nullptr;
   std::vector<Spoken> utterance_;
   uint64_t unknown_phonemes_ = 0;
