@@ -16,7 +16,7 @@ inline constexpr unsigned kMinRate = 16000;
 inline constexpr unsigned kMaxRate = 48000;
 
 // The level dimension: 0 for the loudest frame down to -kLevelWeight for kLevelRangeDb below
-// it or less (streaming.cc measures it below the utterance's loudest so far).
+// it or less (live.cc measures it below the utterance's loudest so far).
 inline constexpr float kLevelRangeDb = 50;
 inline constexpr float kLevelWeight = 6;
 

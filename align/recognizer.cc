@@ -150,7 +150,7 @@ SharedDecoder* shared_decoder(unsigned rate, std::string& error) {
 }  // namespace
 
 #if PFAP_HAVE_POCKETSPHINX
-// A decoder for live recognition, one StreamingRecognizer's at a time: its utterance lasts
+// A decoder for live recognition, one LiveRecognizer's at a time: its utterance lasts
 // over many calls, so it cannot take turns with others as the shared decoders do. Returned to
 // a pool per rate, never freed (as the shared ones). Fed in blocks, pocketsphinx normalizes
 // the cepstra by a running mean (its live CMN) that each use would carry into the next: the
@@ -319,7 +319,7 @@ bool recognize(std::span<const int16_t> audio, unsigned rate, Recognition& out,
 
 }  // namespace pfap::align
 
-// Live (StreamingRecognizer).
+// Live (LiveRecognizer).
 
 namespace pfap::align {
 namespace {
@@ -335,9 +335,9 @@ constexpr size_t kHalfF0Window = 512;
 
 }  // namespace
 
-StreamingRecognizer::~StreamingRecognizer() { release(); }
+LiveRecognizer::~LiveRecognizer() { release(); }
 
-void StreamingRecognizer::release() {
+void LiveRecognizer::release() {
 #if PFAP_HAVE_POCKETSPHINX
   if (decoder_ == nullptr) return;
   if (in_utterance_) ps_end_utt(decoder_->ps);
@@ -347,7 +347,7 @@ void StreamingRecognizer::release() {
   in_utterance_ = false;
 }
 
-bool StreamingRecognizer::start(unsigned rate, std::string& error) {
+bool LiveRecognizer::start(unsigned rate, std::string& error) {
   release();
   rate_ = rate;
   problem_ = RecognitionProblem::kNone;
@@ -372,7 +372,7 @@ bool StreamingRecognizer::start(unsigned rate, std::string& error) {
 #endif
 }
 
-std::vector<StreamingRecognizer::Segment> StreamingRecognizer::best_path() const {
+std::vector<LiveRecognizer::Segment> LiveRecognizer::best_path() const {
   std::vector<Segment> out;
 #if PFAP_HAVE_POCKETSPHINX
   const size_t n = samples();
@@ -386,7 +386,7 @@ std::vector<StreamingRecognizer::Segment> StreamingRecognizer::best_path() const
   return out;
 }
 
-void StreamingRecognizer::push(std::span<const int16_t> samples,
+void LiveRecognizer::push(std::span<const int16_t> samples,
                                std::vector<tts::SpokenPhoneme>& out) {
   audio_.insert(audio_.end(), samples.begin(), samples.end());
 #if PFAP_HAVE_POCKETSPHINX
@@ -398,7 +398,7 @@ void StreamingRecognizer::push(std::span<const int16_t> samples,
   step(false, out);
 }
 
-void StreamingRecognizer::finish(std::vector<tts::SpokenPhoneme>& out) {
+void LiveRecognizer::finish(std::vector<tts::SpokenPhoneme>& out) {
   step(true, out);
   if (!any_speech_ && problem_ == RecognitionProblem::kNone) {
     problem_ = loudest_db_ < kSpeechLevelDb ? RecognitionProblem::kNoSpeech
@@ -406,7 +406,7 @@ void StreamingRecognizer::finish(std::vector<tts::SpokenPhoneme>& out) {
   }
 }
 
-void StreamingRecognizer::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
+void LiveRecognizer::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
   const size_t n = samples();
   // The level of the audio since the last step (and a window before), for "silent".
   if (n > last_step_ && problem_ != RecognitionProblem::kBadRate) {
@@ -456,7 +456,7 @@ void StreamingRecognizer::step(bool at_end, std::vector<tts::SpokenPhoneme>& out
   }
 }
 
-void StreamingRecognizer::end_utterance(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
+void LiveRecognizer::end_utterance(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
   const size_t n = samples();
 #if PFAP_HAVE_POCKETSPHINX
   ps_end_utt(decoder_->ps);
@@ -484,7 +484,7 @@ void StreamingRecognizer::end_utterance(bool at_end, std::vector<tts::SpokenPhon
 #endif
 }
 
-void StreamingRecognizer::emit(uint8_t symbol, size_t to, bool whole, bool end_of_text,
+void LiveRecognizer::emit(uint8_t symbol, size_t to, bool whole, bool end_of_text,
                                std::vector<tts::SpokenPhoneme>& out) {
   if (to <= settled_) return;
   MarkupEvent e;

@@ -12,9 +12,9 @@
 #include <string_view>
 #include <vector>
 
+#include "live.h"  // kLookaheadMs, kHoldMs, kStepMs: the live bound, one for both modes
 #include "mfcc.h"
 #include "speech.h"
-#include "streaming.h"  // kLookaheadMs, kHoldMs, kStepMs: the live bound, one for both modes
 
 namespace pfap::align {
 
@@ -71,10 +71,10 @@ struct LiveDecoder;  // a pocketsphinx decoder of the live pool (recognizer.cc)
 // audio goes to pocketsphinx as it arrives, and after every kStepMs of it the best path so far
 // is traced back; a phone is settled, and given out, once it ends at least kLookaheadMs before
 // the newest audio, and a phone still going on kLookaheadMs + kHoldMs before it is given out
-// in pieces, as StreamingAligner does: the same bound. pocketsphinx's utterance restarts at a
+// in pieces, as LiveAligner does: the same bound. pocketsphinx's utterance restarts at a
 // pause once it is kRestartMs long (its history grows with it). docs/align.md, "Live without
 // the text".
-class StreamingRecognizer;
+class LiveRecognizer;
 
 // What pfapalign declares in the LATENCY query when it recognizes live: the bound, as with a
 // text (kLiveLatencyMs), and 300 ms more for the search's own work, which takes a quarter of
@@ -82,12 +82,12 @@ class StreamingRecognizer;
 // after their start by the clock on a lightly loaded machine (docs/align.md).
 inline constexpr unsigned kLiveRecognitionLatencyMs = kLiveLatencyMs + 300;
 
-class StreamingRecognizer {
+class LiveRecognizer {
  public:
-  StreamingRecognizer() = default;
-  StreamingRecognizer(const StreamingRecognizer&) = delete;
-  StreamingRecognizer& operator=(const StreamingRecognizer&) = delete;
-  ~StreamingRecognizer();
+  LiveRecognizer() = default;
+  LiveRecognizer(const LiveRecognizer&) = delete;
+  LiveRecognizer& operator=(const LiveRecognizer&) = delete;
+  ~LiveRecognizer();
 
   // Starts recognizing audio (mono, `rate` Hz). False with `error` when the model cannot be
   // loaded or the build has no recognizer; a rate outside kMinRate..kMaxRate is problem()

@@ -15,8 +15,9 @@ void sort_by_start(std::vector<UtteranceSpan>& utterances) {
 
 }  // namespace
 
-PhonemeSource phoneme_source(bool has_text) {
+PhonemeSource phoneme_source(bool has_text, Recognizer recognizer) {
   if (has_text) return PhonemeSource::kTexts;
+  if (recognizer == Recognizer::kVisemes) return PhonemeSource::kVisemes;
   return recognition_available() ? PhonemeSource::kRecognition : PhonemeSource::kPause;
 }
 
@@ -74,6 +75,101 @@ void append_s16le(std::span<const uint8_t> bytes, size_t max_count, std::vector<
   }
 }
 
+void KeptAudio::reset() {
+  samples_.clear();
+  overflowed_ = false;
+}
+
+bool KeptAudio::append(std::span<const uint8_t> bytes, unsigned rate) {
+  const size_t limit = size_t{kMaxAudioSeconds} * rate;
+  const size_t room = limit - std::min(samples_.size(), limit);
+  append_s16le(bytes, room, samples_);
+  if (bytes.size() / sizeof(int16_t) <= room || overflowed_) return false;
+  overflowed_ = true;
+  return true;
+}
+
+void TextQueue::reset() {
+  std::lock_guard guard(lock_);
+  texts_.clear();
+  ended_ = false;
+  flushing_ = false;
+}
+
+void TextQueue::add(PadText text) {
+  std::lock_guard guard(lock_);
+  texts_.push_back(std::move(text));
+}
+
+void TextQueue::end() {
+  {
+    std::lock_guard guard(lock_);
+    ended_ = true;
+  }
+  changed_.notify_all();
+}
+
+void TextQueue::clear() {
+  std::lock_guard guard(lock_);
+  texts_.clear();
+  ended_ = false;
+}
+
+void TextQueue::flush() {
+  {
+    std::lock_guard guard(lock_);
+    flushing_ = true;
+  }
+  changed_.notify_all();
+}
+
+bool TextQueue::ready(bool wait_for_end) {
+  std::unique_lock guard(lock_);
+  if (wait_for_end) changed_.wait(guard, [&] { return ended_ || flushing_; });
+  return !flushing_;
+}
+
+std::vector<PadText> TextQueue::take() {
+  std::lock_guard guard(lock_);
+  std::vector<PadText> taken;
+  taken.swap(texts_);
+  return taken;
+}
+
+void TextQueue::put_back(std::vector<PadText> texts) {
+  std::lock_guard guard(lock_);
+  texts_.insert(texts_.begin(), std::make_move_iterator(texts.begin()),
+                std::make_move_iterator(texts.end()));
+}
+
+template <typename Cut>
+std::vector<UtteranceSpan> TextQueue::take_cut(const ToSample& to_sample, Cut cut) {
+  std::vector<PadText> texts = take();
+  std::vector<TimedText> timed;
+  for (PadText& t : texts) timed.push_back({to_sample(t.running_time), std::move(t.bytes)});
+  std::vector<size_t> later;
+  std::vector<UtteranceSpan> utterances = cut(timed, later);
+  std::vector<PadText> waiting;
+  for (size_t i : later) waiting.push_back({texts[i].running_time, std::move(timed[i].bytes)});
+  put_back(std::move(waiting));
+  return utterances;
+}
+
+std::vector<UtteranceSpan> TextQueue::take_utterances(const ToSample& to_sample,
+                                                      const std::optional<std::string>& whole,
+                                                      size_t n, bool end_of_stream) {
+  return take_cut(to_sample, [&](std::vector<TimedText>& timed, std::vector<size_t>& later) {
+    return utterances_of(timed, whole, n, end_of_stream, later);
+  });
+}
+
+std::vector<UtteranceSpan> TextQueue::take_live_utterances(const ToSample& to_sample, size_t now,
+                                                           size_t end) {
+  return take_cut(to_sample, [&](std::vector<TimedText>& timed, std::vector<size_t>& later) {
+    return live_utterances_before(timed, now, end, later);
+  });
+}
+
 void LiveUtterances::reset() {
   open_ = false;
   samples_ = 0;
@@ -83,7 +179,7 @@ bool LiveUtterances::start_text(const tts::Utterance& utterance, const tts::Voic
                                 unsigned rate, std::string& error) {
   if (!aligner_.start(utterance, voice, rate, error)) return false;
   open_ = true;
-  recognizing_ = false;
+  kind_ = Kind::kText;
   from_ = samples_;
   return true;
 }
@@ -91,17 +187,30 @@ bool LiveUtterances::start_text(const tts::Utterance& utterance, const tts::Voic
 bool LiveUtterances::start_recognition(unsigned rate, std::string& error) {
   if (!recognizer_.start(rate, error)) return false;
   open_ = true;
-  recognizing_ = true;
+  kind_ = Kind::kRecognition;
   from_ = samples_;
   return true;
 }
 
+void LiveUtterances::start_visemes(unsigned rate) {
+  visemes_.emplace(rate, kLiveVisemeRunFrames);
+  open_ = true;
+  kind_ = Kind::kVisemes;
+  from_ = samples_;
+}
+
 void LiveUtterances::push(std::span<const int16_t> samples, std::vector<tts::SpokenPhoneme>& out) {
   const size_t first = out.size();
-  if (recognizing_) {
-    recognizer_.push(samples, out);
-  } else {
-    aligner_.push(samples, out);
+  switch (kind_) {
+    case Kind::kText:
+      aligner_.push(samples, out);
+      break;
+    case Kind::kRecognition:
+      recognizer_.push(samples, out);
+      break;
+    case Kind::kVisemes:
+      visemes_->push(samples, out);
+      break;
   }
   samples_ += samples.size();
   count_from_stream_start(out, first);
@@ -111,10 +220,16 @@ void LiveUtterances::end(std::vector<tts::SpokenPhoneme>& out) {
   if (!open_) return;
   open_ = false;
   const size_t first = out.size();
-  if (recognizing_) {
-    recognizer_.finish(out);
-  } else {
-    aligner_.finish(out);
+  switch (kind_) {
+    case Kind::kText:
+      aligner_.finish(out);
+      break;
+    case Kind::kRecognition:
+      recognizer_.finish(out);
+      break;
+    case Kind::kVisemes:
+      visemes_->finish(out);
+      break;
   }
   count_from_stream_start(out, first);
 }

@@ -6,23 +6,29 @@
 // (S16LE) as samples. docs/align.md, "Timeline and utterances".
 #pragma once
 
+#include <condition_variable>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "aligner.h"  // kMaxAudioSeconds
+#include "live.h"
 #include "recognizer.h"
-#include "streaming.h"
+#include "viseme_phonemes.h"
 
 namespace pfap::align {
 
 // Where a stream's phonemes come from, offline and live: its texts, when it has any; else the
-// audio alone, recognized (recognizer.h); else, in a build without the recognizer, one pause
-// (which the element warns about).
-enum class PhonemeSource { kTexts, kRecognition, kPause };
-PhonemeSource phoneme_source(bool has_text);
+// audio alone: by `recognizer`, pocketsphinx's phonemes (recognizer.h; in a build without it,
+// one pause, which the element warns about) or the viseme detector's (viseme_phonemes.h).
+enum class Recognizer { kPhonemes, kVisemes };
+enum class PhonemeSource { kTexts, kRecognition, kPause, kVisemes };
+PhonemeSource phoneme_source(bool has_text, Recognizer recognizer = Recognizer::kPhonemes);
 
 // One text: the sample it starts at, counted from the first sample kept (none: it has no
 // time, and continues the text before it offline or starts at the audio so far live), and its
@@ -64,15 +70,81 @@ std::vector<UtteranceSpan> live_utterances_before(std::vector<TimedText>& texts,
 // `max_count` of them.
 void append_s16le(std::span<const uint8_t> bytes, size_t max_count, std::vector<int16_t>& samples);
 
+// Offline: the audio kept for one alignment, at most kMaxAudioSeconds of it (aligner.h); the
+// rest is left out, and the element warns once.
+class KeptAudio {
+ public:
+  // Forgets the audio and the overflow.
+  void reset();
+  // Appends the S16LE `bytes` of audio at `rate` Hz, as much as the limit lets in. True the
+  // first time some of them are left out.
+  bool append(std::span<const uint8_t> bytes, unsigned rate);
+  const std::vector<int16_t>& samples() const { return samples_; }
+
+ private:
+  std::vector<int16_t> samples_;
+  bool overflowed_ = false;
+};
+
+// One buffer of the text pad: its start, a running time in ns (none: it continues the one
+// before), and its bytes.
+struct PadText {
+  std::optional<uint64_t> running_time;
+  std::string bytes;
+};
+
+// The text pad's buffers, from its thread to the audio's: offline, the alignment at the
+// audio's end waits for the text pad's end (its EOS) unless the stream flushes or stops.
+class TextQueue {
+ public:
+  // A new stream: no texts, not ended, not flushing.
+  void reset();
+  void add(PadText text);
+  // The text pad's EOS: every text is here.
+  void end();
+  // The text pad's flush: its texts dropped, and it has not ended.
+  void clear();
+  // The audio flushes or the element stops: waiting stops, until reset().
+  void flush();
+  // With `wait_for_end`, waits for end() or flush() first. False when flushing.
+  bool ready(bool wait_for_end);
+  // Takes the texts, in order.
+  std::vector<PadText> take();
+  // Puts `texts` (taken, for audio still to come) back before those added since.
+  void put_back(std::vector<PadText> texts);
+
+  // The sample a text's running time falls on (the element's timeline; none for none).
+  using ToSample = std::function<std::optional<size_t>(std::optional<uint64_t> running_time)>;
+  // Offline: utterances_of() over the texts taken; those for audio still to come stay.
+  std::vector<UtteranceSpan> take_utterances(const ToSample& to_sample,
+                                             const std::optional<std::string>& whole, size_t n,
+                                             bool end_of_stream);
+  // Live: live_utterances_before() over the texts taken; the others stay.
+  std::vector<UtteranceSpan> take_live_utterances(const ToSample& to_sample, size_t now,
+                                                  size_t end);
+
+ private:
+  // Takes the texts, cuts them with `cut` (which says which are `later`), puts those back.
+  template <typename Cut>
+  std::vector<UtteranceSpan> take_cut(const ToSample& to_sample, Cut cut);
+
+  std::mutex lock_;
+  std::condition_variable changed_;
+  std::vector<PadText> texts_;
+  bool ended_ = false;
+  bool flushing_ = false;
+};
+
 // Live: a stream's utterances, one open at a time, as its audio comes: each aligned to its
-// text (StreamingAligner) or, without a text, recognized to the stream's end
-// (StreamingRecognizer). Phoneme starts count from the stream's first sample.
+// text (LiveAligner) or, without a text, recognized to the stream's end (LiveRecognizer, or
+// the viseme detector: VisemePhonemes). Phoneme starts count from the stream's first sample.
 class LiveUtterances {
  public:
   // A new stream: nothing open, no audio yet.
   void reset();
   bool is_open() const { return open_; }
-  bool is_recognizing() const { return open_ && recognizing_; }
+  // The open utterance is pocketsphinx's (start_recognition()).
+  bool is_recognizing() const { return open_ && kind_ == Kind::kRecognition; }
   size_t samples() const { return samples_; }       // the audio so far
   size_t utterance_start() const { return from_; }  // the open utterance's first sample
 
@@ -84,6 +156,9 @@ class LiveUtterances {
   // Opens the recognizer's utterance at the audio so far (end() the open one first). False
   // with `error` where the model cannot be loaded.
   bool start_recognition(unsigned rate, std::string& error);
+  // Opens the viseme detector's utterance at the audio so far (end() the open one first), its
+  // runs in pieces of kLiveVisemeRunFrames.
+  void start_visemes(unsigned rate);
   // Gives `samples` to the open utterance; the phonemes now settled to `out`.
   void push(std::span<const int16_t> samples, std::vector<tts::SpokenPhoneme>& out);
   // Ends the open utterance, if any, at the audio so far: its last phonemes to `out`.
@@ -96,10 +171,12 @@ class LiveUtterances {
  private:
   void count_from_stream_start(std::vector<tts::SpokenPhoneme>& out, size_t first) const;
 
-  StreamingAligner aligner_;
-  StreamingRecognizer recognizer_;
+  enum class Kind { kText, kRecognition, kVisemes };
+  LiveAligner aligner_;
+  LiveRecognizer recognizer_;
+  std::optional<VisemePhonemes> visemes_;
   bool open_ = false;
-  bool recognizing_ = false;
+  Kind kind_ = Kind::kText;
   size_t from_ = 0;
   size_t samples_ = 0;
 };

@@ -2,7 +2,7 @@
 // A frame-level viseme detector for live audio without a text: the 15 Oculus visemes (the
 // MPEG-4 visemes with silence, pfap::Viseme) of each 10 ms frame, from MFCCs with 80 ms of
 // past and 40 ms ahead through a small network (align/viseme_model.txt, made by
-// tools/viseme-train), smoothed into runs. Streaming: push audio as it comes, take the runs
+// tools/viseme-train), smoothed into runs. Live: push audio as it comes, take the runs
 // that are settled; each needs at most kVisemeLookaheadMs of audio after its frames. No
 // GStreamer; web/src/viseme_detector.js is the same in JavaScript. docs/align.md, "A viseme
 // detector".
@@ -20,10 +20,8 @@
 
 namespace pfap::align {
 
-// The alphabet of the detector's phonemes: symbol k is Oculus viseme k (0 sil, 1 PP, 2 FF,
-// 3 TH, 4 DD, 5 kk, 6 CH, 7 SS, 8 nn, 9 RR, 10 aa, 11 E, 12 ih, 13 oh, 14 ou), which is
-// MPEG-4 viseme k (docs/visemes.md).
-inline constexpr std::string_view kOculusVisemeAlphabet = "x-pfap-oculus-viseme";
+// The detector's phonemes are of pfap::kOculusVisemeAlphabet: symbol k is Oculus viseme k,
+// which is MPEG-4 viseme k (docs/visemes.md).
 inline constexpr size_t kVisemeCount = 15;
 
 // The model's context: frames before and after the one it decides.
@@ -44,6 +42,20 @@ inline constexpr double kVisemeLookaheadMs =
     (kVisemeWindow - kVisemeWindowLead - kVisemeHop) * 1000.0 / kVisemeRate +
     (kVisemeAheadFrames + kSmoothFrames) * 10.0 + 2.25;
 static_assert(kVisemeLookaheadMs <= 60, "the detector looks at most 60 ms ahead");
+
+// Live (pfapalign live=true recognizer=visemes): runs go out in pieces of at most
+// kLiveVisemeRunFrames frames, so that a frame goes out once its piece's frames and the
+// lookahead have come: at most kLiveVisemeBoundMs after its start (a run is given out when
+// the next one's first frame is decided, or when it is a piece long). Smaller pieces: less
+// latency, more phonemes (at 3, 33 a second through a long pause). The latency pfapalign
+// declares adds kVisemeWorkMs for the work before the push (about 0.1 ms a 20 ms block,
+// docs/align.md) on a loaded machine, rounded up to a ms.
+inline constexpr size_t kLiveVisemeRunFrames = 3;
+inline constexpr double kLiveVisemeBoundMs = kLiveVisemeRunFrames * 10.0 + kVisemeLookaheadMs;
+inline constexpr double kVisemeWorkMs = 5;
+inline constexpr unsigned kLiveVisemeLatencyMs =
+    static_cast<unsigned>(kLiveVisemeBoundMs + kVisemeWorkMs + 0.999);
+static_assert(kLiveVisemeLatencyMs <= 100, "lips within 100 ms (issue 30)");
 
 // A run of frames showing one viseme: frames [start, start + frames), 10 ms each from the
 // stream's first sample.

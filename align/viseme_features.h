@@ -23,7 +23,7 @@ inline constexpr size_t kVisemeMfccs = 13;               // c0 (the level) .. c1
 inline constexpr unsigned kMinVisemeInputRate = 8000;    // the resampler's range
 inline constexpr unsigned kMaxVisemeInputRate = 192000;
 
-// A windowed-sinc resampler from `rate` to 16 kHz, streaming: low-pass at 0.45 of the lower
+// A windowed-sinc resampler from `rate` to 16 kHz, as the audio comes: low-pass at 0.45 of the lower
 // rate, 16 zero crossings of the filter each side (at most 2.25 ms of input ahead), one
 // table of filter phases. At 16 kHz it passes the samples through.
 class Resampler {
@@ -46,7 +46,7 @@ class Resampler {
   bool passthrough_ = true;
 };
 
-// MFCC frames of 16 kHz audio, streaming. Frame k stands for samples [160k, 160k + 160); its
+// MFCC frames of 16 kHz audio, as it comes. Frame k stands for samples [160k, 160k + 160); its
 // window is [160k - 120, 160k + 280), zeros before the stream's start and after its end.
 class MfccFrames {
  public:

@@ -14,8 +14,8 @@
 //   pfap-align-eval DIR NAME...      (tools/align-eval-festival makes DIR and runs this)
 // With PFAP_ALIGN_EVAL_VERBOSE set it prints both phoneme sequences with their starts in ms;
 // PFAP_ALIGN_EVAL_VOICE picks the espeak-ng voice (default "en"); with PFAP_ALIGN_EVAL_LIVE
-// set it aligns as pfapalign live=true does (align/streaming.h, the audio in 20 ms blocks) and
-// recognizes live too (StreamingRecognizer), beside the offline recognition; with
+// set it aligns as pfapalign live=true does (align/live.h, the audio in 20 ms blocks) and
+// recognizes live too (LiveRecognizer), beside the offline recognition; with
 // PFAP_ALIGN_EVAL_TEXT_ONLY set it leaves out the text-free modes (minutes of recognition);
 // PFAP_ALIGN_EVAL_LEAD_IN=S puts S seconds of silence before each recording (its truth moved
 // with it), for the first sound's start error (issue 31), printed beside the median and p90.
@@ -34,9 +34,9 @@
 
 #include "aligner.h"
 #include "command_line.h"
+#include "live.h"
 #include "pfap/phoneme_table.h"
 #include "recognizer.h"
-#include "streaming.h"
 #include "viseme_detector.h"
 #include "viseme_frames.h"
 #include "wav_file.h"
@@ -178,7 +178,7 @@ double percentile(std::vector<double> v, double p) {
 bool align_live(const pfap::tts::Utterance& utterance, const pfap::tts::VoiceSettings& voice,
                 const std::vector<int16_t>& samples, unsigned rate, pfap::align::Alignment& out,
                 std::string& error) {
-  pfap::align::StreamingAligner aligner;
+  pfap::align::LiveAligner aligner;
   if (!aligner.start(utterance, voice, rate, error)) return false;
   std::vector<pfap::tts::SpokenPhoneme> phonemes;
   const size_t block = rate / 50;
@@ -201,7 +201,7 @@ bool align_live(const pfap::tts::Utterance& utterance, const pfap::tts::VoiceSet
 // most audio that had come past what was given out, after any block.
 bool recognize_live(const std::vector<int16_t>& samples, unsigned rate,
                     pfap::align::Recognition& out, size_t& lag, std::string& error) {
-  pfap::align::StreamingRecognizer recognizer;
+  pfap::align::LiveRecognizer recognizer;
   if (!recognizer.start(rate, error)) return false;
   out = pfap::align::Recognition{};
   const size_t block = rate / 50;

@@ -10,5 +10,5 @@ static gboolean plugin_init(GstPlugin* plugin) { return GST_ELEMENT_REGISTER(pfa
 
 GST_PLUGIN_DEFINE(GST_VERSION_MAJOR, GST_VERSION_MINOR, pfapalign,
                   "PFAP from recorded speech: its text aligned (espeak-ng, aubio), or recognized "
-                  "without one (pocketsphinx)",
+                  "without one (pocketsphinx, or the viseme detector)",
                   plugin_init, VERSION, "LGPL", GST_PACKAGE_NAME, GST_PACKAGE_ORIGIN)

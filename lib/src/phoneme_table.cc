@@ -50,11 +50,19 @@ constexpr std::array<PhonemeInfo, 9> kRhubarbShapes{{
     {"H", V::kNL},
 }};
 
-constexpr std::array<PhonemeAlphabet, 4> kAlphabets{{
+// Symbol k is MPEG-4 viseme k: the identity, by Oculus's names.
+constexpr std::array<PhonemeInfo, 15> kOculusVisemes{{
+    {"sil", V::kNone}, {"PP", V::kPBM}, {"FF", V::kFV}, {"TH", V::kTH}, {"DD", V::kTD},
+    {"kk", V::kKG},    {"CH", V::kCh},  {"SS", V::kSZ}, {"nn", V::kNL}, {"RR", V::kR},
+    {"aa", V::kA},     {"E", V::kE},    {"ih", V::kI},  {"oh", V::kQ},  {"ou", V::kU},
+}};
+
+constexpr std::array<PhonemeAlphabet, 5> kAlphabets{{
     {kArpabetAlphabet, kArpabet},
     {kPollyVisemeAlphabet, kPollyVisemes},
     {kAzureVisemeAlphabet, kAzureVisemes},
     {kRhubarbShapeAlphabet, kRhubarbShapes},
+    {kOculusVisemeAlphabet, kOculusVisemes},
 }};
 
 }  // namespace

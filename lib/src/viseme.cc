@@ -93,15 +93,36 @@ constexpr std::array<OtherVisemes, 9> kRhubarb{{
     {14, t, H},
 }};
 
+// x-pfap-oculus-viseme: each viseme as the x-pfap-arpabet phoneme of OVRLipSync's example
+// word for it (sil, put, fat, think, tip, call, chair, sir, lot, red, car, bed, tip, toe, book).
+constexpr std::array<OtherVisemes, 15> kOculus{{
+    kArpabet[0],   // sil: pause
+    kArpabet[27],  // PP: P
+    kArpabet[14],  // FF: F
+    kArpabet[32],  // TH: TH
+    kArpabet[31],  // DD: T
+    kArpabet[20],  // kk: K
+    kArpabet[8],   // CH: CH
+    kArpabet[29],  // SS: S
+    kArpabet[21],  // nn: L
+    kArpabet[28],  // RR: R
+    kArpabet[1],   // aa: AA
+    kArpabet[11],  // E: EH
+    kArpabet[17],  // ih: IH
+    kArpabet[25],  // oh: OW
+    kArpabet[33],  // ou: UH
+}};
+
 struct Table {
   std::string_view alphabet;
   std::span<const OtherVisemes> rows;
 };
-constexpr std::array<Table, 4> kTables{{
+constexpr std::array<Table, 5> kTables{{
     {kArpabetAlphabet, kArpabet},
     {kPollyVisemeAlphabet, kPolly},
     {kAzureVisemeAlphabet, kAzure},
     {kRhubarbShapeAlphabet, kRhubarb},
+    {kOculusVisemeAlphabet, kOculus},
 }};
 
 constexpr std::array<std::string_view, kOculusVisemeCount> kOculusNames{

@@ -176,7 +176,7 @@ TEST(Recognizer, LongAudioIsDecodedInWindowsCutAtPauses) {
   }
 }
 
-// Live (StreamingRecognizer): the audio given in 20 ms blocks, as a microphone gives it.
+// Live (LiveRecognizer): the audio given in 20 ms blocks, as a microphone gives it.
 struct LiveRun {
   std::vector<tts::SpokenPhoneme> phonemes;
   RecognitionProblem problem = RecognitionProblem::kNone;
@@ -185,7 +185,7 @@ struct LiveRun {
 
 LiveRun recognized_live(const std::vector<int16_t>& audio, unsigned rate) {
   LiveRun run;
-  StreamingRecognizer recognizer;
+  LiveRecognizer recognizer;
   std::string error;
   EXPECT_TRUE(recognizer.start(rate, error)) << error;
   const size_t block = rate / 50;
@@ -198,7 +198,7 @@ LiveRun recognized_live(const std::vector<int16_t>& audio, unsigned rate) {
   return run;
 }
 
-// The bound the live modes state (streaming.h), and one 20 ms block.
+// The bound the live modes state (live.h), and one 20 ms block.
 size_t live_bound(unsigned rate) {
   return size_t{kLookaheadMs + kHoldMs + kStepMs} * rate / 1000 + rate / 50;
 }

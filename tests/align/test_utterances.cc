@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // pfapalign's cutting of the audio into utterances (align/utterances.h), offline and live,
-// and its reading of S16LE.
+// its reading of S16LE, the audio it keeps offline and the text pad's queue.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "recognizer.h"
@@ -41,6 +43,11 @@ TEST(Utterances, TextsComeFirstThenTheRecognizerThenAPause) {
   EXPECT_EQ(pfap::align::phoneme_source(false), pfap::align::recognition_available()
                                                     ? PhonemeSource::kRecognition
                                                     : PhonemeSource::kPause);
+  // recognizer=visemes: the detector, in any build, and only without a text.
+  EXPECT_EQ(pfap::align::phoneme_source(false, pfap::align::Recognizer::kVisemes),
+            PhonemeSource::kVisemes);
+  EXPECT_EQ(pfap::align::phoneme_source(true, pfap::align::Recognizer::kVisemes),
+            PhonemeSource::kTexts);
 }
 
 TEST(Utterances, NoTextAtAllIsToBeRecognized) {
@@ -111,6 +118,90 @@ TEST(Utterances, S16leIsLittleEndianSignedAndCapped) {
   EXPECT_EQ(samples, (std::vector<int16_t>{7, 1, -1, -32768, 32767}));  // the odd byte left out
   pfap::align::append_s16le(bytes, 2, samples);
   EXPECT_EQ(samples, (std::vector<int16_t>{7, 1, -1, -32768, 32767, 1, -1}));
+}
+
+TEST(Utterances, KeptAudioStopsAtTheLimitAndSaysSoOnce) {
+  pfap::align::KeptAudio kept;
+  constexpr unsigned kRate = 100;  // the limit: kMaxAudioSeconds * 100 samples
+  const size_t limit = size_t{pfap::align::kMaxAudioSeconds} * kRate;
+  const std::vector<uint8_t> second(2 * kRate, 0x01);  // 0x0101 each
+  for (size_t i = 0; i + 1 < pfap::align::kMaxAudioSeconds; ++i) {
+    EXPECT_FALSE(kept.append(second, kRate));
+  }
+  const std::vector<uint8_t> more(2 * kRate + 3, 0x02);  // one second, a sample and a byte
+  EXPECT_TRUE(kept.append(more, kRate));
+  EXPECT_FALSE(kept.append(more, kRate));  // said once
+  ASSERT_EQ(kept.samples().size(), limit);
+  EXPECT_EQ(kept.samples().front(), 0x0101);
+  EXPECT_EQ(kept.samples().back(), 0x0202);
+  kept.reset();
+  EXPECT_TRUE(kept.samples().empty());
+  EXPECT_FALSE(kept.append(second, kRate));
+  EXPECT_EQ(kept.samples().size(), kRate);
+}
+
+TEST(Utterances, TextQueueKeepsOrderAndWaitsForTheEndOrAFlush) {
+  using pfap::align::PadText;
+  pfap::align::TextQueue queue;
+  EXPECT_TRUE(queue.ready(false));
+  queue.add({std::nullopt, "a"});
+  queue.add({7, "b"});
+  std::vector<PadText> taken = queue.take();
+  ASSERT_EQ(taken.size(), 2u);
+  queue.add({9, "c"});
+  queue.put_back({std::move(taken[1])});  // "b" before "c", added since
+  taken = queue.take();
+  ASSERT_EQ(taken.size(), 2u);
+  EXPECT_EQ(taken[0].bytes, "b");
+  EXPECT_EQ(taken[0].running_time, 7u);
+  EXPECT_EQ(taken[1].bytes, "c");
+  EXPECT_TRUE(queue.take().empty());
+
+  // The wait ends at the text pad's end, from another thread.
+  std::thread ender([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    queue.add({std::nullopt, "last"});
+    queue.end();
+  });
+  EXPECT_TRUE(queue.ready(true));
+  ender.join();
+  EXPECT_EQ(queue.take().size(), 1u);
+  // The text pad's flush: not ended any more, its texts gone.
+  queue.add({std::nullopt, "dropped"});
+  queue.clear();
+  EXPECT_TRUE(queue.take().empty());
+
+  // A flush ends the wait, false, until reset().
+  std::thread flusher([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    queue.flush();
+  });
+  EXPECT_FALSE(queue.ready(true));
+  flusher.join();
+  EXPECT_FALSE(queue.ready(false));
+  queue.reset();
+  EXPECT_TRUE(queue.ready(false));
+}
+
+// The queue cuts its texts as utterances_of() and live_utterances_before() do, at the samples
+// the element's timeline gives, and keeps those for audio still to come, in order.
+TEST(Utterances, TextQueueCutsItsTextsAndKeepsThoseStillToCome) {
+  pfap::align::TextQueue queue;
+  const auto to_sample = [](std::optional<uint64_t> t) -> std::optional<size_t> {
+    if (!t) return std::nullopt;
+    return static_cast<size_t>(*t / 10);
+  };
+  queue.add({1000, "first"});
+  queue.add({std::nullopt, " more"});
+  queue.add({5000, "later"});
+  queue.add({7000, "last"});
+  expect_spans(queue.take_utterances(to_sample, std::nullopt, 300, false),
+               {{0, 100, "", false}, {100, 300, "first more", true}});
+  // Live: from the audio so far (400), those starting before 600.
+  expect_spans(queue.take_live_utterances(to_sample, 400, 600), {{500, 600, "later", true}});
+  expect_spans(queue.take_utterances(to_sample, std::nullopt, 800, true),
+               {{0, 700, "", false}, {700, 800, "last", true}});
+  EXPECT_TRUE(queue.take().empty());
 }
 
 TEST(Utterances, LivePhonemesCountFromTheStreamsStartAndTileIt) {

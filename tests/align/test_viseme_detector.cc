@@ -2,7 +2,8 @@
 // The frame-level viseme detector (align/viseme_detector.h): agreement with espeak-ng's own
 // phoneme times on sentences in a voice it was not trained on, the runs tiling the audio
 // whatever the blocks, the lookahead it declares, and bad input (silence, noise, clipping,
-// other rates, a broken model) giving a clear result in bounded work.
+// other rates, a broken model) giving a clear result in bounded work; and its runs as
+// pfapalign's phonemes (align/viseme_phonemes.h), with the live bound they keep.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include "speech_fixtures.h"
 #include "viseme_detector.h"
 #include "viseme_frames.h"
+#include "viseme_phonemes.h"
 
 namespace pfap::align {
 namespace {
@@ -200,6 +202,96 @@ TEST(VisemeDetector, ClippedAndResampledSpeechStillAgrees) {
     }
   }
   std::printf("\n");
+}
+
+// The phonemes of `samples` by VisemePhonemes, pushed in blocks of `block` samples; with
+// `pushed_at`, for each phoneme the samples pushed when it came out.
+std::vector<tts::SpokenPhoneme> viseme_phonemes(std::span<const int16_t> samples, unsigned rate,
+                                                size_t block, size_t max_run_frames,
+                                                std::vector<size_t>* pushed_at = nullptr) {
+  VisemePhonemes visemes(rate, max_run_frames);
+  std::vector<tts::SpokenPhoneme> out;
+  for (size_t i = 0; i < samples.size(); i += block) {
+    const size_t n = std::min(block, samples.size() - i);
+    visemes.push(samples.subspan(i, n), out);
+    if (pushed_at != nullptr) pushed_at->resize(out.size(), i + n);
+  }
+  visemes.finish(out);
+  if (pushed_at != nullptr) pushed_at->resize(out.size(), samples.size());
+  return out;
+}
+
+// Each 10 ms frame's viseme, by the phoneme holding the frame's middle.
+std::vector<Viseme> frames_of(const std::vector<tts::SpokenPhoneme>& phonemes, unsigned rate) {
+  std::vector<Viseme> out;
+  for (const tts::SpokenPhoneme& p : phonemes) {
+    while ((out.size() * rate + rate / 200) / 100 < p.start + p.n_samples) {
+      out.push_back(static_cast<Viseme>(p.event.phoneme.symbol));
+    }
+  }
+  return out;
+}
+
+TEST(VisemePhonemes, TheRunsAsPhonemesTilingTheAudioOfflineAndLive) {
+  const Spoken s = spoken(kSentences[0]);
+  const std::vector<Viseme> runs = frames_of(detect(s.samples, s.rate, s.samples.size()));
+  // Offline: one phoneme a run; live: pieces of at most kLiveVisemeRunFrames, the same frames.
+  for (const size_t max_run : {size_t{0}, kLiveVisemeRunFrames}) {
+    SCOPED_TRACE(max_run);
+    const std::vector<tts::SpokenPhoneme> phonemes =
+        viseme_phonemes(s.samples, s.rate, s.rate / 50, max_run);
+    testing::expect_tiles(phonemes, s.samples.size(), s.rate);
+    const std::vector<Viseme> frames = frames_of(phonemes, s.rate);
+    ASSERT_EQ(frames.size(), runs.size());
+    EXPECT_EQ(frames, runs);
+    for (size_t k = 0; k < phonemes.size(); ++k) {
+      const tts::SpokenPhoneme& p = phonemes[k];
+      EXPECT_LT(p.event.phoneme.symbol, kVisemeCount);
+      const bool after_pause = k == 0 || phonemes[k - 1].event.phoneme.symbol == 0;
+      EXPECT_EQ(p.event.phoneme.word_begin, p.event.phoneme.symbol != 0 && after_pause) << k;
+      if (max_run > 0 && k + 1 < phonemes.size()) {
+        EXPECT_LE(p.n_samples, max_run * s.rate / 100 + 1) << k;
+      }
+    }
+  }
+}
+
+// Every phoneme comes out once kLiveVisemeBoundMs of audio has come after its start, whatever
+// the block (plus the block: the push that completes that audio); at 16 kHz and through the
+// resampler.
+TEST(VisemePhonemes, LiveEachPhonemeWithinTheBoundAfterItsStart) {
+  const Spoken s = spoken(kSentences[1]);
+  for (const unsigned rate : {16000u, 22050u}) {
+    const std::vector<int16_t> audio = testing::resample(s.samples, s.rate, rate);
+    for (const size_t block_ms : {1u, 10u, 20u}) {
+      SCOPED_TRACE(std::to_string(rate) + " Hz, " + std::to_string(block_ms) + " ms blocks");
+      std::vector<size_t> pushed_at;
+      const std::vector<tts::SpokenPhoneme> phonemes =
+          viseme_phonemes(audio, rate, rate * block_ms / 1000, kLiveVisemeRunFrames, &pushed_at);
+      double most = 0;
+      for (size_t k = 0; k + 1 < phonemes.size(); ++k) {  // the last comes at the end
+        const double ms = 1000.0 * static_cast<double>(pushed_at[k] - phonemes[k].start) / rate;
+        most = std::max(most, ms);
+      }
+      std::printf("%u Hz, %zu ms blocks: %zu phonemes, out at most %.2f ms after their start\n",
+                  rate, block_ms, phonemes.size(), most);
+      EXPECT_LE(most, kLiveVisemeBoundMs + static_cast<double>(block_ms) + 0.1);
+    }
+  }
+}
+
+TEST(VisemePhonemes, ARateTheDetectorCannotTakeIsPausesAsTheAudioComes) {
+  EXPECT_FALSE(visemes_take_rate(4000));
+  EXPECT_TRUE(visemes_take_rate(8000));
+  const std::vector<int16_t> audio(4000, 1000);  // 1 s at 4 kHz
+  std::vector<size_t> pushed_at;
+  const std::vector<tts::SpokenPhoneme> phonemes =
+      viseme_phonemes(audio, 4000, 80, kLiveVisemeRunFrames, &pushed_at);
+  testing::expect_tiles(phonemes, audio.size(), 4000);
+  for (size_t k = 0; k < phonemes.size(); ++k) {
+    EXPECT_EQ(phonemes[k].event.phoneme.symbol, 0);
+    EXPECT_EQ(pushed_at[k], phonemes[k].start + phonemes[k].n_samples);  // at once
+  }
 }
 
 TEST(VisemeDetector, RatesOutsideTheRangeAreTakenAsTheNearest) {

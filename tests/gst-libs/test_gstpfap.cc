@@ -189,6 +189,15 @@ TEST(GstPfapAlphabet, ArpabetMapsSymbolsToNamesAndVisemes) {
   EXPECT_FALSE(gst_pfap_alphabet_lookup_symbol(arpabet, "QQ", &symbol));
 }
 
+// pfapalign recognizer=visemes's alphabet: symbol k is MPEG-4 viseme k.
+TEST(GstPfapAlphabet, TheVisemeDetectorsAlphabetIsKnown) {
+  const GstPfapAlphabet* oculus = gst_pfap_alphabet_find("x-pfap-oculus-viseme");
+  ASSERT_NE(oculus, nullptr);
+  EXPECT_EQ(gst_pfap_alphabet_get_n_symbols(oculus), 15u);
+  EXPECT_STREQ(gst_pfap_alphabet_get_phoneme_name(oculus, 1), "PP");
+  for (guint8 k = 0; k < 15; ++k) EXPECT_EQ(gst_pfap_alphabet_get_viseme(oculus, k), k);
+}
+
 TEST(GstPfapBookmark, ParsesExpressionsAndFormatsTheTransformedForm) {
   GError* raw = nullptr;
   g_autolist(GstPfapFap) faps = gst_pfap_bookmarks_parse(

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// What the parsers' base class (GstPfapBaseParse) does for each of its parsers, pfapparse,
-// pfapmarksparse and fapparse, from one table: the text in any chunks, line ends and a byte
+// What the parsers' base class (GstPfapBaseParse) does for each of its parsers, pfaptextparse,
+// pfapmarksparse and pfapfapparse, from one table: the text in any chunks, line ends and a byte
 // order mark; the longest line; what an error stops; the source file in messages. Each
 // parser's own format is tested in test_pfapparse.cc, test_marks.cc and test_fapfile.cc.
 #include <gst/check/gstharness.h>
@@ -42,13 +42,13 @@ struct Reader {
 
 const std::vector<Reader>& readers() {
   static const std::vector<Reader> rows = {
-      {"pfapparse", {"0 1 20 100 -", "20 2 20 100 -", "40 3 20 100 E"}, "60 x"},
+      {"pfaptextparse", {"0 1 20 100 -", "20 2 20 100 -", "40 3 20 100 E"}, "60 x"},
       {"pfapmarksparse format=polly",
        {"{\"time\":0,\"type\":\"viseme\",\"value\":\"p\"}",
         "{\"time\":100,\"type\":\"viseme\",\"value\":\"a\"}",
         "{\"time\":250,\"type\":\"viseme\",\"value\":\"sil\"}"},
        "{\"time\":300"},
-      {"fapparse", {"2.1 t 25 2", fap_mask(), "0 5", fap_mask(), "1 7"}, "x"},
+      {"pfapfapparse", {"2.1 t 25 2", fap_mask(), "0 5", fap_mask(), "1 7"}, "x"},
   };
   return rows;
 }
@@ -127,7 +127,7 @@ TEST(Parsers, AnyChunksLineEndsAndByteOrderMarkGiveTheSameEvents) {
 }
 
 // The limit counts a line's bytes without its line end, "\r\n" as "\n": a blank line of 64 KiB
-// is read with either, one byte more is a bad line. (pfapparse and pfapmarksparse counted the
+// is read with either, one byte more is a bad line. (pfaptextparse and pfapmarksparse counted the
 // '\r' of a "\r\n".)
 TEST(Parsers, TheLongestLineIsTheSameWithEitherLineEnd) {
   for (const Reader& r : readers()) {
@@ -152,7 +152,7 @@ TEST(Parsers, TheLongestLineIsTheSameWithEitherLineEnd) {
 }
 
 // A bad line without skip-bad-lines stops the stream: nothing after it is read, the buffers
-// after it are refused, and EOS still goes downstream. (pfapparse and pfapmarksparse read on
+// after it are refused, and EOS still goes downstream. (pfaptextparse and pfapmarksparse read on
 // from the next buffer.)
 TEST(Parsers, AfterAnErrorNothingMoreIsRead) {
   for (const Reader& r : readers()) {
@@ -170,7 +170,7 @@ TEST(Parsers, AfterAnErrorNothingMoreIsRead) {
       ++buffers;
       gst_buffer_unref(b);
     }
-    // pfapparse's first line is an event; the others' first lines give none alone.
+    // pfaptextparse's first line is an event; the others' first lines give none alone.
     EXPECT_LE(buffers, 1u);
     bool eos = false;
     while (GstEvent* e = gst_harness_try_pull_event(h.harness())) {

@@ -41,6 +41,7 @@ struct Result {
   std::vector<int16_t> audio;
   std::vector<Event> events;
   std::vector<std::string> warnings;
+  std::string alphabet;  // of `pfap`'s caps
 };
 
 std::string caps_at(unsigned rate, int channels = 1) {
@@ -57,15 +58,19 @@ pfap::tts::Speech say(const std::string& text, int rate = 140, int pitch = 30) {
   return s;
 }
 
-// Runs pfapalign (espeak-ng voice `voice`) over `samples` at `rate` with the `text` property
-// (nullptr: none), or, when `texts` is not empty, with those (PTS, text) buffers on text_sink.
+// Runs pfapalign (espeak-ng voice `voice`, `recognizer` unless nullptr) over `samples` at
+// `rate` with the `text` property (nullptr: none), or, when `texts` is not empty, with those
+// (PTS, text) buffers on text_sink.
 Result run(const std::vector<int16_t>& samples, unsigned rate, const char* text,
            const std::vector<std::pair<GstClockTime, std::string>>& texts = {},
-           const char* voice = "en", bool live = false) {
+           const char* voice = "en", bool live = false, const char* recognizer = nullptr) {
   GstHarness* h = gst_harness_new_with_padnames("pfapalign", "sink", "src");
-  if (live) {  // read when the element goes to PAUSED
+  if (live || recognizer != nullptr) {  // read when the element goes to PAUSED
     gst_element_set_state(h->element, GST_STATE_READY);
-    g_object_set(h->element, "live", TRUE, nullptr);
+    if (live) g_object_set(h->element, "live", TRUE, nullptr);
+    if (recognizer != nullptr) {
+      gst_util_set_object_arg(G_OBJECT(h->element), "recognizer", recognizer);
+    }
     gst_element_set_state(h->element, GST_STATE_PLAYING);
   }
   GstHarness* pfap = gst_harness_new_with_element(h->element, nullptr, "pfap");
@@ -118,6 +123,13 @@ Result run(const std::vector<int16_t>& samples, unsigned rate, const char* text,
     g_error_free(error);
     gst_message_unref(m);
   }
+  GstPad* pfap_pad = gst_element_get_static_pad(h->element, "pfap");
+  if (GstCaps* caps = gst_pad_get_current_caps(pfap_pad)) {
+    const gchar* alphabet = gst_structure_get_string(gst_caps_get_structure(caps, 0), "alphabet");
+    r.alphabet = alphabet != nullptr ? alphabet : "";
+    gst_caps_unref(caps);
+  }
+  gst_object_unref(pfap_pad);
   gst_bus_set_flushing(bus, TRUE);
   if (t != nullptr) gst_harness_teardown(t);
   gst_harness_teardown(pfap);
@@ -401,6 +413,94 @@ TEST(PfapAlign, WaitForTheTextsEosEndsWithTheStream) {
   gst_harness_teardown(h);
 }
 
+// recognizer=visemes without a text: the detector's phonemes of the whole audio at its end,
+// in its alphabet; with a text, the text is aligned as without the property.
+TEST(PfapAlign, VisemesWithoutTextAndTheTextWhenThereIsOne) {
+  const pfap::tts::Speech truth = say(kText);
+  const GstClockTime end =
+      gst_util_uint64_scale(truth.samples.size(), GST_SECOND, truth.sample_rate);
+  const Result visemes = run(truth.samples, truth.sample_rate, nullptr, {}, "en", false, "visemes");
+  EXPECT_EQ(visemes.alphabet, "x-pfap-oculus-viseme");
+  EXPECT_EQ(visemes.audio, truth.samples);
+  EXPECT_TRUE(visemes.warnings.empty()) << visemes.warnings.front();
+  expect_tiles(visemes, end);
+  std::set<int> seen;
+  for (const Event& e : visemes.events) {
+    EXPECT_LT(e.event.phoneme.symbol, 15);
+    seen.insert(e.event.phoneme.symbol);
+  }
+  EXPECT_GT(seen.size(), 5u) << "speech is heard as several visemes";
+  // Smoothed runs, about ten a second, not a phoneme every frame.
+  EXPECT_LT(visemes.events.size(), truth.samples.size() * 20 / truth.sample_rate);
+
+  const Result text = run(truth.samples, truth.sample_rate, kText, {}, "en", false, "visemes");
+  EXPECT_EQ(text.alphabet, "x-pfap-arpabet");
+  ASSERT_EQ(text.events.size(), truth.phonemes.size());
+  for (size_t k = 0; k < text.events.size(); ++k) {
+    EXPECT_EQ(text.events[k].event.phoneme.symbol, truth.phonemes[k].event.phoneme.symbol);
+  }
+}
+
+// Below the detector's 8 kHz: a warning, and the audio is pauses.
+TEST(PfapAlign, VisemesAtARateTheDetectorCannotTakeWarnAndArePauses) {
+  const std::vector<int16_t> audio(6000, 1000);  // 1 s at 6 kHz
+  const Result r = run(audio, 6000, nullptr, {}, "en", false, "visemes");
+  EXPECT_TRUE(has_warning(r, "viseme detector cannot take it")) << r.warnings.size();
+  expect_tiles(r, GST_SECOND);
+  for (const Event& e : r.events) EXPECT_EQ(e.event.phoneme.symbol, 0);
+}
+
+// A push of phonemes at the audio's EOS that fails (here `pfap`'s peer refuses them) is posted
+// as an error, offline and live: the event function cannot return it, and it was lost.
+TEST(PfapAlign, AFailedPushAtTheEndIsPostedAsAnError) {
+  const pfap::tts::Speech truth = say(kText);
+  for (const bool live : {false, true}) {
+    SCOPED_TRACE(live ? "live" : "offline");
+    GstHarness* h = gst_harness_new_with_padnames("pfapalign", "sink", "src");
+    if (live) {  // read when the element goes to PAUSED
+      gst_element_set_state(h->element, GST_STATE_READY);
+      g_object_set(h->element, "live", TRUE, nullptr);
+      gst_element_set_state(h->element, GST_STATE_PLAYING);
+    }
+    GstPad* refusing = gst_pad_new("refusing", GST_PAD_SINK);
+    gst_pad_set_chain_function(refusing, [](GstPad*, GstObject*, GstBuffer* b) {
+      gst_buffer_unref(b);
+      return GST_FLOW_NOT_NEGOTIATED;
+    });
+    gst_pad_set_event_function(refusing, [](GstPad*, GstObject*, GstEvent* e) -> gboolean {
+      gst_event_unref(e);
+      return TRUE;
+    });
+    gst_pad_set_active(refusing, TRUE);
+    GstPad* pfap = gst_element_get_static_pad(h->element, "pfap");
+    ASSERT_EQ(gst_pad_link(pfap, refusing), GST_PAD_LINK_OK);
+    GstBus* bus = gst_bus_new();
+    gst_element_set_bus(h->element, bus);
+    g_object_set(h->element, "text", kText, nullptr);
+    gst_harness_set_src_caps_str(h, caps_at(truth.sample_rate).c_str());
+    // Live, 100 ms: the phonemes settle later than this, all of them at the EOS.
+    const size_t n = live ? truth.sample_rate / 10 : truth.samples.size();
+    EXPECT_EQ(gst_harness_push(h, gst_buffer_new_memdup(truth.samples.data(), n * 2)), GST_FLOW_OK);
+    gst_harness_push_event(h, gst_event_new_eos());
+    GstMessage* m = gst_bus_pop_filtered(bus, GST_MESSAGE_ERROR);
+    ASSERT_NE(m, nullptr);
+    GError* error = nullptr;
+    gchar* debug = nullptr;
+    gst_message_parse_error(m, &error, &debug);
+    EXPECT_TRUE(g_error_matches(error, GST_STREAM_ERROR, GST_STREAM_ERROR_FAILED));
+    EXPECT_NE(std::string(debug).find("not-negotiated"), std::string::npos) << debug;
+    g_error_free(error);
+    g_free(debug);
+    gst_message_unref(m);
+    gst_bus_set_flushing(bus, TRUE);
+    gst_harness_teardown(h);
+    gst_pad_set_active(refusing, FALSE);
+    gst_object_unref(refusing);
+    gst_object_unref(pfap);
+    gst_object_unref(bus);
+  }
+}
+
 // The launch lines of docs/elements.md's pfapalign section, each run on a WAV pfaptts makes;
 // the live one (live=true, RTP in and out) is run by test_pfapalign_live.
 std::vector<std::string> documented_commands() {
@@ -432,7 +532,7 @@ size_t file_size(const std::string& path) {
 
 TEST(PfapAlignDocumented, EveryCommandRuns) {
   const std::vector<std::string> commands = documented_commands();
-  ASSERT_EQ(commands.size(), 4u);
+  ASSERT_EQ(commands.size(), 5u);
   const pfap::testing::TempDir dir;
   const std::string text =
       "Please call Stella. Ask her to bring these things with her from the store.";
@@ -474,6 +574,12 @@ TEST(PfapAlignDocumented, EveryCommandRuns) {
   // Recognized phonemes, or one pause where the build cannot recognize.
   EXPECT_GT(std::count(without_text.begin(), without_text.end(), '\n'),
             pfap::align::recognition_available() ? 30 : 0);
+  ASSERT_EQ(run_line(commands[4], dir), "") << commands[4];
+  // The viseme detector's, in every build: runs of its 15 visemes.
+  const std::vector<std::string> visemes = symbols(read("speech.pfap"));
+  EXPECT_GT(visemes.size(), 20u);
+  EXPECT_TRUE(std::all_of(visemes.begin(), visemes.end(),
+                          [](const std::string& v) { return std::stoi(v) < 15; }));
 }
 
 }  // namespace

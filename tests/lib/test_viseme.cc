@@ -32,10 +32,11 @@ VisemeSet visemes(std::string_view alphabet_name, std::string_view phoneme) {
 }
 
 constexpr std::string_view kAlphabets[] = {kArpabetAlphabet, kPollyVisemeAlphabet,
-                                           kAzureVisemeAlphabet, kRhubarbShapeAlphabet};
+                                           kAzureVisemeAlphabet, kRhubarbShapeAlphabet,
+                                           kOculusVisemeAlphabet};
 
 TEST(Viseme, EverySymbolOfEveryAlphabetHasAVisemeInEachSet) {
-  const size_t sizes[] = {40, 17, 22, 9};
+  const size_t sizes[] = {40, 17, 22, 9, 15};
   for (size_t a = 0; a < std::size(kAlphabets); ++a) {
     const PhonemeAlphabet& table = alphabet(kAlphabets[a]);
     ASSERT_EQ(table.symbols.size(), sizes[a]) << kAlphabets[a];
@@ -70,6 +71,23 @@ TEST(Viseme, VisemeAlphabetsMapToThemselves) {
   const PhonemeAlphabet& rhubarb = alphabet(kRhubarbShapeAlphabet);
   for (uint8_t s = 0; s < rhubarb.symbols.size(); ++s) {
     EXPECT_EQ(find_visemes(rhubarb, s)->rhubarb, s);
+  }
+  // x-pfap-oculus-viseme: symbol k is Oculus (and MPEG-4) viseme k, by Oculus's name.
+  const PhonemeAlphabet& oculus = alphabet(kOculusVisemeAlphabet);
+  for (uint8_t s = 0; s < oculus.symbols.size(); ++s) {
+    EXPECT_EQ(static_cast<int>(find_visemes(oculus, s)->oculus), s);
+    EXPECT_EQ(oculus.symbols[s].name, oculus_name(OculusViseme(s)));
+  }
+  // Its other columns are those of the phoneme of OVRLipSync's example word.
+  const PhonemeAlphabet& arpabet = alphabet(kArpabetAlphabet);
+  const struct {
+    const char* viseme;
+    const char* phoneme;
+  } examples[] = {{"PP", "P"}, {"nn", "L"}, {"oh", "OW"}, {"ou", "UH"}};
+  for (const auto& e : examples) {
+    EXPECT_EQ(find_visemes(oculus, *find_symbol(oculus, e.viseme)),
+              find_visemes(arpabet, *find_symbol(arpabet, e.phoneme)))
+        << e.viseme;
   }
 }
 

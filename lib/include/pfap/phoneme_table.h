@@ -54,6 +54,9 @@ inline constexpr std::string_view kPollyVisemeAlphabet = "x-pfap-polly-viseme";
 inline constexpr std::string_view kAzureVisemeAlphabet = "x-pfap-azure-viseme";
 // Rhubarb Lip Sync mouth shapes: 0 X (rest), then A..H (1..8).
 inline constexpr std::string_view kRhubarbShapeAlphabet = "x-pfap-rhubarb-shape";
+// The viseme detector's (pfapalign recognizer=visemes, pfap.js): symbol k is Oculus viseme k,
+// which is MPEG-4 viseme k: 0 sil, then PP FF TH DD kk CH SS nn RR aa E ih oh ou (1..14).
+inline constexpr std::string_view kOculusVisemeAlphabet = "x-pfap-oculus-viseme";
 
 // The alphabet called `name`, or nullptr if it is not one this library knows.
 const PhonemeAlphabet* find_alphabet(std::string_view name);

@@ -39,7 +39,7 @@ inline constexpr unsigned kStepMs = 50;
 // the work itself (a few ms a step, docs/align.md) and for a loaded machine.
 inline constexpr unsigned kLiveLatencyMs = kLookaheadMs + kHoldMs + kStepMs + 50;
 
-class StreamingAligner {
+class LiveAligner {
  public:
   // Speaks `utterance` and waits for its audio (mono, `rate` Hz). False with `error` only when
   // espeak-ng cannot speak; problem() says when the text or rate cannot be aligned (the audio

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// The live aligner (align/streaming.*): audio pushed in 20 ms blocks, as a microphone gives
+// The live aligner (align/live.*): audio pushed in 20 ms blocks, as a microphone gives
 // it; every phoneme given out within the stated bound of the audio, the phonemes tiling the
 // audio, and their boundaries near espeak-ng's own times for speech at another rate and pitch.
 #include <gtest/gtest.h>
@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "boundaries.h"
+#include "live.h"
 #include "speech_fixtures.h"
-#include "streaming.h"
 #include "white_noise.h"
 
 namespace pfap::align {
@@ -26,7 +26,7 @@ using testing::utterance;
 // but the last kLookaheadMs + kHoldMs + kStepMs and a block has been given out.
 std::vector<tts::SpokenPhoneme> live(const std::string& text, const std::vector<int16_t>& audio,
                                      unsigned rate, Problem want = Problem::kNone) {
-  StreamingAligner a;
+  LiveAligner a;
   std::string error;
   EXPECT_TRUE(a.start(utterance(text), {}, rate, error)) << error;
   EXPECT_EQ(a.problem(), want);
@@ -69,7 +69,7 @@ double percentile(const std::vector<double>& sorted, double p) {
   return sorted.empty() ? 1e9 : sorted[static_cast<size_t>(p * (sorted.size() - 1))];
 }
 
-TEST(Streaming, BoundaryErrorWithinTheLatencyBound) {
+TEST(Live, BoundaryErrorWithinTheLatencyBound) {
   std::vector<double> errors;
   for (const char* text : kSentences) {
     SCOPED_TRACE(text);
@@ -102,7 +102,7 @@ TEST(Streaming, BoundaryErrorWithinTheLatencyBound) {
 // A speaker pausing where the text's synthesis runs on: 300 ms of near silence spliced into
 // espeak-ng's speech before "lay" and before "cool". Without the pause in the warp, the open
 // end ran on into the next words in it and settled them hundreds of ms early.
-TEST(Streaming, APauseTheTextLacksIsWaitedOut) {
+TEST(Live, APauseTheTextLacksIsWaitedOut) {
   const std::string text = "The lazy cow lay in the cool grass.";
   tts::Speech truth = say(text, {"en", 130, 25, 100});
   to_phonetic_boundaries(truth);
@@ -150,7 +150,7 @@ TEST(Streaming, APauseTheTextLacksIsWaitedOut) {
   EXPECT_LT(worst, 50);
 }
 
-TEST(Streaming, BookmarksWordStartsAndStressOnTheFirstPieceOnly) {
+TEST(Live, BookmarksWordStartsAndStressOnTheFirstPieceOnly) {
   const std::string text = "<FAP 3 1 0 1>Hello world.";
   const tts::Speech truth = say(text, {"en", 140, 30, 100});
   std::vector<int16_t> audio = truth.samples;
@@ -174,9 +174,9 @@ TEST(Streaming, BookmarksWordStartsAndStressOnTheFirstPieceOnly) {
             1);
 }
 
-TEST(Streaming, SilenceIsAPauseUntilTheSpeech) {
+TEST(Live, SilenceIsAPauseUntilTheSpeech) {
   // Two seconds of silence, a little noise in it: a pause, given out in pieces as it goes on.
-  StreamingAligner a;
+  LiveAligner a;
   std::string error;
   ASSERT_TRUE(a.start(utterance("Hello world."), {}, 16000, error));
   const std::vector<int16_t> silence = pfap::testing::white_noise(32000, 32);
@@ -188,7 +188,7 @@ TEST(Streaming, SilenceIsAPauseUntilTheSpeech) {
   for (const tts::SpokenPhoneme& p : out) EXPECT_EQ(p.event.phoneme.symbol, 0);
 }
 
-TEST(Streaming, EmptyTextAndBadRateArePausesInPieces) {
+TEST(Live, EmptyTextAndBadRateArePausesInPieces) {
   const std::vector<int16_t> audio(16000, 1000);
   const auto empty = live("<FAP 3 1 0 1>", audio, 16000, Problem::kEmptyText);
   const auto bad_rate =
@@ -200,8 +200,8 @@ TEST(Streaming, EmptyTextAndBadRateArePausesInPieces) {
   EXPECT_EQ(empty.front().event.faps.size(), 1u);
 }
 
-TEST(Streaming, NoAudioAndShortAudio) {
-  StreamingAligner a;
+TEST(Live, NoAudioAndShortAudio) {
+  LiveAligner a;
   std::string error;
   ASSERT_TRUE(a.start(utterance(kSentences[1]), {}, 16000, error));
   std::vector<tts::SpokenPhoneme> out;
@@ -213,7 +213,7 @@ TEST(Streaming, NoAudioAndShortAudio) {
 
 // Issue 31, live: 2 s of silence before a sentence is a pause, and the first sound starts
 // where the speaker's does. espeak-ng starts this text with its first sound, no pause.
-TEST(Streaming, LeadingSilenceIsAPause) {
+TEST(Live, LeadingSilenceIsAPause) {
   constexpr const char* kText = "Always remember the open ocean.";
   tts::Speech truth = say(kText, {"en-us", 140, 60, 100});
   to_phonetic_boundaries(truth);

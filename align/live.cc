@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-#include "streaming.h"
+#include "live.h"
 
 #include <algorithm>
 #include <cmath>
@@ -103,9 +103,9 @@ OpenWarp open_warp(const Features& rec, size_t r0, size_t rows, const Features& 
 
 }  // namespace
 
-bool StreamingAligner::start(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
-                             unsigned rate, std::string& error) {
-  *this = StreamingAligner{};
+bool LiveAligner::start(const tts::Utterance& utterance, const tts::VoiceSettings& voice,
+                        unsigned rate, std::string& error) {
+  *this = LiveAligner{};
   rate_ = rate;
   // The audio to come is unknown: the text is bounded as for the most align() takes.
   if (utterance.text.size() > max_text_characters(kMaxAudioSeconds)) {
@@ -131,19 +131,18 @@ bool StreamingAligner::start(const tts::Utterance& utterance, const tts::VoiceSe
   return true;
 }
 
-void StreamingAligner::push(std::span<const int16_t> samples,
-                            std::vector<tts::SpokenPhoneme>& out) {
+void LiveAligner::push(std::span<const int16_t> samples, std::vector<tts::SpokenPhoneme>& out) {
   rec_.insert(rec_.end(), samples.begin(), samples.end());
   if (this->samples() - last_step_ < samples_of(kStepMs, rate_)) return;
   last_step_ = this->samples();
   step(false, out);
 }
 
-void StreamingAligner::finish(std::vector<tts::SpokenPhoneme>& out) {
+void LiveAligner::finish(std::vector<tts::SpokenPhoneme>& out) {
   if (next_ < syn_.phonemes.size()) step(true, out);
 }
 
-void StreamingAligner::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
+void LiveAligner::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
   const size_t n = samples();
   const size_t lookahead = samples_of(kLookaheadMs, rate_);
   const size_t horizon = at_end ? n : n - std::min(n, lookahead);
@@ -185,7 +184,7 @@ void StreamingAligner::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
       const size_t b = syn_.phonemes[next_ + 1].start;
       size_t at = map(b);
       if (at == kNone || at > horizon) break;
-      at = snap(next_ + 1, at);  // the lookahead holds the audio it looks at (streaming.h)
+      at = snap(next_ + 1, at);  // the lookahead holds the audio it looks at (live.h)
       syn_settled_ = b;
       emit(std::clamp(at, rec_settled_, n), true, out);
     }
@@ -217,7 +216,7 @@ void StreamingAligner::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
   }
 }
 
-size_t StreamingAligner::snap(size_t k, size_t at) const {
+size_t LiveAligner::snap(size_t k, size_t at) const {
   const bool pause_before = syn_.phonemes[k - 1].event.phoneme.symbol == 0;
   if (pause_before == (syn_.phonemes[k].event.phoneme.symbol == 0)) return at;  // no edge
   const std::vector<tts::SpokenPhoneme> pair = {syn_.phonemes[k - 1], syn_.phonemes[k]};
@@ -226,7 +225,7 @@ size_t StreamingAligner::snap(size_t k, size_t at) const {
   return rec_first_ + static_cast<size_t>(std::lround(starts[0]));
 }
 
-void StreamingAligner::emit(size_t to, bool whole, std::vector<tts::SpokenPhoneme>& out) {
+void LiveAligner::emit(size_t to, bool whole, std::vector<tts::SpokenPhoneme>& out) {
   MarkupEvent e = syn_.phonemes[next_].event;
   if (next_started_) {
     // As pfap::split_long_phoneme's pieces: what marks the phoneme's start is on the first.
