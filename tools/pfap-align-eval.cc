@@ -18,7 +18,8 @@
 // recognizes live too (StreamingRecognizer), beside the offline recognition; with
 // PFAP_ALIGN_EVAL_TEXT_ONLY set it leaves out the text-free modes (minutes of recognition);
 // PFAP_ALIGN_EVAL_LEAD_IN=S puts S seconds of silence before each recording (its truth moved
-// with it), for the first sound's start error (issue 31), printed beside the median and p90.
+// with it) and PFAP_ALIGN_EVAL_LEAD_OUT=S after it, for the first sound's start error and the
+// last sound's end error (issue 31), printed beside the median and p90.
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -147,24 +148,42 @@ struct Agreement {
   }
 };
 
-// PFAP_ALIGN_EVAL_LEAD_IN seconds of digital silence (as `sox in.wav out.wav pad S 0`) put
-// before `samples`, and the truth's starts after its first moved by as much.
-void add_lead_in(std::vector<int16_t>& samples, unsigned rate, std::vector<Phone>& truth) {
-  const char* lead_in = std::getenv("PFAP_ALIGN_EVAL_LEAD_IN");
-  const double seconds = lead_in != nullptr ? std::max(0.0, std::atof(lead_in)) : 0;
-  samples.insert(samples.begin(), static_cast<size_t>(seconds * rate), 0);
-  for (size_t k = 1; k < truth.size(); ++k) truth[k].start += seconds;
+double seconds_from_env(const char* name) {
+  const char* value = std::getenv(name);
+  return value != nullptr ? std::max(0.0, std::atof(value)) : 0;
 }
+
+// PFAP_ALIGN_EVAL_LEAD_IN seconds of digital silence put before `samples` and
+// PFAP_ALIGN_EVAL_LEAD_OUT seconds after (as `sox in.wav out.wav pad IN OUT`), the truth's
+// starts after its first moved by the lead-in.
+void add_silence(std::vector<int16_t>& samples, unsigned rate, std::vector<Phone>& truth) {
+  const double lead_in = seconds_from_env("PFAP_ALIGN_EVAL_LEAD_IN");
+  samples.insert(samples.begin(), static_cast<size_t>(lead_in * rate), 0);
+  samples.resize(
+      samples.size() + static_cast<size_t>(seconds_from_env("PFAP_ALIGN_EVAL_LEAD_OUT") * rate), 0);
+  for (size_t k = 1; k < truth.size(); ++k) truth[k].start += lead_in;
+}
+
+bool is_sound(const Phone& p) { return p.name != "pau" && p.name != "h#" && p.name != "brth"; }
 
 // The error of the first sound's start (the first phoneme that is not a pause) in seconds.
 double first_sound_error(const std::vector<Phone>& got, const std::vector<Phone>& truth) {
   auto first = [](const std::vector<Phone>& ps) {
-    for (const Phone& p : ps) {
-      if (p.name != "pau" && p.name != "h#" && p.name != "brth") return p.start;
-    }
-    return 0.0;
+    const auto p = std::find_if(ps.begin(), ps.end(), is_sound);
+    return p != ps.end() ? p->start : 0.0;
   };
   return std::abs(first(got) - first(truth));
+}
+
+// The error of the last sound's end (the start of the pause after it, else the recording's
+// `end`) in seconds.
+double last_sound_error(const std::vector<Phone>& got, const std::vector<Phone>& truth,
+                        double end) {
+  auto last_end = [end](const std::vector<Phone>& ps) {
+    const auto p = std::find_if(ps.rbegin(), ps.rend(), is_sound);
+    return p != ps.rbegin() && p != ps.rend() ? (p - 1)->start : end;
+  };
+  return std::abs(last_end(got) - last_end(truth));
 }
 
 double percentile(std::vector<double> v, double p) {
@@ -254,7 +273,7 @@ int main(int argc, char** argv) {
   pfap::tts::VoiceSettings voice;
   if (const char* v = std::getenv("PFAP_ALIGN_EVAL_VOICE")) voice.voice = v;
   const pfap::PhonemeAlphabet& arpabet = *pfap::find_alphabet(pfap::kArpabetAlphabet);
-  std::vector<double> aligned_errors, first_errors, equal_errors, scaled_errors, costs;
+  std::vector<double> aligned_errors, first_errors, last_errors, equal_errors, scaled_errors, costs;
   size_t matched_total = 0, truth_total = 0, poor = 0;
   double audio_seconds = 0, align_seconds = 0, recognize_seconds = 0, recognize_cpu_seconds = 0;
   const bool recognize =
@@ -282,7 +301,7 @@ int main(int argc, char** argv) {
     std::stringstream text;
     text << text_in.rdbuf();
     std::vector<Phone> truth = read_segs(base + ".segs");
-    add_lead_in(samples, rate, truth);
+    add_silence(samples, rate, truth);
 
     std::vector<pfap::tts::BadBookmark> bad;
     const pfap::tts::Utterance utterance = pfap::tts::parse_utterance(text.str(), bad);
@@ -326,6 +345,7 @@ int main(int argc, char** argv) {
     const std::vector<double> e = matched_errors(got, truth, matched);
     aligned_errors.insert(aligned_errors.end(), e.begin(), e.end());
     first_errors.push_back(first_sound_error(got, truth));
+    last_errors.push_back(last_sound_error(got, truth, duration));
     const std::vector<double> b1 = matched_errors(equal, truth, unused);
     equal_errors.insert(equal_errors.end(), b1.begin(), b1.end());
     const std::vector<double> b2 = matched_errors(scaled, truth, unused);
@@ -412,6 +432,9 @@ int main(int argc, char** argv) {
   std::printf("%-36s median %6.1f ms   p90 %6.1f ms   max %6.1f ms\n", "first sound's start",
               percentile(first_errors, 0.5) * 1000, percentile(first_errors, 0.9) * 1000,
               percentile(first_errors, 1) * 1000);
+  std::printf("%-36s median %6.1f ms   p90 %6.1f ms   max %6.1f ms\n", "last sound's end",
+              percentile(last_errors, 0.5) * 1000, percentile(last_errors, 0.9) * 1000,
+              percentile(last_errors, 1) * 1000);
   std::printf("%-36s median %6.1f ms   p90 %6.1f ms\n", "baseline: equal-length phonemes",
               percentile(equal_errors, 0.5) * 1000, percentile(equal_errors, 0.9) * 1000);
   std::printf("%-36s median %6.1f ms   p90 %6.1f ms\n", "baseline: espeak-ng times stretched",
