@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <iterator>
 
 namespace pfap::align {
 namespace {
@@ -98,9 +99,14 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
     }
     db[b] = static_cast<float>(10 * std::log10(energy / static_cast<double>(block) + 1e-12));
   }
-  std::vector<float> sorted = db;
-  std::sort(sorted.begin(), sorted.end());
-  const float threshold = std::min(sorted[n / 10] + 20, sorted.back() - 20);
+  // The floor leaves out digital silence (blocks more than kFloorRangeDb below the loudest):
+  // zeros before a recording put it at -120 dB, and every hum and fading end above it sounded.
+  const float loudest = *std::max_element(db.begin(), db.end());
+  std::vector<float> heard;
+  std::copy_if(db.begin(), db.end(), std::back_inserter(heard),
+               [&](float d) { return d > loudest - kFloorRangeDb; });
+  std::sort(heard.begin(), heard.end());
+  const float threshold = std::min(heard[heard.size() / 10] + 20, loudest - 20);
   auto quiet_blocks = [&](long from, long step) {
     size_t count = 0;
     for (long b = from; b >= 0 && b < static_cast<long>(n) && db[b] < threshold; b += step) {
