@@ -5,11 +5,25 @@
 #include <cmath>
 #include <cstdlib>
 #include <iterator>
+#include <string_view>
+
+#include "pfap/phoneme_table.h"
 
 namespace pfap::align {
 namespace {
 
 bool is_pause(const tts::SpokenPhoneme& p) { return p.event.phoneme.symbol == 0; }
+
+// p, t, k, b, d, g, ch, jh: their closure is silence.
+bool is_stop(const tts::SpokenPhoneme& p) {
+  static const PhonemeAlphabet& arpabet = *find_alphabet(kArpabetAlphabet);
+  const PhonemeInfo* info = find_phoneme(arpabet, p.event.phoneme.symbol);
+  if (info == nullptr) return false;
+  for (std::string_view stop : {"P", "T", "K", "B", "D", "G", "CH", "JH"}) {
+    if (info->name == stop) return true;
+  }
+  return false;
+}
 
 }  // namespace
 
@@ -135,6 +149,10 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
       }();
       if (found >= 0) {
         starts[k - 1] = static_cast<double>(found) * static_cast<double>(block);
+        // A stop's closure is as silent as the pause before it: the edge is its release.
+        if (speech_begins && is_stop(phonemes[k])) {
+          starts[k - 1] = std::max(starts[k - 1] - double{kStopClosureMs} * rate / 1000, 0.0);
+        }
         break;
       }
     }

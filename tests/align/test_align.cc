@@ -17,6 +17,7 @@
 #include "dtw.h"
 #include "f0.h"
 #include "features.h"
+#include "pfap/phoneme_table.h"
 #include "recognizer.h"
 #include "speech_fixtures.h"
 #include "white_noise.h"
@@ -271,6 +272,28 @@ TEST(Boundaries, DigitalSilenceIsNoFloorForTheEdges) {
   snap_to_silence(phonemes, audio, kRate, starts);
   EXPECT_DOUBLE_EQ(starts[0], static_cast<double>(speech_begins));
   EXPECT_DOUBLE_EQ(starts[1], static_cast<double>(speech_ends));
+}
+
+// A stop out of a pause starts at its closure, kStopClosureMs before its release, which is the
+// edge of silence; another sound at the edge.
+TEST(Boundaries, StopOutOfAPauseStartsAtItsClosure) {
+  constexpr unsigned kRate = 16000;
+  std::vector<int16_t> audio(kRate / 2, 0);
+  const std::vector<int16_t> sound = tone(200, 0.5, kRate);
+  audio.insert(audio.end(), sound.begin(), sound.end());
+  const PhonemeAlphabet& arpabet = *find_alphabet(kArpabetAlphabet);
+  const double release = 0.5 * kRate, closure = kStopClosureMs * kRate / 1000.0;
+  const struct {
+    const char* name;
+    bool stop;
+  } kCases[] = {{"P", true}, {"G", true}, {"CH", true}, {"AA", false}, {"S", false}};
+  for (const auto& [name, stop] : kCases) {
+    SCOPED_TRACE(name);
+    std::vector<double> starts = {release + 0.03 * kRate};  // the warp's: 30 ms late
+    snap_to_silence({phoneme_at(0, 0), phoneme_at(*find_symbol(arpabet, name), 1)}, audio, kRate,
+                    starts);
+    EXPECT_DOUBLE_EQ(starts[0], stop ? release - closure : release);
+  }
 }
 
 TEST(Aligner, KeepsWordStartsStressAndBookmarks) {
