@@ -120,10 +120,8 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
   std::copy_if(db.begin(), db.end(), std::back_inserter(heard),
                [&](float d) { return d > loudest - kFloorRangeDb; });
   std::sort(heard.begin(), heard.end());
-  const float floor = heard[heard.size() / 10];
-  const float end_threshold = std::min(floor + kEndMarginDb, loudest - 20);
-  const float onset_threshold = std::min(floor + kOnsetMarginDb, loudest - 20);
-  auto quiet_blocks = [&](long from, long step, float threshold) {
+  const float threshold = std::min(heard[heard.size() / 10] + 20, loudest - 20);
+  auto quiet_blocks = [&](long from, long step) {
     size_t count = 0;
     for (long b = from; b >= 0 && b < static_cast<long>(n) && db[b] < threshold; b += step) {
       ++count;
@@ -140,12 +138,10 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
       const long found = [&] {
         for (long b : {at - d, at + d}) {
           if (b < 1 || b >= static_cast<long>(n)) continue;
-          if (speech_ends && db[b - 1] >= end_threshold &&
-              quiet_blocks(b, 1, end_threshold) >= kMinQuietBlocks) {
+          if (speech_ends && db[b - 1] >= threshold && quiet_blocks(b, 1) >= kMinQuietBlocks) {
             return b;
           }
-          if (speech_begins && db[b] >= onset_threshold &&
-              quiet_blocks(b - 1, -1, onset_threshold) >= kMinQuietBlocks) {
+          if (speech_begins && db[b] >= threshold && quiet_blocks(b - 1, -1) >= kMinQuietBlocks) {
             return b;
           }
         }

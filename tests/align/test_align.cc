@@ -274,25 +274,6 @@ TEST(Boundaries, DigitalSilenceIsNoFloorForTheEdges) {
   EXPECT_DOUBLE_EQ(starts[1], static_cast<double>(speech_ends));
 }
 
-// A weak onset (/f/, /h/) rises less than kEndMarginDb above the floor: an onset's silence
-// ends kOnsetMarginDb above it.
-TEST(Boundaries, AWeakOnsetIsSound) {
-  constexpr unsigned kRate = 16000;
-  std::vector<int16_t> audio(kRate / 2);  // a hiss at -68 dBFS
-  for (size_t i = 0; i < audio.size(); ++i) {
-    audio[i] = static_cast<int16_t>((static_cast<int>(i % 7) - 3) * 6);
-  }
-  const size_t onset = audio.size();
-  std::vector<int16_t> weak = tone(3000, 0.05, kRate);  // -51 dBFS: 17 dB above the hiss
-  for (int16_t& x : weak) x = static_cast<int16_t>(x / 60);
-  audio.insert(audio.end(), weak.begin(), weak.end());
-  const std::vector<int16_t> vowel = tone(200, 0.3, kRate);
-  audio.insert(audio.end(), vowel.begin(), vowel.end());
-  std::vector<double> starts = {static_cast<double>(onset) + 0.03 * kRate};  // 30 ms late
-  snap_to_silence({phoneme_at(0, 0), phoneme_at(1, 1)}, audio, kRate, starts);
-  EXPECT_DOUBLE_EQ(starts[0], static_cast<double>(onset));
-}
-
 // A stop out of a pause starts at its closure, kStopClosureMs before its release, which is the
 // edge of silence; another sound at the edge.
 TEST(Boundaries, StopOutOfAPauseStartsAtItsClosure) {
