@@ -4,11 +4,26 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <iterator>
+#include <string_view>
+
+#include "pfap/phoneme_table.h"
 
 namespace pfap::align {
 namespace {
 
 bool is_pause(const tts::SpokenPhoneme& p) { return p.event.phoneme.symbol == 0; }
+
+// p, t, k, b, d, g, ch, jh: their closure is silence.
+bool is_stop(const tts::SpokenPhoneme& p) {
+  static const PhonemeAlphabet& arpabet = *find_alphabet(kArpabetAlphabet);
+  const PhonemeInfo* info = find_phoneme(arpabet, p.event.phoneme.symbol);
+  if (info == nullptr) return false;
+  for (std::string_view stop : {"P", "T", "K", "B", "D", "G", "CH", "JH"}) {
+    if (info->name == stop) return true;
+  }
+  return false;
+}
 
 }  // namespace
 
@@ -98,9 +113,14 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
     }
     db[b] = static_cast<float>(10 * std::log10(energy / static_cast<double>(block) + 1e-12));
   }
-  std::vector<float> sorted = db;
-  std::sort(sorted.begin(), sorted.end());
-  const float threshold = std::min(sorted[n / 10] + 20, sorted.back() - 20);
+  // The floor leaves out digital silence (blocks more than kFloorRangeDb below the loudest):
+  // zeros before a recording put it at -120 dB, and every hum and fading end above it sounded.
+  const float loudest = *std::max_element(db.begin(), db.end());
+  std::vector<float> heard;
+  std::copy_if(db.begin(), db.end(), std::back_inserter(heard),
+               [&](float d) { return d > loudest - kFloorRangeDb; });
+  std::sort(heard.begin(), heard.end());
+  const float threshold = std::min(heard[heard.size() / 10] + 20, loudest - 20);
   auto quiet_blocks = [&](long from, long step) {
     size_t count = 0;
     for (long b = from; b >= 0 && b < static_cast<long>(n) && db[b] < threshold; b += step) {
@@ -129,6 +149,10 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
       }();
       if (found >= 0) {
         starts[k - 1] = static_cast<double>(found) * static_cast<double>(block);
+        // A stop's closure is as silent as the pause before it: the edge is its release.
+        if (speech_begins && is_stop(phonemes[k])) {
+          starts[k - 1] = std::max(starts[k - 1] - double{kStopClosureMs} * rate / 1000, 0.0);
+        }
         break;
       }
     }

@@ -52,13 +52,23 @@ std::vector<bool> pause_frames(const std::vector<tts::SpokenPhoneme>& phonemes, 
 // edge, in ms.
 inline constexpr unsigned kSnapRadiusMs = 100;
 inline constexpr unsigned kMinSilenceMs = 20;
+// Blocks more than this below the loudest are digital silence, no floor: 70, 80 and 90 were
+// tried on the Festival corpora, 90 ended the last sound best (docs/align.md).
+inline constexpr float kFloorRangeDb = 90;
+// How long a stop's closure after a pause is taken to be: silence cannot tell; on the Festival
+// kal corpus 40 to 80 ms gave the same first-sound p90, 50 was chosen (docs/align.md).
+inline constexpr unsigned kStopClosureMs = 50;
 
 // Moves each boundary next to a pause in `phonemes` (a start into a pause: speech ends; a
 // start out of one: speech begins) onto the nearest edge of silence in `audio` within
 // kSnapRadiusMs: the warp matches a fading end of speech with the synthetic pause. `starts[k]`
 // is phoneme k + 1's start in samples of `audio` (phoneme 0 starts at 0). Silence: 5 ms
-// blocks below the recording's floor (its 10th-percentile block) + 20 dB, or below its
-// loudest - 20 dB if that is lower, for at least kMinSilenceMs.
+// blocks below the recording's floor + 20 dB, or below its loudest - 20 dB if that is lower,
+// for at least kMinSilenceMs. The floor is the 10th-percentile block of those within
+// kFloorRangeDb of the loudest: digital silence (zeros before or after the speech, however
+// long) has no level to be a floor. A stop (p t k b d g ch jh) out of a pause starts
+// kStopClosureMs before the edge: its closure is silent, the edge its release, and phonetic
+// labels (and the lips) start it at its closure.
 void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
                      std::span<const int16_t> audio, unsigned rate, std::vector<double>& starts);
 

@@ -18,7 +18,8 @@
 // recognizes live too (LiveRecognizer), beside the offline recognition; with
 // PFAP_ALIGN_EVAL_TEXT_ONLY set it leaves out the text-free modes (minutes of recognition);
 // PFAP_ALIGN_EVAL_LEAD_IN=S puts S seconds of silence before each recording (its truth moved
-// with it), for the first sound's start error (issue 31), printed beside the median and p90.
+// with it) and PFAP_ALIGN_EVAL_LEAD_OUT=S after it, for the first sound's start error and the
+// last sound's end error (issue 31), printed beside the median and p90.
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -147,24 +148,42 @@ struct Agreement {
   }
 };
 
-// PFAP_ALIGN_EVAL_LEAD_IN seconds of digital silence (as `sox in.wav out.wav pad S 0`) put
-// before `samples`, and the truth's starts after its first moved by as much.
-void add_lead_in(std::vector<int16_t>& samples, unsigned rate, std::vector<Phone>& truth) {
-  const char* lead_in = std::getenv("PFAP_ALIGN_EVAL_LEAD_IN");
-  const double seconds = lead_in != nullptr ? std::max(0.0, std::atof(lead_in)) : 0;
-  samples.insert(samples.begin(), static_cast<size_t>(seconds * rate), 0);
-  for (size_t k = 1; k < truth.size(); ++k) truth[k].start += seconds;
+double seconds_from_env(const char* name) {
+  const char* value = std::getenv(name);
+  return value != nullptr ? std::max(0.0, std::atof(value)) : 0;
 }
+
+// PFAP_ALIGN_EVAL_LEAD_IN seconds of digital silence put before `samples` and
+// PFAP_ALIGN_EVAL_LEAD_OUT seconds after (as `sox in.wav out.wav pad IN OUT`), the truth's
+// starts after its first moved by the lead-in.
+void add_silence(std::vector<int16_t>& samples, unsigned rate, std::vector<Phone>& truth) {
+  const double lead_in = seconds_from_env("PFAP_ALIGN_EVAL_LEAD_IN");
+  samples.insert(samples.begin(), static_cast<size_t>(lead_in * rate), 0);
+  samples.resize(
+      samples.size() + static_cast<size_t>(seconds_from_env("PFAP_ALIGN_EVAL_LEAD_OUT") * rate), 0);
+  for (size_t k = 1; k < truth.size(); ++k) truth[k].start += lead_in;
+}
+
+bool is_sound(const Phone& p) { return p.name != "pau" && p.name != "h#" && p.name != "brth"; }
 
 // The error of the first sound's start (the first phoneme that is not a pause) in seconds.
 double first_sound_error(const std::vector<Phone>& got, const std::vector<Phone>& truth) {
   auto first = [](const std::vector<Phone>& ps) {
-    for (const Phone& p : ps) {
-      if (p.name != "pau" && p.name != "h#" && p.name != "brth") return p.start;
-    }
-    return 0.0;
+    const auto p = std::find_if(ps.begin(), ps.end(), is_sound);
+    return p != ps.end() ? p->start : 0.0;
   };
   return std::abs(first(got) - first(truth));
+}
+
+// The error of the last sound's end (the start of the pause after it, else the recording's
+// `end`) in seconds.
+double last_sound_error(const std::vector<Phone>& got, const std::vector<Phone>& truth,
+                        double end) {
+  auto last_end = [end](const std::vector<Phone>& ps) {
+    const auto p = std::find_if(ps.rbegin(), ps.rend(), is_sound);
+    return p != ps.rbegin() && p != ps.rend() ? (p - 1)->start : end;
+  };
+  return std::abs(last_end(got) - last_end(truth));
 }
 
 double percentile(std::vector<double> v, double p) {
@@ -241,7 +260,8 @@ struct Settings {
 
 // What is measured over every sentence.
 struct Totals {
-  std::vector<double> aligned_errors, first_errors, equal_errors, scaled_errors, costs;
+  std::vector<double> aligned_errors, first_errors, last_errors, equal_errors, scaled_errors,
+      costs;
   size_t matched = 0, truth_phonemes = 0, poor = 0;
   double audio_seconds = 0, align_seconds = 0;
   std::vector<pfap::Viseme> truth_frames;  // every sentence's, for the baseline
@@ -301,7 +321,7 @@ bool read_sentence(const std::string& dir, const char* name, const char* text_na
   text << text_in.rdbuf();
   out.text = text.str();
   out.truth = read_segs(base + ".segs");
-  add_lead_in(out.samples, out.rate, out.truth);
+  add_silence(out.samples, out.rate, out.truth);
   out.duration = static_cast<double>(out.samples.size()) / out.rate;
   return true;
 }
@@ -337,6 +357,7 @@ std::vector<double> measure_boundaries(const Settings& settings, const Sentence&
   const std::vector<double> e = matched_errors(got, s.truth, matched);
   totals.aligned_errors.insert(totals.aligned_errors.end(), e.begin(), e.end());
   totals.first_errors.push_back(first_sound_error(got, s.truth));
+  totals.last_errors.push_back(last_sound_error(got, s.truth, s.duration));
   const std::vector<double> b1 = matched_errors(equal, s.truth, unused);
   totals.equal_errors.insert(totals.equal_errors.end(), b1.begin(), b1.end());
   const std::vector<double> b2 = matched_errors(scaled, s.truth, unused);
@@ -436,6 +457,9 @@ void print_boundary_summary(const Totals& t, int sentences) {
   std::printf("%-36s median %6.1f ms   p90 %6.1f ms   max %6.1f ms\n", "first sound's start",
               percentile(t.first_errors, 0.5) * 1000, percentile(t.first_errors, 0.9) * 1000,
               percentile(t.first_errors, 1) * 1000);
+  std::printf("%-36s median %6.1f ms   p90 %6.1f ms   max %6.1f ms\n", "last sound's end",
+              percentile(t.last_errors, 0.5) * 1000, percentile(t.last_errors, 0.9) * 1000,
+              percentile(t.last_errors, 1) * 1000);
   std::printf("%-36s median %6.1f ms   p90 %6.1f ms\n", "baseline: equal-length phonemes",
               percentile(t.equal_errors, 0.5) * 1000, percentile(t.equal_errors, 0.9) * 1000);
   std::printf("%-36s median %6.1f ms   p90 %6.1f ms\n", "baseline: espeak-ng times stretched",

@@ -17,6 +17,7 @@
 #include "dtw.h"
 #include "f0.h"
 #include "features.h"
+#include "pfap/phoneme_table.h"
 #include "recognizer.h"
 #include "speech_fixtures.h"
 #include "white_noise.h"
@@ -237,6 +238,62 @@ TEST(Boundaries, PauseBoundariesSnapToTheEdgesOfSilence) {
   EXPECT_DOUBLE_EQ(starts[1], 0.5 * kRate);
   EXPECT_DOUBLE_EQ(starts[2], 0.7 * kRate);
   EXPECT_DOUBLE_EQ(starts[3], 0.85 * kRate);
+}
+
+// Issue 31: seconds of digital silence before and after a recording are no floor. Before, they
+// put it at -120 dB, so that a recording's own quiet (a hiss at -68 dBFS before its first
+// sound, a fading end at -40 dBFS) was sound, and the boundaries stayed where the warp put them.
+TEST(Boundaries, DigitalSilenceIsNoFloorForTheEdges) {
+  constexpr unsigned kRate = 16000;
+  auto hiss = [](double seconds) {  // -68 dBFS
+    std::vector<int16_t> h(static_cast<size_t>(seconds * kRate));
+    for (size_t i = 0; i < h.size(); ++i)
+      h[i] = static_cast<int16_t>((static_cast<int>(i % 7) - 3) * 6);
+    return h;
+  };
+  std::vector<int16_t> audio(2 * kRate, 0);
+  const std::vector<int16_t> before = hiss(0.2);
+  audio.insert(audio.end(), before.begin(), before.end());
+  const size_t speech_begins = audio.size();
+  const std::vector<int16_t> speech = tone(200, 0.5, kRate);  // -15 dBFS
+  audio.insert(audio.end(), speech.begin(), speech.end());
+  std::vector<int16_t> fade = tone(200, 0.06, kRate);  // -40 dBFS
+  for (int16_t& x : fade) x = static_cast<int16_t>(x / 18);
+  audio.insert(audio.end(), fade.begin(), fade.end());
+  const size_t speech_ends = audio.size();
+  const std::vector<int16_t> after = hiss(0.3);
+  audio.insert(audio.end(), after.begin(), after.end());
+  audio.resize(audio.size() + 2 * kRate, 0);
+  const std::vector<tts::SpokenPhoneme> phonemes = {phoneme_at(0, 0), phoneme_at(1, 1),
+                                                    phoneme_at(0, 2)};
+  // The warp's starts: the sound 50 ms early, in the hiss; its end 60 ms early, at the fade.
+  std::vector<double> starts = {static_cast<double>(speech_begins) - 0.05 * kRate,
+                                static_cast<double>(speech_ends) - 0.06 * kRate};
+  snap_to_silence(phonemes, audio, kRate, starts);
+  EXPECT_DOUBLE_EQ(starts[0], static_cast<double>(speech_begins));
+  EXPECT_DOUBLE_EQ(starts[1], static_cast<double>(speech_ends));
+}
+
+// A stop out of a pause starts at its closure, kStopClosureMs before its release, which is the
+// edge of silence; another sound at the edge.
+TEST(Boundaries, StopOutOfAPauseStartsAtItsClosure) {
+  constexpr unsigned kRate = 16000;
+  std::vector<int16_t> audio(kRate / 2, 0);
+  const std::vector<int16_t> sound = tone(200, 0.5, kRate);
+  audio.insert(audio.end(), sound.begin(), sound.end());
+  const PhonemeAlphabet& arpabet = *find_alphabet(kArpabetAlphabet);
+  const double release = 0.5 * kRate, closure = kStopClosureMs * kRate / 1000.0;
+  const struct {
+    const char* name;
+    bool stop;
+  } kCases[] = {{"P", true}, {"G", true}, {"CH", true}, {"AA", false}, {"S", false}};
+  for (const auto& [name, stop] : kCases) {
+    SCOPED_TRACE(name);
+    std::vector<double> starts = {release + 0.03 * kRate};  // the warp's: 30 ms late
+    snap_to_silence({phoneme_at(0, 0), phoneme_at(*find_symbol(arpabet, name), 1)}, audio, kRate,
+                    starts);
+    EXPECT_DOUBLE_EQ(starts[0], stop ? release - closure : release);
+  }
 }
 
 TEST(Aligner, KeepsWordStartsStressAndBookmarks) {
