@@ -51,6 +51,7 @@
 #include <memory>
 
 #include "command_line.h"
+#include "pad_time.h"
 
 namespace {
 
@@ -103,14 +104,7 @@ class EndAudioWithMarkup {
   static GstPadProbeReturn on_audio(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
     EndAudioWithMarkup* self = static_cast<Ref*>(data)->get();
     if (!self->markup_ended_) return GST_PAD_PROBE_OK;
-    GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
-    GstEvent* event = gst_pad_get_sticky_event(pad, GST_EVENT_SEGMENT, 0);
-    if (event == nullptr) return GST_PAD_PROBE_OK;
-    const GstSegment* segment = nullptr;
-    gst_event_parse_segment(event, &segment);
-    const GstClockTime start =
-        gst_segment_to_running_time(segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
-    gst_event_unref(event);
+    const GstClockTime start = running_time_of(pad, GST_PAD_PROBE_INFO_BUFFER(info));
     if (!GST_CLOCK_TIME_IS_VALID(start) || start < self->markup_end_) return GST_PAD_PROBE_OK;
     if (!self->audio_ended_.exchange(true)) {
       gst_element_send_event(self->source_, gst_event_new_eos());
@@ -142,16 +136,9 @@ class AudioFromZero {
 
  private:
   static GstPadProbeReturn on_first_buffer(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
-    GstEvent* event = gst_pad_get_sticky_event(pad, GST_EVENT_SEGMENT, 0);
-    if (event == nullptr) return GST_PAD_PROBE_OK;
-    const GstSegment* segment = nullptr;
-    gst_event_parse_segment(event, &segment);
-    const GstClockTime start = gst_segment_to_running_time(
-        segment, GST_FORMAT_TIME, GST_BUFFER_PTS(GST_PAD_PROBE_INFO_BUFFER(info)));
-    gst_event_unref(event);
-    if (GST_CLOCK_TIME_IS_VALID(start)) {
-      gst_pad_set_offset(static_cast<GstPad*>(data), -static_cast<gint64>(start));
-    }
+    const GstClockTime start = running_time_of(pad, GST_PAD_PROBE_INFO_BUFFER(info));
+    if (!GST_CLOCK_TIME_IS_VALID(start)) return GST_PAD_PROBE_OK;  // no segment or PTS yet
+    gst_pad_set_offset(static_cast<GstPad*>(data), -static_cast<gint64>(start));
     return GST_PAD_PROBE_REMOVE;
   }
 };

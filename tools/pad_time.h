@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// The running time of a buffer as it passes a pad, for the tools' pad probes (pfap-web and
-// pfap-broadcast stamp the speech's level with it).
+// The running time of a buffer as it passes a pad, for pad probes: pfap-web and pfap-broadcast
+// stamp the speech's level with it, examples/pfap-rtsp-server ends and aligns its audio with
+// it, and tests/gst measure lip sync with it. (The elements place events by the segments they
+// hold, signed: gst/pfap/runningtime.h.)
 #pragma once
 
 #include <gst/gst.h>

@@ -60,10 +60,10 @@
 #include <string_view>
 #include <vector>
 
+#include "markupbuffer.h"
 #include "pfap/fap_animation.h"
 #include "pfap/fap_file.h"
 #include "pfap/phoneme_table.h"
-#include "markupbuffer.h"
 #include "ratelimit.h"
 
 GST_DEBUG_CATEGORY_STATIC(fapparse_debug);

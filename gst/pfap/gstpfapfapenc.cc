@@ -77,10 +77,10 @@ struct Stream {
 
 struct _GstPfapFapEnc {
   GstPfapBaseEnc parent;
-  gint frame_rate_n;   // under the object lock
-  gint frame_rate_d;   // under the object lock
-  gchar* name;         // under the object lock
-  guint max_frames;    // under the object lock
+  gint frame_rate_n;  // under the object lock
+  gint frame_rate_d;  // under the object lock
+  gchar* name;        // under the object lock
+  guint max_frames;   // under the object lock
   Stream* stream;
 };
 

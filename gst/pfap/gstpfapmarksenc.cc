@@ -63,7 +63,7 @@ struct Stream {
   Stream(pfap::MarksFormat format, int rate_n, int rate_d) : writer(format, rate_n, rate_d) {}
 
   pfap::MarksWriter writer;
-  uint64_t unknown_warned = 0;       // unknown phonemes already counted in a warning
+  uint64_t unknown_warned = 0;  // unknown phonemes already counted in a warning
   uint64_t unknown_warnings = 0;
   uint64_t cut_rests = 0;  // the writer's count when last looked at
   GstFlowReturn flow = GST_FLOW_OK;
@@ -86,8 +86,7 @@ static GstStaticPadTemplate src_template = GST_STATIC_PAD_TEMPLATE(
     "src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS("text/x-raw, format = (string) utf8"));
 
 G_DEFINE_TYPE(GstPfapMarksEnc, gst_pfap_marks_enc, GST_TYPE_PFAP_BASE_ENC)
-GST_ELEMENT_REGISTER_DEFINE(pfapmarksenc, "pfapmarksenc", GST_RANK_NONE,
-                            GST_TYPE_PFAP_MARKS_ENC)
+GST_ELEMENT_REGISTER_DEFINE(pfapmarksenc, "pfapmarksenc", GST_RANK_NONE, GST_TYPE_PFAP_MARKS_ENC)
 
 #define GST_TYPE_PFAP_MARKS_FORMAT (gst_pfap_marks_format_get_type())
 static GType gst_pfap_marks_format_get_type() {

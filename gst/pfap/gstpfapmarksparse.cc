@@ -43,8 +43,8 @@
 #include <string_view>
 #include <vector>
 
-#include "pfap/speech_marks.h"
 #include "markupbuffer.h"
+#include "pfap/speech_marks.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapmarksparse_debug);
 #define GST_CAT_DEFAULT pfapmarksparse_debug

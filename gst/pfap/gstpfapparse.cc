@@ -46,10 +46,10 @@
 #include <string>
 #include <string_view>
 
-#include "pfap/model.h"
-#include "pfap/text.h"
 #include "gstpfaptypefind.h"
 #include "markupbuffer.h"
+#include "pfap/model.h"
+#include "pfap/text.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapparse_debug);
 #define GST_CAT_DEFAULT pfapparse_debug

@@ -176,7 +176,7 @@ static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
 
 // The second structure shows the optional alphabet field (SDP fmtp) with the alphabet
 // pfaptts and the examples use; the first, which fixation picks, any other alphabet or none.
-#define PFAP_RTP_CAPS                                                                  \
+#define PFAP_RTP_CAPS                                                              \
   "application/x-rtp, media = (string) application, payload = (int) [ 96, 127 ], " \
   "clock-rate = (int) [ 1, 2147483647 ], encoding-name = (string) PFAP"
 static GstStaticPadTemplate src_template = GST_STATIC_PAD_TEMPLATE(
@@ -455,12 +455,12 @@ static GstStructure* stats_structure(GstRtpPfapPay* self) {
   GST_OBJECT_UNLOCK(self);
   // GstRTPBasePayload's (clock-rate, running-time, seqnum, timestamp, ssrc, pt, ...) and ours.
   GstStructure* stats = pfap_owner_stats(G_OBJECT(self), GST_TYPE_RTP_BASE_PAYLOAD);
-  gst_structure_set(stats, "packets", G_TYPE_UINT64, s.packets, "recovery-entries",
-                    G_TYPE_UINT64, s.recovery_entries, "complete-recoveries", G_TYPE_UINT64,
-                    s.complete_recoveries, "requests", G_TYPE_UINT64, s.requests,
-                    "requests-served", G_TYPE_UINT64, s.requests_served, "complete-too-large",
-                    G_TYPE_UINT64, s.complete_too_large, "oversized", G_TYPE_UINT64, s.oversized,
-                    "malformed", G_TYPE_UINT64, s.malformed, nullptr);
+  gst_structure_set(stats, "packets", G_TYPE_UINT64, s.packets, "recovery-entries", G_TYPE_UINT64,
+                    s.recovery_entries, "complete-recoveries", G_TYPE_UINT64, s.complete_recoveries,
+                    "requests", G_TYPE_UINT64, s.requests, "requests-served", G_TYPE_UINT64,
+                    s.requests_served, "complete-too-large", G_TYPE_UINT64, s.complete_too_large,
+                    "oversized", G_TYPE_UINT64, s.oversized, "malformed", G_TYPE_UINT64,
+                    s.malformed, nullptr);
   return stats;
 }
 

@@ -72,6 +72,36 @@ TEST(GstPfapEvent, PhonemeRoundTripsThroughABufferWithItsDuration) {
   EXPECT_EQ(gst_pfap_event_get_n_faps(copy), 2u);
 }
 
+// A buffer of several memories (an appsrc application may build one) is read as one run of
+// bytes, as the plugins read it (markupbuffer.h).
+TEST(GstPfapEvent, EventSplitOverTwoMemoriesIsReadWhole) {
+  g_autoptr(GstPfapEvent) event = gst_pfap_event_new(GST_PFAP_EVENT_KIND_RECOVERED);
+  g_autoptr(GstPfapFap) joy = gst_pfap_fap_new(69, -40, 300, GST_PFAP_CURVE_TRIANGLE);
+  gst_pfap_event_add_fap(event, joy);
+  GstBuffer* whole = gst_pfap_event_to_buffer(event, nullptr);
+  ASSERT_NE(whole, nullptr);
+  const gsize size = gst_buffer_get_size(whole);
+  // Split inside the FAP record, so neither memory holds a valid event.
+  GstBuffer* split =
+      gst_buffer_append(gst_buffer_copy_region(whole, GST_BUFFER_COPY_MEMORY, 0, 11),
+                        gst_buffer_copy_region(whole, GST_BUFFER_COPY_MEMORY, 11, size - 11));
+  gst_buffer_unref(whole);
+  ASSERT_EQ(gst_buffer_n_memory(split), 2u);
+
+  GError* raw = nullptr;
+  g_autoptr(GstPfapEvent) back = gst_pfap_event_new_from_buffer(split, &raw);
+  gst_buffer_unref(split);
+  Error error(raw);
+  ASSERT_NE(back, nullptr) << error->message;
+  EXPECT_EQ(gst_pfap_event_get_kind(back), GST_PFAP_EVENT_KIND_RECOVERED);
+  g_autoptr(GstPfapFap) fap = gst_pfap_event_get_fap(back, 0);
+  ASSERT_NE(fap, nullptr);
+  EXPECT_EQ(fap->index, 69);
+  EXPECT_EQ(fap->amplitude, -40);
+  EXPECT_EQ(fap->transition_ms, 300);
+  EXPECT_EQ(fap->curve, GST_PFAP_CURVE_TRIANGLE);
+}
+
 TEST(GstPfapEvent, StateEventsCarryNoPhoneme) {
   g_autoptr(GstPfapEvent) event = gst_pfap_event_new(GST_PFAP_EVENT_KIND_COMPLETE);
   gst_pfap_event_set_symbol(event, 9);
@@ -264,10 +294,10 @@ TEST(GstPfapFapState, AnOutOfRangeFapChangesNothing) {
 }
 
 TEST(GstPfapTypes, AreRegisteredForBindings) {
-  EXPECT_TRUE(G_TYPE_IS_BOXED(GST_PFAP_TYPE_EVENT));
-  EXPECT_TRUE(G_TYPE_IS_BOXED(GST_PFAP_TYPE_FAP));
-  EXPECT_TRUE(G_TYPE_IS_BOXED(GST_PFAP_TYPE_ALPHABET));
-  EXPECT_TRUE(G_TYPE_IS_OBJECT(GST_PFAP_TYPE_FAP_STATE));
+  EXPECT_TRUE(G_TYPE_IS_BOXED(GST_TYPE_PFAP_EVENT));
+  EXPECT_TRUE(G_TYPE_IS_BOXED(GST_TYPE_PFAP_FAP));
+  EXPECT_TRUE(G_TYPE_IS_BOXED(GST_TYPE_PFAP_ALPHABET));
+  EXPECT_TRUE(G_TYPE_IS_OBJECT(GST_TYPE_PFAP_FAP_STATE));
   EXPECT_TRUE(G_TYPE_IS_FLAGS(gst_pfap_event_flags_get_type()));
   EXPECT_TRUE(G_TYPE_IS_ENUM(gst_pfap_event_kind_get_type()));
   EXPECT_STREQ(GST_PFAP_CAPS, "application/x-pfap");

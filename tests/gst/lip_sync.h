@@ -19,6 +19,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "pad_time.h"
 #include "pfap_buffers.h"
 
 namespace pfap::testing {
@@ -56,16 +57,8 @@ struct SentAudio {
 inline GstPadProbeReturn record_sent_audio(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
   auto* sent = static_cast<SentAudio*>(data);
   GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
-  GstEvent* segment_event = gst_pad_get_sticky_event(pad, GST_EVENT_SEGMENT, 0);
-  if (segment_event == nullptr || !GST_BUFFER_PTS_IS_VALID(buffer)) {
-    if (segment_event != nullptr) gst_event_unref(segment_event);
-    return GST_PAD_PROBE_OK;
-  }
-  const GstSegment* segment = nullptr;
-  gst_event_parse_segment(segment_event, &segment);
-  const GstClockTime rt =
-      gst_segment_to_running_time(segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
-  gst_event_unref(segment_event);
+  const GstClockTime rt = running_time_of(pad, buffer);
+  if (!GST_CLOCK_TIME_IS_VALID(rt)) return GST_PAD_PROBE_OK;
   GstMapInfo map;
   gst_buffer_map(buffer, &map, GST_MAP_READ);
   {

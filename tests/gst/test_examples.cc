@@ -56,6 +56,7 @@
 
 #include "pfap/markup.h"
 #include "documented_commands.h"
+#include "pad_time.h"
 #include "pfap_buffers.h"
 #include "pipeline.h"
 #include "temp_dir.h"
@@ -1223,18 +1224,6 @@ class Player {
   std::vector<std::string> plugged_;
 };
 
-// The running time of a buffer passing `pad`, from the pad's segment.
-GstClockTime running_time_at(GstPad* pad, GstBuffer* buffer) {
-  GstEvent* event = gst_pad_get_sticky_event(pad, GST_EVENT_SEGMENT, 0);
-  if (event == nullptr) return GST_CLOCK_TIME_NONE;
-  const GstSegment* segment = nullptr;
-  gst_event_parse_segment(event, &segment);
-  const GstClockTime t =
-      gst_segment_to_running_time(segment, GST_FORMAT_TIME, GST_BUFFER_PTS(buffer));
-  gst_event_unref(event);
-  return t;
-}
-
 // What pfapface takes in and puts out, in the order it happened: each phoneme with its running
 // time, each frame with its own. A frame shows the phonemes pfapface had before drawing it
 // whose time span holds the frame's running time.
@@ -1267,14 +1256,14 @@ struct FaceLog {
     const Event e = pfap::testing::read_event(buffer);
     if (e.kind != PFAP_EVENT_PHONEME) return GST_PAD_PROBE_OK;
     std::lock_guard lock(log->mutex);
-    log->phonemes.push_back({log->next++, running_time_at(pad, buffer), e.duration});
+    log->phonemes.push_back({log->next++, running_time_of(pad, buffer), e.duration});
     return GST_PAD_PROBE_OK;
   }
   static GstPadProbeReturn on_frame(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
     auto* log = static_cast<FaceLog*>(data);
     GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
     std::lock_guard lock(log->mutex);
-    log->frames.push_back({log->next++, running_time_at(pad, buffer)});
+    log->frames.push_back({log->next++, running_time_of(pad, buffer)});
     return GST_PAD_PROBE_OK;
   }
   // The running time of the first frame that shows phoneme `p`, or NONE.
@@ -1310,7 +1299,7 @@ struct TickLog {
   static GstPadProbeReturn on_audio(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
     auto* log = static_cast<TickLog*>(data);
     GstBuffer* buffer = GST_PAD_PROBE_INFO_BUFFER(info);
-    const GstClockTime start = running_time_at(pad, buffer);
+    const GstClockTime start = running_time_of(pad, buffer);
     if (!GST_CLOCK_TIME_IS_VALID(start)) return GST_PAD_PROBE_OK;
     GstMapInfo map;
     if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) return GST_PAD_PROBE_OK;

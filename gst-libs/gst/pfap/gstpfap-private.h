@@ -15,9 +15,9 @@ struct _GstPfapEvent {
   pfap::MarkupEvent event;
 };
 
-pfap::Fap gst_pfap_fap_to_lib (const GstPfapFap& fap);
-GstPfapFap *gst_pfap_fap_from_lib (const pfap::Fap& fap);
+pfap::Fap gst_pfap_fap_to_lib(const GstPfapFap& fap);
+GstPfapFap* gst_pfap_fap_from_lib(const pfap::Fap& fap);
 // Why libpfap refuses `fap` (pfap::is_valid is false), in words: its values and the ranges.
-gchar *gst_pfap_fap_out_of_range (const pfap::Fap& fap);
+gchar* gst_pfap_fap_out_of_range(const pfap::Fap& fap);
 // A list of new GstPfapFaps.
-GList *gst_pfap_faps_from_lib (const std::vector<pfap::Fap>& faps);
+GList* gst_pfap_faps_from_lib(const std::vector<pfap::Fap>& faps);

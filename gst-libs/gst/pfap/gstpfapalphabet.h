@@ -74,10 +74,10 @@ typedef enum {
  */
 typedef struct _GstPfapAlphabet GstPfapAlphabet;
 
-#define GST_PFAP_TYPE_ALPHABET (gst_pfap_alphabet_get_type ())
+#define GST_TYPE_PFAP_ALPHABET (gst_pfap_alphabet_get_type())
 
 GST_PFAP_API
-GType gst_pfap_alphabet_get_type (void);
+GType gst_pfap_alphabet_get_type(void);
 
 /**
  * gst_pfap_alphabet_find:
@@ -87,7 +87,7 @@ GType gst_pfap_alphabet_get_type (void);
  * does not know it
  */
 GST_PFAP_API
-const GstPfapAlphabet *gst_pfap_alphabet_find (const gchar *name);
+const GstPfapAlphabet *gst_pfap_alphabet_find(const gchar *name);
 
 /**
  * gst_pfap_alphabet_get_name:
@@ -96,7 +96,7 @@ const GstPfapAlphabet *gst_pfap_alphabet_find (const gchar *name);
  * Returns: (transfer none): its name
  */
 GST_PFAP_API
-const gchar *gst_pfap_alphabet_get_name (const GstPfapAlphabet *alphabet);
+const gchar *gst_pfap_alphabet_get_name(const GstPfapAlphabet *alphabet);
 
 /**
  * gst_pfap_alphabet_get_n_symbols:
@@ -105,7 +105,7 @@ const gchar *gst_pfap_alphabet_get_name (const GstPfapAlphabet *alphabet);
  * Returns: the number of symbols of @alphabet: symbols 0 to this minus 1 are known
  */
 GST_PFAP_API
-guint gst_pfap_alphabet_get_n_symbols (const GstPfapAlphabet *alphabet);
+guint gst_pfap_alphabet_get_n_symbols(const GstPfapAlphabet *alphabet);
 
 /**
  * gst_pfap_alphabet_get_phoneme_name:
@@ -116,8 +116,7 @@ guint gst_pfap_alphabet_get_n_symbols (const GstPfapAlphabet *alphabet);
  * @alphabet has no such symbol
  */
 GST_PFAP_API
-const gchar *gst_pfap_alphabet_get_phoneme_name (const GstPfapAlphabet *alphabet,
-                                                 guint8 symbol);
+const gchar *gst_pfap_alphabet_get_phoneme_name(const GstPfapAlphabet *alphabet, guint8 symbol);
 
 /**
  * gst_pfap_alphabet_get_viseme:
@@ -127,7 +126,7 @@ const gchar *gst_pfap_alphabet_get_phoneme_name (const GstPfapAlphabet *alphabet
  * Returns: the viseme of phoneme @symbol; %GST_PFAP_VISEME_NONE also for an unknown symbol
  */
 GST_PFAP_API
-GstPfapViseme gst_pfap_alphabet_get_viseme (const GstPfapAlphabet *alphabet, guint8 symbol);
+GstPfapViseme gst_pfap_alphabet_get_viseme(const GstPfapAlphabet *alphabet, guint8 symbol);
 
 /**
  * gst_pfap_alphabet_lookup_symbol:
@@ -138,8 +137,8 @@ GstPfapViseme gst_pfap_alphabet_get_viseme (const GstPfapAlphabet *alphabet, gui
  * Returns: whether @alphabet has a phoneme called @name
  */
 GST_PFAP_API
-gboolean gst_pfap_alphabet_lookup_symbol (const GstPfapAlphabet *alphabet, const gchar *name,
-                                          guint8 *symbol);
+gboolean gst_pfap_alphabet_lookup_symbol(const GstPfapAlphabet *alphabet, const gchar *name,
+                                         guint8 *symbol);
 
 G_END_DECLS
 

@@ -4,8 +4,8 @@
 #ifndef __GST_PFAP_BOOKMARK_H__
 #define __GST_PFAP_BOOKMARK_H__
 
-#include <gst/pfap/pfap-prelude.h>
 #include <gst/pfap/gstpfapevent.h>
+#include <gst/pfap/pfap-prelude.h>
 
 G_BEGIN_DECLS
 
@@ -25,7 +25,7 @@ G_BEGIN_DECLS
  * The #GError domain of bookmarks that cannot be parsed. The message starts with the byte
  * offset in the text where the problem is: "at byte 12: ...".
  */
-#define GST_PFAP_BOOKMARK_ERROR (gst_pfap_bookmark_error_quark ())
+#define GST_PFAP_BOOKMARK_ERROR (gst_pfap_bookmark_error_quark())
 
 /**
  * GstPfapBookmarkError:
@@ -60,7 +60,7 @@ typedef enum {
 } GstPfapBookmarkError;
 
 GST_PFAP_API
-GQuark gst_pfap_bookmark_error_quark (void);
+GQuark gst_pfap_bookmark_error_quark(void);
 
 /**
  * GST_PFAP_MAX_BOOKMARKS:
@@ -80,7 +80,7 @@ GQuark gst_pfap_bookmark_error_quark (void);
  * with g_list_free_full() and gst_pfap_fap_free()
  */
 GST_PFAP_API
-GList *gst_pfap_bookmarks_parse (const gchar *text, guint max_bookmarks, GError **error);
+GList *gst_pfap_bookmarks_parse(const gchar *text, guint max_bookmarks, GError **error);
 
 /**
  * gst_pfap_bookmarks_format:
@@ -93,7 +93,7 @@ GList *gst_pfap_bookmarks_parse (const gchar *text, guint max_bookmarks, GError 
  * Returns: (transfer full): the bookmarks
  */
 GST_PFAP_API
-gchar *gst_pfap_bookmarks_format (const GList *faps);
+gchar *gst_pfap_bookmarks_format(const GList *faps);
 
 G_END_DECLS
 

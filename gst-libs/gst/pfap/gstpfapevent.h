@@ -121,7 +121,7 @@ typedef enum {
  *
  * The #GError domain of events that cannot be read or written.
  */
-#define GST_PFAP_EVENT_ERROR (gst_pfap_event_error_quark ())
+#define GST_PFAP_EVENT_ERROR (gst_pfap_event_error_quark())
 
 /**
  * GstPfapEventError:
@@ -136,7 +136,7 @@ typedef enum {
 } GstPfapEventError;
 
 GST_PFAP_API
-GQuark gst_pfap_event_error_quark (void);
+GQuark gst_pfap_event_error_quark(void);
 
 /**
  * GstPfapFap:
@@ -154,10 +154,10 @@ typedef struct {
   gint32 amplitude;
 } GstPfapFap;
 
-#define GST_PFAP_TYPE_FAP (gst_pfap_fap_get_type ())
+#define GST_TYPE_PFAP_FAP (gst_pfap_fap_get_type())
 
 GST_PFAP_API
-GType gst_pfap_fap_get_type (void);
+GType gst_pfap_fap_get_type(void);
 
 /**
  * gst_pfap_fap_new: (constructor)
@@ -170,8 +170,8 @@ GType gst_pfap_fap_get_type (void);
  * event written, a bookmark formatted), not here.
  */
 GST_PFAP_API
-GstPfapFap *gst_pfap_fap_new (guint8 index, gint32 amplitude, guint16 transition_ms,
-                              GstPfapCurve curve);
+GstPfapFap *gst_pfap_fap_new(guint8 index, gint32 amplitude, guint16 transition_ms,
+                             GstPfapCurve curve);
 
 /**
  * gst_pfap_fap_copy:
@@ -180,14 +180,14 @@ GstPfapFap *gst_pfap_fap_new (guint8 index, gint32 amplitude, guint16 transition
  * Returns: (transfer full): a copy of @fap
  */
 GST_PFAP_API
-GstPfapFap *gst_pfap_fap_copy (const GstPfapFap *fap);
+GstPfapFap *gst_pfap_fap_copy(const GstPfapFap *fap);
 
 /**
  * gst_pfap_fap_free:
  * @fap: (transfer full): a #GstPfapFap
  */
 GST_PFAP_API
-void gst_pfap_fap_free (GstPfapFap *fap);
+void gst_pfap_fap_free(GstPfapFap *fap);
 
 /**
  * GstPfapEvent:
@@ -196,10 +196,10 @@ void gst_pfap_fap_free (GstPfapFap *fap);
  */
 typedef struct _GstPfapEvent GstPfapEvent;
 
-#define GST_PFAP_TYPE_EVENT (gst_pfap_event_get_type ())
+#define GST_TYPE_PFAP_EVENT (gst_pfap_event_get_type())
 
 GST_PFAP_API
-GType gst_pfap_event_get_type (void);
+GType gst_pfap_event_get_type(void);
 
 /**
  * gst_pfap_event_new: (constructor)
@@ -209,7 +209,7 @@ GType gst_pfap_event_get_type (void);
  * symbol, duration and f0 0.
  */
 GST_PFAP_API
-GstPfapEvent *gst_pfap_event_new (GstPfapEventKind kind);
+GstPfapEvent *gst_pfap_event_new(GstPfapEventKind kind);
 
 /**
  * gst_pfap_event_new_from_data: (constructor)
@@ -224,7 +224,7 @@ GstPfapEvent *gst_pfap_event_new (GstPfapEventKind kind);
  * of range).
  */
 GST_PFAP_API
-GstPfapEvent *gst_pfap_event_new_from_data (const guint8 *data, gsize size, GError **error);
+GstPfapEvent *gst_pfap_event_new_from_data(const guint8 *data, gsize size, GError **error);
 
 /**
  * gst_pfap_event_new_from_buffer: (constructor)
@@ -237,7 +237,7 @@ GstPfapEvent *gst_pfap_event_new_from_data (const guint8 *data, gsize size, GErr
  * valid event.
  */
 GST_PFAP_API
-GstPfapEvent *gst_pfap_event_new_from_buffer (GstBuffer *buffer, GError **error);
+GstPfapEvent *gst_pfap_event_new_from_buffer(GstBuffer *buffer, GError **error);
 
 /**
  * gst_pfap_event_to_buffer:
@@ -245,13 +245,14 @@ GstPfapEvent *gst_pfap_event_new_from_buffer (GstBuffer *buffer, GError **error)
  * @error: a #GError for a %GST_PFAP_EVENT_ERROR_OUT_OF_RANGE value
  *
  * Writes @event into a new buffer for appsrc, after gst_init(). A phoneme's buffer has the
- * phoneme's duration; set its PTS to the phoneme's start. A state event's symbol, duration and f0 are written as 0.
+ * phoneme's duration; set its PTS to the phoneme's start. A state event's symbol, duration and f0
+ * are written as 0.
  *
  * Returns: (transfer full) (nullable): the buffer, or %NULL when a value is out of range
  * (the message says which).
  */
 GST_PFAP_API
-GstBuffer *gst_pfap_event_to_buffer (const GstPfapEvent *event, GError **error);
+GstBuffer *gst_pfap_event_to_buffer(const GstPfapEvent *event, GError **error);
 
 /**
  * gst_pfap_event_copy:
@@ -260,14 +261,14 @@ GstBuffer *gst_pfap_event_to_buffer (const GstPfapEvent *event, GError **error);
  * Returns: (transfer full): a copy of @event
  */
 GST_PFAP_API
-GstPfapEvent *gst_pfap_event_copy (const GstPfapEvent *event);
+GstPfapEvent *gst_pfap_event_copy(const GstPfapEvent *event);
 
 /**
  * gst_pfap_event_free:
  * @event: (transfer full): a #GstPfapEvent
  */
 GST_PFAP_API
-void gst_pfap_event_free (GstPfapEvent *event);
+void gst_pfap_event_free(GstPfapEvent *event);
 
 /**
  * gst_pfap_event_get_kind:
@@ -276,7 +277,7 @@ void gst_pfap_event_free (GstPfapEvent *event);
  * Returns: what @event is
  */
 GST_PFAP_API
-GstPfapEventKind gst_pfap_event_get_kind (const GstPfapEvent *event);
+GstPfapEventKind gst_pfap_event_get_kind(const GstPfapEvent *event);
 
 /**
  * gst_pfap_event_set_kind:
@@ -284,7 +285,7 @@ GstPfapEventKind gst_pfap_event_get_kind (const GstPfapEvent *event);
  * @kind: what it is
  */
 GST_PFAP_API
-void gst_pfap_event_set_kind (GstPfapEvent *event, GstPfapEventKind kind);
+void gst_pfap_event_set_kind(GstPfapEvent *event, GstPfapEventKind kind);
 
 /**
  * gst_pfap_event_get_flags:
@@ -293,7 +294,7 @@ void gst_pfap_event_set_kind (GstPfapEvent *event, GstPfapEventKind kind);
  * Returns: the flags of @event
  */
 GST_PFAP_API
-GstPfapEventFlags gst_pfap_event_get_flags (const GstPfapEvent *event);
+GstPfapEventFlags gst_pfap_event_get_flags(const GstPfapEvent *event);
 
 /**
  * gst_pfap_event_set_flags:
@@ -301,7 +302,7 @@ GstPfapEventFlags gst_pfap_event_get_flags (const GstPfapEvent *event);
  * @flags: its flags
  */
 GST_PFAP_API
-void gst_pfap_event_set_flags (GstPfapEvent *event, GstPfapEventFlags flags);
+void gst_pfap_event_set_flags(GstPfapEvent *event, GstPfapEventFlags flags);
 
 /**
  * gst_pfap_event_get_symbol:
@@ -310,7 +311,7 @@ void gst_pfap_event_set_flags (GstPfapEvent *event, GstPfapEventFlags flags);
  * Returns: the phoneme's symbol in the stream's alphabet (gst_pfap_alphabet_find())
  */
 GST_PFAP_API
-guint8 gst_pfap_event_get_symbol (const GstPfapEvent *event);
+guint8 gst_pfap_event_get_symbol(const GstPfapEvent *event);
 
 /**
  * gst_pfap_event_set_symbol:
@@ -318,7 +319,7 @@ guint8 gst_pfap_event_get_symbol (const GstPfapEvent *event);
  * @symbol: the phoneme's symbol
  */
 GST_PFAP_API
-void gst_pfap_event_set_symbol (GstPfapEvent *event, guint8 symbol);
+void gst_pfap_event_set_symbol(GstPfapEvent *event, guint8 symbol);
 
 /**
  * gst_pfap_event_get_duration_ms:
@@ -327,7 +328,7 @@ void gst_pfap_event_set_symbol (GstPfapEvent *event, guint8 symbol);
  * Returns: the phoneme's duration in milliseconds
  */
 GST_PFAP_API
-guint16 gst_pfap_event_get_duration_ms (const GstPfapEvent *event);
+guint16 gst_pfap_event_get_duration_ms(const GstPfapEvent *event);
 
 /**
  * gst_pfap_event_set_duration_ms:
@@ -335,7 +336,7 @@ guint16 gst_pfap_event_get_duration_ms (const GstPfapEvent *event);
  * @duration_ms: the phoneme's duration, 0..%GST_PFAP_MAX_DURATION_MS
  */
 GST_PFAP_API
-void gst_pfap_event_set_duration_ms (GstPfapEvent *event, guint16 duration_ms);
+void gst_pfap_event_set_duration_ms(GstPfapEvent *event, guint16 duration_ms);
 
 /**
  * gst_pfap_event_get_f0:
@@ -345,7 +346,7 @@ void gst_pfap_event_set_duration_ms (GstPfapEvent *event, guint16 duration_ms);
  * carries it (0: unknown or unvoiced)
  */
 GST_PFAP_API
-guint8 gst_pfap_event_get_f0 (const GstPfapEvent *event);
+guint8 gst_pfap_event_get_f0(const GstPfapEvent *event);
 
 /**
  * gst_pfap_event_set_f0:
@@ -353,7 +354,7 @@ guint8 gst_pfap_event_get_f0 (const GstPfapEvent *event);
  * @f0: the phoneme's average fundamental frequency in units of 2 Hz
  */
 GST_PFAP_API
-void gst_pfap_event_set_f0 (GstPfapEvent *event, guint8 f0);
+void gst_pfap_event_set_f0(GstPfapEvent *event, guint8 f0);
 
 /**
  * gst_pfap_event_get_n_faps:
@@ -362,7 +363,7 @@ void gst_pfap_event_set_f0 (GstPfapEvent *event, guint8 f0);
  * Returns: the number of FAPs of @event
  */
 GST_PFAP_API
-guint gst_pfap_event_get_n_faps (const GstPfapEvent *event);
+guint gst_pfap_event_get_n_faps(const GstPfapEvent *event);
 
 /**
  * gst_pfap_event_get_fap:
@@ -372,7 +373,7 @@ guint gst_pfap_event_get_n_faps (const GstPfapEvent *event);
  * Returns: (transfer full) (nullable): a copy of FAP @i of @event, or %NULL past the last
  */
 GST_PFAP_API
-GstPfapFap *gst_pfap_event_get_fap (const GstPfapEvent *event, guint i);
+GstPfapFap *gst_pfap_event_get_fap(const GstPfapEvent *event, guint i);
 
 /**
  * gst_pfap_event_get_faps:
@@ -382,7 +383,7 @@ GstPfapFap *gst_pfap_event_get_fap (const GstPfapEvent *event, guint i);
  * free with g_list_free_full() and gst_pfap_fap_free()
  */
 GST_PFAP_API
-GList *gst_pfap_event_get_faps (const GstPfapEvent *event);
+GList *gst_pfap_event_get_faps(const GstPfapEvent *event);
 
 /**
  * gst_pfap_event_add_fap:
@@ -390,7 +391,7 @@ GList *gst_pfap_event_get_faps (const GstPfapEvent *event);
  * @fap: a FAP target to append
  */
 GST_PFAP_API
-void gst_pfap_event_add_fap (GstPfapEvent *event, const GstPfapFap *fap);
+void gst_pfap_event_add_fap(GstPfapEvent *event, const GstPfapFap *fap);
 
 /**
  * gst_pfap_event_clear_faps:
@@ -399,10 +400,10 @@ void gst_pfap_event_add_fap (GstPfapEvent *event, const GstPfapFap *fap);
  * Removes every FAP from @event.
  */
 GST_PFAP_API
-void gst_pfap_event_clear_faps (GstPfapEvent *event);
+void gst_pfap_event_clear_faps(GstPfapEvent *event);
 
-G_DEFINE_AUTOPTR_CLEANUP_FUNC (GstPfapFap, gst_pfap_fap_free)
-G_DEFINE_AUTOPTR_CLEANUP_FUNC (GstPfapEvent, gst_pfap_event_free)
+G_DEFINE_AUTOPTR_CLEANUP_FUNC(GstPfapFap, gst_pfap_fap_free)
+G_DEFINE_AUTOPTR_CLEANUP_FUNC(GstPfapEvent, gst_pfap_event_free)
 
 G_END_DECLS
 

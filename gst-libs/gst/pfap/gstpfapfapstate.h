@@ -4,8 +4,8 @@
 #ifndef __GST_PFAP_FAP_STATE_H__
 #define __GST_PFAP_FAP_STATE_H__
 
-#include <gst/pfap/pfap-prelude.h>
 #include <gst/pfap/gstpfapevent.h>
+#include <gst/pfap/pfap-prelude.h>
 
 G_BEGIN_DECLS
 
@@ -21,10 +21,10 @@ G_BEGIN_DECLS
  * callback applying events while the application's thread draws.
  */
 
-#define GST_PFAP_TYPE_FAP_STATE (gst_pfap_fap_state_get_type ())
+#define GST_TYPE_PFAP_FAP_STATE (gst_pfap_fap_state_get_type())
 
 GST_PFAP_API
-G_DECLARE_FINAL_TYPE (GstPfapFapState, gst_pfap_fap_state, GST_PFAP, FAP_STATE, GObject)
+G_DECLARE_FINAL_TYPE(GstPfapFapState, gst_pfap_fap_state, GST, PFAP_FAP_STATE, GObject)
 
 /**
  * gst_pfap_fap_state_new: (constructor)
@@ -32,7 +32,7 @@ G_DECLARE_FINAL_TYPE (GstPfapFapState, gst_pfap_fap_state, GST_PFAP, FAP_STATE, 
  * Returns: (transfer full): a state with every FAP at 0
  */
 GST_PFAP_API
-GstPfapFapState *gst_pfap_fap_state_new (void);
+GstPfapFapState *gst_pfap_fap_state_new(void);
 
 /**
  * gst_pfap_fap_state_apply_event:
@@ -48,8 +48,8 @@ GstPfapFapState *gst_pfap_fap_state_new (void);
  * Returns: whether @event was applied
  */
 GST_PFAP_API
-gboolean gst_pfap_fap_state_apply_event (GstPfapFapState *state, const GstPfapEvent *event,
-                                         GstClockTime time, GError **error);
+gboolean gst_pfap_fap_state_apply_event(GstPfapFapState *state, const GstPfapEvent *event,
+                                        GstClockTime time, GError **error);
 
 /**
  * gst_pfap_fap_state_apply_fap:
@@ -63,8 +63,8 @@ gboolean gst_pfap_fap_state_apply_event (GstPfapFapState *state, const GstPfapEv
  * Returns: whether @fap was applied: %FALSE, changing nothing, when it is out of range
  */
 GST_PFAP_API
-gboolean gst_pfap_fap_state_apply_fap (GstPfapFapState *state, const GstPfapFap *fap,
-                                       GstClockTime time, GError **error);
+gboolean gst_pfap_fap_state_apply_fap(GstPfapFapState *state, const GstPfapFap *fap,
+                                      GstClockTime time, GError **error);
 
 /**
  * gst_pfap_fap_state_get_amplitude:
@@ -75,8 +75,7 @@ gboolean gst_pfap_fap_state_apply_fap (GstPfapFapState *state, const GstPfapFap 
  * Returns: the amplitude of FAP @index at @time
  */
 GST_PFAP_API
-gdouble gst_pfap_fap_state_get_amplitude (GstPfapFapState *state, guint index,
-                                          GstClockTime time);
+gdouble gst_pfap_fap_state_get_amplitude(GstPfapFapState *state, guint index, GstClockTime time);
 
 /**
  * gst_pfap_fap_state_get_settled:
@@ -87,7 +86,7 @@ gdouble gst_pfap_fap_state_get_amplitude (GstPfapFapState *state, guint index,
  * what it held before
  */
 GST_PFAP_API
-gint32 gst_pfap_fap_state_get_settled (GstPfapFapState *state, guint index);
+gint32 gst_pfap_fap_state_get_settled(GstPfapFapState *state, guint index);
 
 /**
  * gst_pfap_fap_state_is_at_rest:
@@ -98,8 +97,7 @@ gint32 gst_pfap_fap_state_get_settled (GstPfapFapState *state, guint index);
  * Returns: whether FAP @index has no transition running at @time
  */
 GST_PFAP_API
-gboolean gst_pfap_fap_state_is_at_rest (GstPfapFapState *state, guint index,
-                                        GstClockTime time);
+gboolean gst_pfap_fap_state_is_at_rest(GstPfapFapState *state, guint index, GstClockTime time);
 
 /**
  * gst_pfap_fap_state_reset:
@@ -108,7 +106,7 @@ gboolean gst_pfap_fap_state_is_at_rest (GstPfapFapState *state, guint index,
  * Returns every FAP to 0 with no transition running, as a new state.
  */
 GST_PFAP_API
-void gst_pfap_fap_state_reset (GstPfapFapState *state);
+void gst_pfap_fap_state_reset(GstPfapFapState *state);
 
 G_END_DECLS
 

@@ -9,11 +9,11 @@
 #include <gst/gst.h>
 
 #ifndef GST_PFAP_API
-# ifdef BUILDING_GST_PFAP
-#  define GST_PFAP_API GST_API_EXPORT
-# else
-#  define GST_PFAP_API GST_API_IMPORT
-# endif
+#ifdef BUILDING_GST_PFAP
+#define GST_PFAP_API GST_API_EXPORT
+#else
+#define GST_PFAP_API GST_API_IMPORT
+#endif
 #endif
 
 #endif /* __GST_PFAP_PRELUDE_H__ */

@@ -8,11 +8,11 @@
 #ifndef __GST_PFAP_H__
 #define __GST_PFAP_H__
 
-#include <gst/pfap/pfap-prelude.h>
-#include <gst/pfap/pfap-enumtypes.h>
-#include <gst/pfap/gstpfapevent.h>
 #include <gst/pfap/gstpfapalphabet.h>
 #include <gst/pfap/gstpfapbookmark.h>
+#include <gst/pfap/gstpfapevent.h>
 #include <gst/pfap/gstpfapfapstate.h>
+#include <gst/pfap/pfap-enumtypes.h>
+#include <gst/pfap/pfap-prelude.h>
 
 #endif /* __GST_PFAP_H__ */
