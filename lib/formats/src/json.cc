@@ -3,6 +3,8 @@
 
 #include <cstring>
 
+#include "pfap/utf8.h"
+
 namespace pfap::json {
 namespace {
 
@@ -156,24 +158,6 @@ class Parser {
     return true;
   }
 
-  static void append_utf8(uint32_t c, std::string& out) {
-    if (c < 0x80) {
-      out += static_cast<char>(c);
-    } else if (c < 0x800) {
-      out += static_cast<char>(0xC0 | (c >> 6));
-      out += static_cast<char>(0x80 | (c & 0x3F));
-    } else if (c < 0x10000) {
-      out += static_cast<char>(0xE0 | (c >> 12));
-      out += static_cast<char>(0x80 | ((c >> 6) & 0x3F));
-      out += static_cast<char>(0x80 | (c & 0x3F));
-    } else {
-      out += static_cast<char>(0xF0 | (c >> 18));
-      out += static_cast<char>(0x80 | ((c >> 12) & 0x3F));
-      out += static_cast<char>(0x80 | ((c >> 6) & 0x3F));
-      out += static_cast<char>(0x80 | (c & 0x3F));
-    }
-  }
-
   bool hex4(uint32_t& out) {
     if (text_.size() - pos_ < 4) return fail("a \\u escape needs 4 hex digits");
     out = 0;
@@ -277,7 +261,7 @@ class Parser {
           } else if (code >= 0xDC00 && code <= 0xDFFF) {
             return fail("a lone surrogate in \\u escapes");
           }
-          append_utf8(code, out);
+          encode_utf8(code, out);
           break;
         }
         default:
