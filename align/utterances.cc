@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <utility>
 
+#include "pfap/phoneme_table.h"
+
 namespace pfap::align {
 
 namespace {
@@ -19,6 +21,28 @@ PhonemeSource phoneme_source(bool has_text, Recognizer recognizer) {
   if (has_text) return PhonemeSource::kTexts;
   if (recognizer == Recognizer::kVisemes) return PhonemeSource::kVisemes;
   return recognition_available() ? PhonemeSource::kRecognition : PhonemeSource::kPause;
+}
+
+std::string_view alphabet_of(PhonemeSource source) {
+  return source == PhonemeSource::kVisemes ? kOculusVisemeAlphabet : kArpabetAlphabet;
+}
+
+unsigned live_latency_ms(PhonemeSource source) {
+  switch (source) {
+    case PhonemeSource::kRecognition:
+      return kLiveRecognitionLatencyMs;
+    case PhonemeSource::kVisemes:
+      return kLiveVisemeLatencyMs;
+    default:
+      return kLiveLatencyMs;
+  }
+}
+
+RateProblem rate_problem(unsigned rate, Recognizer recognizer) {
+  if (recognizer == Recognizer::kVisemes) {
+    return visemes_take_rate(rate) ? RateProblem::kNone : RateProblem::kCannotDetectVisemes;
+  }
+  return rate < kMinRate || rate > kMaxRate ? RateProblem::kCannotAlign : RateProblem::kNone;
 }
 
 std::vector<UtteranceSpan> utterances_of(std::vector<TimedText>& texts,

@@ -14,6 +14,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "aligner.h"  // kMaxAudioSeconds
@@ -29,6 +30,18 @@ namespace pfap::align {
 enum class Recognizer { kPhonemes, kVisemes };
 enum class PhonemeSource { kTexts, kRecognition, kPause, kVisemes };
 PhonemeSource phoneme_source(bool has_text, Recognizer recognizer = Recognizer::kPhonemes);
+
+// The alphabet of phonemes from `source`: the viseme detector's, else x-pfap-arpabet.
+std::string_view alphabet_of(PhonemeSource source);
+
+// The latency the live mode declares for phonemes from `source`, in ms: the aligner's
+// (kLiveLatencyMs; a pause is aligned as a text), pocketsphinx's or the viseme detector's.
+unsigned live_latency_ms(PhonemeSource source);
+
+// What audio at `rate` Hz cannot be: aligned (kMinRate..kMaxRate), or heard by the viseme
+// detector where it has the stream (`recognizer` kVisemes). Either way its phonemes are pauses.
+enum class RateProblem { kNone, kCannotAlign, kCannotDetectVisemes };
+RateProblem rate_problem(unsigned rate, Recognizer recognizer);
 
 // One text: the sample it starts at, counted from the first sample kept (none: it has no
 // time, and continues the text before it offline or starts at the audio so far live), and its

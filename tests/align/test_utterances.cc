@@ -50,6 +50,37 @@ TEST(Utterances, TextsComeFirstThenTheRecognizerThenAPause) {
             PhonemeSource::kTexts);
 }
 
+// The detector's phonemes are its visemes; the rest x-pfap-arpabet. Live, each source
+// declares its own latency: a pause is aligned as a text is.
+TEST(Utterances, EachSourceHasItsAlphabetAndLiveLatency) {
+  using pfap::align::PhonemeSource;
+  EXPECT_EQ(pfap::align::alphabet_of(PhonemeSource::kVisemes), "x-pfap-oculus-viseme");
+  for (const PhonemeSource source :
+       {PhonemeSource::kTexts, PhonemeSource::kRecognition, PhonemeSource::kPause}) {
+    EXPECT_EQ(pfap::align::alphabet_of(source), "x-pfap-arpabet");
+  }
+  EXPECT_EQ(pfap::align::live_latency_ms(PhonemeSource::kTexts), 400u);
+  EXPECT_EQ(pfap::align::live_latency_ms(PhonemeSource::kPause), 400u);
+  EXPECT_EQ(pfap::align::live_latency_ms(PhonemeSource::kRecognition), 700u);
+  EXPECT_EQ(pfap::align::live_latency_ms(PhonemeSource::kVisemes), 95u);
+}
+
+// The aligner takes 16 to 48 kHz; the viseme detector, where it has the stream, 8 to 192.
+TEST(Utterances, RatesOutsideWhatHearsTheAudioAreAProblem) {
+  using pfap::align::RateProblem;
+  using pfap::align::Recognizer;
+  EXPECT_EQ(pfap::align::rate_problem(15999, Recognizer::kPhonemes), RateProblem::kCannotAlign);
+  EXPECT_EQ(pfap::align::rate_problem(16000, Recognizer::kPhonemes), RateProblem::kNone);
+  EXPECT_EQ(pfap::align::rate_problem(48000, Recognizer::kPhonemes), RateProblem::kNone);
+  EXPECT_EQ(pfap::align::rate_problem(48001, Recognizer::kPhonemes), RateProblem::kCannotAlign);
+  EXPECT_EQ(pfap::align::rate_problem(7999, Recognizer::kVisemes),
+            RateProblem::kCannotDetectVisemes);
+  EXPECT_EQ(pfap::align::rate_problem(8000, Recognizer::kVisemes), RateProblem::kNone);
+  EXPECT_EQ(pfap::align::rate_problem(192000, Recognizer::kVisemes), RateProblem::kNone);
+  EXPECT_EQ(pfap::align::rate_problem(192001, Recognizer::kVisemes),
+            RateProblem::kCannotDetectVisemes);
+}
+
 TEST(Utterances, NoTextAtAllIsToBeRecognized) {
   std::vector<TimedText> texts;
   std::vector<size_t> later;
