@@ -45,6 +45,26 @@ RateProblem rate_problem(unsigned rate, Recognizer recognizer) {
   return rate < kMinRate || rate > kMaxRate ? RateProblem::kCannotAlign : RateProblem::kNone;
 }
 
+bool hear(std::span<const int16_t> audio, unsigned rate, PhonemeSource source, Heard& out,
+          std::string& error) {
+  out = Heard{};
+  if (source == PhonemeSource::kVisemes) {
+    VisemePhonemes visemes(rate, 0);
+    visemes.push(audio, out.phonemes);
+    visemes.finish(out.phonemes);
+    return true;
+  }
+  Recognition recognition;
+  if (!recognize(audio, rate, recognition, error)) {
+    if (source == PhonemeSource::kRecognition) return false;
+    out.cannot_recognize = true;  // recognition is one pause
+  } else {
+    out.problem = recognition.problem;
+  }
+  out.phonemes = std::move(recognition.phonemes);
+  return true;
+}
+
 std::vector<UtteranceSpan> utterances_of(std::vector<TimedText>& texts,
                                          const std::optional<std::string>& whole, size_t n,
                                          bool end_of_stream, std::vector<size_t>& later) {

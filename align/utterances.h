@@ -43,6 +43,17 @@ unsigned live_latency_ms(PhonemeSource source);
 enum class RateProblem { kNone, kCannotAlign, kCannotDetectVisemes };
 RateProblem rate_problem(unsigned rate, Recognizer recognizer);
 
+// Offline, without a text: the phonemes of audio heard by a PhonemeSource other than kTexts,
+// contiguous from sample 0 to the audio's end.
+struct Heard {
+  std::vector<tts::SpokenPhoneme> phonemes;
+  RecognitionProblem problem = RecognitionProblem::kNone;  // what the recognizer met
+  bool cannot_recognize = false;  // kPause: the build has no recognizer, the audio is a pause
+};
+// False with `error` where kRecognition's model cannot be loaded.
+bool hear(std::span<const int16_t> audio, unsigned rate, PhonemeSource source, Heard& out,
+          std::string& error);
+
 // One text: the sample it starts at, counted from the first sample kept (none: it has no
 // time, and continues the text before it offline or starts at the audio so far live), and its
 // bytes (any, UTF-8 is checked later).

@@ -263,34 +263,20 @@ static void warn_recognition_problem(GstPfapAlign* self, pfap::align::Recognitio
                       ("%" G_GUINT64_FORMAT " so far", s.recognition_problems[k]));
 }
 
-// Without a text: the phonemes of all the audio kept recognized from it alone (`source`
-// kRecognition), or one pause with a warning where the build cannot (kPause).
-static GstFlowReturn recognize_kept(GstPfapAlign* self, pfap::align::PhonemeSource source) {
+// Without a text: the phonemes of all the audio kept, heard by `source` (recognized or the
+// detector's visemes), or one pause with a warning where the build cannot recognize.
+static GstFlowReturn hear_kept(GstPfapAlign* self, pfap::align::PhonemeSource source) {
   Stream& s = *self->stream;
-  GST_INFO_OBJECT(self, "no text: recognizing %zu samples", s.kept.samples().size());
-  pfap::align::Recognition recognition;
+  GST_INFO_OBJECT(self, "no text: hearing %zu samples", s.kept.samples().size());
+  pfap::align::Heard heard;
   std::string error;
-  if (!pfap::align::recognize(s.kept.samples(), s.rate, recognition, error)) {
-    if (source == pfap::align::PhonemeSource::kRecognition) {  // the model is missing
-      GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));
-      return GST_FLOW_ERROR;
-    }
-    warn_cannot_recognize(self);
-  } else {
-    warn_recognition_problem(self, recognition.problem, s.first);
+  if (!pfap::align::hear(s.kept.samples(), s.rate, source, heard, error)) {
+    GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));  // no model
+    return GST_FLOW_ERROR;
   }
-  return push_phonemes(self, recognition.phonemes, 0);
-}
-
-// recognizer=visemes: the viseme detector's phonemes of all the audio kept.
-static GstFlowReturn detect_visemes_kept(GstPfapAlign* self) {
-  Stream& s = *self->stream;
-  GST_INFO_OBJECT(self, "no text: detecting the visemes of %zu samples", s.kept.samples().size());
-  pfap::align::VisemePhonemes visemes(s.rate, 0);
-  std::vector<pfap::tts::SpokenPhoneme> phonemes;
-  visemes.push(s.kept.samples(), phonemes);
-  visemes.finish(phonemes);
-  return push_phonemes(self, phonemes, 0);
+  if (heard.cannot_recognize) warn_cannot_recognize(self);
+  warn_recognition_problem(self, heard.problem, s.first);
+  return push_phonemes(self, heard.phonemes, 0);
 }
 
 // The utterance of the text `bytes` starting at `at`, bad UTF-8 and bookmarks warned about.
@@ -388,11 +374,7 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
   const pfap::align::PhonemeSource source =
       pfap::align::phoneme_source(!utterances.empty(), s.recognizer);
   GstFlowReturn ret = GST_FLOW_OK;
-  if (source == pfap::align::PhonemeSource::kVisemes) {
-    ret = detect_visemes_kept(self);
-  } else if (source != pfap::align::PhonemeSource::kTexts) {
-    ret = recognize_kept(self, source);
-  }
+  if (source != pfap::align::PhonemeSource::kTexts) ret = hear_kept(self, source);
   for (const pfap::align::UtteranceSpan& u : utterances) {
     if (ret != GST_FLOW_OK) break;
     ret = align_utterance(self, u);

@@ -81,6 +81,34 @@ TEST(Utterances, RatesOutsideWhatHearsTheAudioAreAProblem) {
             RateProblem::kCannotDetectVisemes);
 }
 
+// Without a text, silence is heard as pauses by each source; a build without pocketsphinx
+// says it cannot recognize (kPause) or cannot load the model (kRecognition).
+TEST(Utterances, WithoutATextTheAudioIsHeardOrAPause) {
+  using pfap::align::PhonemeSource;
+  const unsigned rate = 16000;
+  const std::vector<int16_t> silence(rate, 0);
+  const bool available = pfap::align::recognition_available();
+  pfap::align::Heard heard;
+  std::string error;
+
+  ASSERT_TRUE(pfap::align::hear(silence, rate, PhonemeSource::kVisemes, heard, error));
+  pfap::align::testing::expect_tiles(heard.phonemes, silence.size(), rate);
+  EXPECT_FALSE(heard.cannot_recognize);
+
+  ASSERT_TRUE(pfap::align::hear(silence, rate, PhonemeSource::kPause, heard, error));
+  pfap::align::testing::expect_tiles(heard.phonemes, silence.size(), rate);
+  EXPECT_EQ(heard.cannot_recognize, !available);
+
+  EXPECT_EQ(pfap::align::hear(silence, rate, PhonemeSource::kRecognition, heard, error), available);
+  if (available) {
+    pfap::align::testing::expect_tiles(heard.phonemes, silence.size(), rate);
+    EXPECT_EQ(heard.problem, pfap::align::RecognitionProblem::kNoSpeech);
+    EXPECT_FALSE(heard.cannot_recognize);
+  } else {
+    EXPECT_FALSE(error.empty());
+  }
+}
+
 TEST(Utterances, NoTextAtAllIsToBeRecognized) {
   std::vector<TimedText> texts;
   std::vector<size_t> later;
