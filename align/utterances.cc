@@ -228,19 +228,17 @@ bool LiveUtterances::start_text(const tts::Utterance& utterance, const tts::Voic
   return true;
 }
 
-bool LiveUtterances::start_recognition(unsigned rate, std::string& error) {
-  if (!recognizer_.start(rate, error)) return false;
+bool LiveUtterances::start_heard(Recognizer recognizer, unsigned rate, std::string& error) {
+  if (recognizer == Recognizer::kVisemes) {
+    visemes_.emplace(rate, kLiveVisemeRunFrames);
+    kind_ = Kind::kVisemes;
+  } else {
+    if (!recognizer_.start(rate, error)) return false;
+    kind_ = Kind::kRecognition;
+  }
   open_ = true;
-  kind_ = Kind::kRecognition;
   from_ = samples_;
   return true;
-}
-
-void LiveUtterances::start_visemes(unsigned rate) {
-  visemes_.emplace(rate, kLiveVisemeRunFrames);
-  open_ = true;
-  kind_ = Kind::kVisemes;
-  from_ = samples_;
 }
 
 void LiveUtterances::push(std::span<const int16_t> samples, std::vector<tts::SpokenPhoneme>& out) {

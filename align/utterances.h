@@ -177,12 +177,10 @@ class LiveUtterances {
   // cannot be aligned exactly.
   bool start_text(const tts::Utterance& utterance, const tts::VoiceSettings& voice, unsigned rate,
                   std::string& error);
-  // Opens the recognizer's utterance at the audio so far (end() the open one first). False
-  // with `error` where the model cannot be loaded.
-  bool start_recognition(unsigned rate, std::string& error);
-  // Opens the viseme detector's utterance at the audio so far (end() the open one first), its
-  // runs in pieces of kLiveVisemeRunFrames.
-  void start_visemes(unsigned rate);
+  // Opens the utterance heard by `recognizer` at the audio so far, to the stream's end (end()
+  // the open one first): pocketsphinx's, or the viseme detector's with its runs in pieces of
+  // kLiveVisemeRunFrames. False with `error` where pocketsphinx's model cannot be loaded.
+  bool start_heard(Recognizer recognizer, unsigned rate, std::string& error);
   // Gives `samples` to the open utterance; the phonemes now settled to `out`.
   void push(std::span<const int16_t> samples, std::vector<tts::SpokenPhoneme>& out);
   // Ends the open utterance, if any, at the audio so far: its last phonemes to `out`.

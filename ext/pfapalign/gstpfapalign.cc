@@ -73,8 +73,8 @@
 #include "pfap/markup.h"
 #include "ratelimit.h"
 #include "recognizer.h"
+#include "sample_times.h"
 #include "sparse.h"
-#include "timeline.h"
 #include "utterances.h"
 
 GST_DEBUG_CATEGORY_STATIC(pfapalign_debug);
@@ -432,16 +432,6 @@ static GstFlowReturn live_start_utterance(GstPfapAlign* self, const std::string&
   return GST_FLOW_OK;
 }
 
-// Without a text: the recognizer's utterance from the audio so far, to the stream's end.
-static GstFlowReturn live_start_recognition(GstPfapAlign* self) {
-  std::string error;
-  if (!self->stream->utterances.start_recognition(self->stream->rate, error)) {
-    GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));  // no model
-    return GST_FLOW_ERROR;
-  }
-  return GST_FLOW_OK;
-}
-
 // Gives `samples` to the open utterance and pushes the phonemes now settled.
 static GstFlowReturn live_feed(GstPfapAlign* self, std::span<const int16_t> samples) {
   std::vector<pfap::tts::SpokenPhoneme> phonemes;
@@ -473,14 +463,15 @@ static GstFlowReturn live_chain(GstPfapAlign* self, GstBuffer* buffer) {
     const std::optional<std::string> property = text_property(self);
     const bool from_pad = gst_pad_is_linked(self->textpad);
     const pfap::align::PhonemeSource source = live_source(self);
-    if (source == pfap::align::PhonemeSource::kRecognition) {
-      ret = live_start_recognition(self);
-    } else if (source == pfap::align::PhonemeSource::kVisemes) {
-      s.utterances.start_visemes(s.rate);
-    } else {
+    std::string error;
+    if (source == pfap::align::PhonemeSource::kTexts ||
+        source == pfap::align::PhonemeSource::kPause) {
       if (source == pfap::align::PhonemeSource::kPause) warn_cannot_recognize(self);
       ret = live_start_utterance(self, from_pad ? "" : property.value_or(""),
                                  !from_pad && property.has_value());
+    } else if (!s.utterances.start_heard(s.recognizer, s.rate, error)) {
+      GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));  // no model
+      ret = GST_FLOW_ERROR;
     }
   }
   size_t done = 0;

@@ -306,4 +306,29 @@ TEST(Utterances, LivePhonemesCountFromTheStreamsStartAndTileIt) {
   EXPECT_FALSE(live.is_open());
 }
 
+// Without a text, the live utterance is heard to the stream's end: by the viseme detector, or
+// by pocketsphinx where the build has it.
+TEST(Utterances, LiveUtterancesHeardWithoutATextAreTheRecognizersOrTheDetectors) {
+  const unsigned rate = 16000;
+  const std::vector<int16_t> silence(rate, 0);
+  std::vector<tts::SpokenPhoneme> out;
+  std::string error;
+  pfap::align::LiveUtterances visemes;
+  ASSERT_TRUE(visemes.start_heard(pfap::align::Recognizer::kVisemes, rate, error)) << error;
+  EXPECT_TRUE(visemes.is_open());
+  EXPECT_FALSE(visemes.is_recognizing());
+  visemes.push(silence, out);
+  visemes.end(out);
+  EXPECT_FALSE(visemes.is_open());
+  ASSERT_FALSE(out.empty());
+  EXPECT_EQ(out.front().start, 0u);
+  EXPECT_EQ(out.back().start + out.back().n_samples, silence.size());
+
+  pfap::align::LiveUtterances phonemes;
+  const bool available = pfap::align::recognition_available();
+  EXPECT_EQ(phonemes.start_heard(pfap::align::Recognizer::kPhonemes, rate, error), available);
+  EXPECT_EQ(phonemes.is_recognizing(), available);
+  EXPECT_EQ(error.empty(), available);
+}
+
 }  // namespace

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// pfapalign's timeline without GStreamer: align/ counts samples from the first sample a
+// pfapalign's sample times without GStreamer: align/ counts samples from the first sample a
 // stream kept; the element's buffers and texts carry times in ns. These turn one into the
 // other, with GStreamer's rounding (gst_util_uint64_scale down, _round to the nearest).
 #pragma once

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-#include "timeline.h"
+#include "sample_times.h"
 
 namespace pfap::align {
 

@@ -1,12 +1,12 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// pfapalign's timeline: samples to ns and back, with GStreamer's rounding, checked against
+// pfapalign's sample times: samples to ns and back, with GStreamer's rounding, checked against
 // the exact 128-bit products.
 #include <gtest/gtest.h>
 
 #include <cstdint>
 #include <vector>
 
-#include "timeline.h"
+#include "sample_times.h"
 
 namespace {
 
@@ -24,7 +24,7 @@ uint64_t exact_sample(uint64_t first, uint64_t position, unsigned rate) {
   return static_cast<uint64_t>((Wide{position - first} * rate + kSecond / 2) / kSecond);
 }
 
-TEST(Timeline, SampleTimesRoundDown) {
+TEST(SampleTimes, SampleTimesRoundDown) {
   struct Case {
     uint64_t sample;
     unsigned rate;
@@ -40,7 +40,7 @@ TEST(Timeline, SampleTimesRoundDown) {
   }
 }
 
-TEST(Timeline, SamplesAtATimeRoundToTheNearestHalvesUp) {
+TEST(SampleTimes, SamplesAtATimeRoundToTheNearestHalvesUp) {
   EXPECT_EQ(pfap::align::sample_at(kFirst, 0, 16000), 0u);       // before the first sample
   EXPECT_EQ(pfap::align::sample_at(kFirst, kFirst, 16000), 0u);  // at it
   EXPECT_EQ(pfap::align::sample_at(kFirst, kFirst + 31'249, 16000), 0u);
@@ -49,7 +49,7 @@ TEST(Timeline, SamplesAtATimeRoundToTheNearestHalvesUp) {
 }
 
 // Over a day of audio at each rate, where a 64-bit product of ns and rate would overflow.
-TEST(Timeline, AgreesWithTheExactProductsAtEveryRateAndLength) {
+TEST(SampleTimes, AgreesWithTheExactProductsAtEveryRateAndLength) {
   for (const unsigned rate : {1u, 8000u, 11025u, 16000u, 22050u, 44100u, 48000u}) {
     for (uint64_t sample = 0; sample < 200'000'000'000ull; sample = sample * 3 + 7) {
       ASSERT_EQ(pfap::align::sample_time(kFirst, sample, rate), exact_time(kFirst, sample, rate))
@@ -64,7 +64,7 @@ TEST(Timeline, AgreesWithTheExactProductsAtEveryRateAndLength) {
 }
 
 // Phonemes that tile the samples tile the time: each PTS is the last one's end.
-TEST(Timeline, PhonemesThatTileTheSamplesTileTheTime) {
+TEST(SampleTimes, PhonemesThatTileTheSamplesTileTheTime) {
   const unsigned rate = 22050;
   const uint64_t from = 12345;
   uint64_t end = pfap::align::sample_time(kFirst, from, rate);
