@@ -167,7 +167,7 @@ class LiveUtterances {
   // A new stream: nothing open, no audio yet.
   void reset();
   bool is_open() const { return open_; }
-  // The open utterance is pocketsphinx's (start_recognition()).
+  // The open utterance is pocketsphinx's (start_heard() with Recognizer::kPhonemes).
   bool is_recognizing() const { return open_ && kind_ == Kind::kRecognition; }
   size_t samples() const { return samples_; }       // the audio so far
   size_t utterance_start() const { return from_; }  // the open utterance's first sample
