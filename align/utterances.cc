@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <utility>
 
+#include "pfap/phoneme_table.h"
+
 namespace pfap::align {
 
 namespace {
@@ -19,6 +21,48 @@ PhonemeSource phoneme_source(bool has_text, Recognizer recognizer) {
   if (has_text) return PhonemeSource::kTexts;
   if (recognizer == Recognizer::kVisemes) return PhonemeSource::kVisemes;
   return recognition_available() ? PhonemeSource::kRecognition : PhonemeSource::kPause;
+}
+
+std::string_view alphabet_of(PhonemeSource source) {
+  return source == PhonemeSource::kVisemes ? kOculusVisemeAlphabet : kArpabetAlphabet;
+}
+
+unsigned live_latency_ms(PhonemeSource source) {
+  switch (source) {
+    case PhonemeSource::kRecognition:
+      return kLiveRecognitionLatencyMs;
+    case PhonemeSource::kVisemes:
+      return kLiveVisemeLatencyMs;
+    default:
+      return kLiveLatencyMs;
+  }
+}
+
+RateProblem rate_problem(unsigned rate, Recognizer recognizer) {
+  if (recognizer == Recognizer::kVisemes) {
+    return visemes_take_rate(rate) ? RateProblem::kNone : RateProblem::kCannotDetectVisemes;
+  }
+  return rate < kMinRate || rate > kMaxRate ? RateProblem::kCannotAlign : RateProblem::kNone;
+}
+
+bool hear(std::span<const int16_t> audio, unsigned rate, PhonemeSource source, Heard& out,
+          std::string& error) {
+  out = Heard{};
+  if (source == PhonemeSource::kVisemes) {
+    VisemePhonemes visemes(rate, 0);
+    visemes.push(audio, out.phonemes);
+    visemes.finish(out.phonemes);
+    return true;
+  }
+  Recognition recognition;
+  if (!recognize(audio, rate, recognition, error)) {
+    if (source == PhonemeSource::kRecognition) return false;
+    out.cannot_recognize = true;  // recognition is one pause
+  } else {
+    out.problem = recognition.problem;
+  }
+  out.phonemes = std::move(recognition.phonemes);
+  return true;
 }
 
 std::vector<UtteranceSpan> utterances_of(std::vector<TimedText>& texts,
@@ -184,19 +228,17 @@ bool LiveUtterances::start_text(const tts::Utterance& utterance, const tts::Voic
   return true;
 }
 
-bool LiveUtterances::start_recognition(unsigned rate, std::string& error) {
-  if (!recognizer_.start(rate, error)) return false;
+bool LiveUtterances::start_heard(Recognizer recognizer, unsigned rate, std::string& error) {
+  if (recognizer == Recognizer::kVisemes) {
+    visemes_.emplace(rate, kLiveVisemeRunFrames);
+    kind_ = Kind::kVisemes;
+  } else {
+    if (!recognizer_.start(rate, error)) return false;
+    kind_ = Kind::kRecognition;
+  }
   open_ = true;
-  kind_ = Kind::kRecognition;
   from_ = samples_;
   return true;
-}
-
-void LiveUtterances::start_visemes(unsigned rate) {
-  visemes_.emplace(rate, kLiveVisemeRunFrames);
-  open_ = true;
-  kind_ = Kind::kVisemes;
-  from_ = samples_;
 }
 
 void LiveUtterances::push(std::span<const int16_t> samples, std::vector<tts::SpokenPhoneme>& out) {

@@ -14,6 +14,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "aligner.h"  // kMaxAudioSeconds
@@ -29,6 +30,29 @@ namespace pfap::align {
 enum class Recognizer { kPhonemes, kVisemes };
 enum class PhonemeSource { kTexts, kRecognition, kPause, kVisemes };
 PhonemeSource phoneme_source(bool has_text, Recognizer recognizer = Recognizer::kPhonemes);
+
+// The alphabet of phonemes from `source`: the viseme detector's, else x-pfap-arpabet.
+std::string_view alphabet_of(PhonemeSource source);
+
+// The latency the live mode declares for phonemes from `source`, in ms: the aligner's
+// (kLiveLatencyMs; a pause is aligned as a text), pocketsphinx's or the viseme detector's.
+unsigned live_latency_ms(PhonemeSource source);
+
+// What audio at `rate` Hz cannot be: aligned (kMinRate..kMaxRate), or heard by the viseme
+// detector where it has the stream (`recognizer` kVisemes). Either way its phonemes are pauses.
+enum class RateProblem { kNone, kCannotAlign, kCannotDetectVisemes };
+RateProblem rate_problem(unsigned rate, Recognizer recognizer);
+
+// Offline, without a text: the phonemes of audio heard by a PhonemeSource other than kTexts,
+// contiguous from sample 0 to the audio's end.
+struct Heard {
+  std::vector<tts::SpokenPhoneme> phonemes;
+  RecognitionProblem problem = RecognitionProblem::kNone;  // what the recognizer met
+  bool cannot_recognize = false;  // kPause: the build has no recognizer, the audio is a pause
+};
+// False with `error` where kRecognition's model cannot be loaded.
+bool hear(std::span<const int16_t> audio, unsigned rate, PhonemeSource source, Heard& out,
+          std::string& error);
 
 // One text: the sample it starts at, counted from the first sample kept (none: it has no
 // time, and continues the text before it offline or starts at the audio so far live), and its
@@ -143,7 +167,7 @@ class LiveUtterances {
   // A new stream: nothing open, no audio yet.
   void reset();
   bool is_open() const { return open_; }
-  // The open utterance is pocketsphinx's (start_recognition()).
+  // The open utterance is pocketsphinx's (start_heard() with Recognizer::kPhonemes).
   bool is_recognizing() const { return open_ && kind_ == Kind::kRecognition; }
   size_t samples() const { return samples_; }       // the audio so far
   size_t utterance_start() const { return from_; }  // the open utterance's first sample
@@ -153,12 +177,10 @@ class LiveUtterances {
   // cannot be aligned exactly.
   bool start_text(const tts::Utterance& utterance, const tts::VoiceSettings& voice, unsigned rate,
                   std::string& error);
-  // Opens the recognizer's utterance at the audio so far (end() the open one first). False
-  // with `error` where the model cannot be loaded.
-  bool start_recognition(unsigned rate, std::string& error);
-  // Opens the viseme detector's utterance at the audio so far (end() the open one first), its
-  // runs in pieces of kLiveVisemeRunFrames.
-  void start_visemes(unsigned rate);
+  // Opens the utterance heard by `recognizer` at the audio so far, to the stream's end (end()
+  // the open one first): pocketsphinx's, or the viseme detector's with its runs in pieces of
+  // kLiveVisemeRunFrames. False with `error` where pocketsphinx's model cannot be loaded.
+  bool start_heard(Recognizer recognizer, unsigned rate, std::string& error);
   // Gives `samples` to the open utterance; the phonemes now settled to `out`.
   void push(std::span<const int16_t> samples, std::vector<tts::SpokenPhoneme>& out);
   // Ends the open utterance, if any, at the audio so far: its last phonemes to `out`.

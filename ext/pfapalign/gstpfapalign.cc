@@ -73,6 +73,7 @@
 #include "pfap/markup.h"
 #include "ratelimit.h"
 #include "recognizer.h"
+#include "sample_times.h"
 #include "sparse.h"
 #include "utterances.h"
 
@@ -229,11 +230,9 @@ static GstFlowReturn push_phonemes(GstPfapAlign* self,
       GST_ELEMENT_ERROR(self, STREAM, FAILED, (nullptr), ("a phoneme x-pfap cannot hold"));
       return GST_FLOW_ERROR;
     }
-    const GstClockTime start = s.first + gst_util_uint64_scale(from + p.start, GST_SECOND, s.rate);
-    const GstClockTime end =
-        s.first + gst_util_uint64_scale(from + p.start + p.n_samples, GST_SECOND, s.rate);
-    GST_BUFFER_PTS(buffer) = start;
-    GST_BUFFER_DURATION(buffer) = end - start;
+    const pfap::align::PhonemeTime time = pfap::align::phoneme_time(p, from, s.first, s.rate);
+    GST_BUFFER_PTS(buffer) = time.pts;
+    GST_BUFFER_DURATION(buffer) = time.duration;
     if (s.pfap_discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);
     s.pfap_discont = false;
     ret = gst_flow_combiner_update_pad_flow(self->flow_combiner, self->pfappad,
@@ -264,34 +263,20 @@ static void warn_recognition_problem(GstPfapAlign* self, pfap::align::Recognitio
                       ("%" G_GUINT64_FORMAT " so far", s.recognition_problems[k]));
 }
 
-// Without a text: the phonemes of all the audio kept recognized from it alone (`source`
-// kRecognition), or one pause with a warning where the build cannot (kPause).
-static GstFlowReturn recognize_kept(GstPfapAlign* self, pfap::align::PhonemeSource source) {
+// Without a text: the phonemes of all the audio kept, heard by `source` (recognized or the
+// detector's visemes), or one pause with a warning where the build cannot recognize.
+static GstFlowReturn hear_kept(GstPfapAlign* self, pfap::align::PhonemeSource source) {
   Stream& s = *self->stream;
-  GST_INFO_OBJECT(self, "no text: recognizing %zu samples", s.kept.samples().size());
-  pfap::align::Recognition recognition;
+  GST_INFO_OBJECT(self, "no text: hearing %zu samples", s.kept.samples().size());
+  pfap::align::Heard heard;
   std::string error;
-  if (!pfap::align::recognize(s.kept.samples(), s.rate, recognition, error)) {
-    if (source == pfap::align::PhonemeSource::kRecognition) {  // the model is missing
-      GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));
-      return GST_FLOW_ERROR;
-    }
-    warn_cannot_recognize(self);
-  } else {
-    warn_recognition_problem(self, recognition.problem, s.first);
+  if (!pfap::align::hear(s.kept.samples(), s.rate, source, heard, error)) {
+    GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));  // no model
+    return GST_FLOW_ERROR;
   }
-  return push_phonemes(self, recognition.phonemes, 0);
-}
-
-// recognizer=visemes: the viseme detector's phonemes of all the audio kept.
-static GstFlowReturn detect_visemes_kept(GstPfapAlign* self) {
-  Stream& s = *self->stream;
-  GST_INFO_OBJECT(self, "no text: detecting the visemes of %zu samples", s.kept.samples().size());
-  pfap::align::VisemePhonemes visemes(s.rate, 0);
-  std::vector<pfap::tts::SpokenPhoneme> phonemes;
-  visemes.push(s.kept.samples(), phonemes);
-  visemes.finish(phonemes);
-  return push_phonemes(self, phonemes, 0);
+  if (heard.cannot_recognize) warn_cannot_recognize(self);
+  warn_recognition_problem(self, heard.problem, s.first);
+  return push_phonemes(self, heard.phonemes, 0);
 }
 
 // The utterance of the text `bytes` starting at `at`, bad UTF-8 and bookmarks warned about.
@@ -340,7 +325,7 @@ static pfap::tts::VoiceSettings voice_settings(GstPfapAlign* self) {
 static GstFlowReturn align_utterance(GstPfapAlign* self, const pfap::align::UtteranceSpan& u) {
   Stream& s = *self->stream;
   const size_t from = u.from;
-  const GstClockTime at = s.first + gst_util_uint64_scale(from, GST_SECOND, s.rate);
+  const GstClockTime at = pfap::align::sample_time(s.first, from, s.rate);
   const pfap::tts::Utterance utterance = parse_text(self, u.text, at);
   const pfap::tts::VoiceSettings voice = voice_settings(self);
 
@@ -369,8 +354,8 @@ static std::optional<size_t> text_sample(GstPfapAlign* self, std::optional<uint6
   if (!running_time.has_value()) return std::nullopt;
   const guint64 position =
       gst_segment_position_from_running_time(&s.segment, GST_FORMAT_TIME, *running_time);
-  if (!GST_CLOCK_TIME_IS_VALID(position) || position <= s.first) return 0;
-  return gst_util_uint64_scale_round(position - s.first, s.rate, GST_SECOND);
+  if (!GST_CLOCK_TIME_IS_VALID(position)) return 0;
+  return pfap::align::sample_at(s.first, position, s.rate);
 }
 
 // Aligns the audio kept so far with its texts and pushes the phonemes, then forgets both. At
@@ -389,11 +374,7 @@ static GstFlowReturn align_kept(GstPfapAlign* self, bool eos) {
   const pfap::align::PhonemeSource source =
       pfap::align::phoneme_source(!utterances.empty(), s.recognizer);
   GstFlowReturn ret = GST_FLOW_OK;
-  if (source == pfap::align::PhonemeSource::kVisemes) {
-    ret = detect_visemes_kept(self);
-  } else if (source != pfap::align::PhonemeSource::kTexts) {
-    ret = recognize_kept(self, source);
-  }
+  if (source != pfap::align::PhonemeSource::kTexts) ret = hear_kept(self, source);
   for (const pfap::align::UtteranceSpan& u : utterances) {
     if (ret != GST_FLOW_OK) break;
     ret = align_utterance(self, u);
@@ -425,7 +406,7 @@ static GstFlowReturn live_end_utterance(GstPfapAlign* self) {
   s.utterances.end(phonemes);
   if (recognizing) {
     const GstClockTime at =
-        s.first + gst_util_uint64_scale(s.utterances.utterance_start(), GST_SECOND, s.rate);
+        pfap::align::sample_time(s.first, s.utterances.utterance_start(), s.rate);
     warn_recognition_problem(self, s.utterances.recognition_problem(), at);
   }
   return push_phonemes(self, phonemes, 0);
@@ -438,8 +419,7 @@ static GstFlowReturn live_start_utterance(GstPfapAlign* self, const std::string&
   Stream& s = *self->stream;
   const GstFlowReturn ret = live_end_utterance(self);
   if (ret != GST_FLOW_OK) return ret;
-  const GstClockTime at =
-      s.first + gst_util_uint64_scale(s.utterances.samples(), GST_SECOND, s.rate);
+  const GstClockTime at = pfap::align::sample_time(s.first, s.utterances.samples(), s.rate);
   const pfap::tts::Utterance utterance = parse_text(self, bytes, at);
   const pfap::tts::VoiceSettings voice = voice_settings(self);
   std::string error;
@@ -449,16 +429,6 @@ static GstFlowReturn live_start_utterance(GstPfapAlign* self, const std::string&
   }
   if (is_text) warn_problem(self, s.utterances.problem(), at, 0, -1);
   PFAP_WARN_INEXACT_PHONEMES(self, s.utterances.inexact(), voice.voice, s.warned_phonemes);
-  return GST_FLOW_OK;
-}
-
-// Without a text: the recognizer's utterance from the audio so far, to the stream's end.
-static GstFlowReturn live_start_recognition(GstPfapAlign* self) {
-  std::string error;
-  if (!self->stream->utterances.start_recognition(self->stream->rate, error)) {
-    GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));  // no model
-    return GST_FLOW_ERROR;
-  }
   return GST_FLOW_OK;
 }
 
@@ -493,14 +463,15 @@ static GstFlowReturn live_chain(GstPfapAlign* self, GstBuffer* buffer) {
     const std::optional<std::string> property = text_property(self);
     const bool from_pad = gst_pad_is_linked(self->textpad);
     const pfap::align::PhonemeSource source = live_source(self);
-    if (source == pfap::align::PhonemeSource::kRecognition) {
-      ret = live_start_recognition(self);
-    } else if (source == pfap::align::PhonemeSource::kVisemes) {
-      s.utterances.start_visemes(s.rate);
-    } else {
+    std::string error;
+    if (source == pfap::align::PhonemeSource::kTexts ||
+        source == pfap::align::PhonemeSource::kPause) {
       if (source == pfap::align::PhonemeSource::kPause) warn_cannot_recognize(self);
       ret = live_start_utterance(self, from_pad ? "" : property.value_or(""),
                                  !from_pad && property.has_value());
+    } else if (!s.utterances.start_heard(s.recognizer, s.rate, error)) {
+      GST_ELEMENT_ERROR(self, LIBRARY, INIT, ("%s", error.c_str()), (nullptr));  // no model
+      ret = GST_FLOW_ERROR;
     }
   }
   size_t done = 0;
@@ -536,17 +507,7 @@ static gboolean live_latency_query(GstPfapAlign* self, GstQuery* query) {
   gboolean live = FALSE;
   GstClockTime min = 0, max = GST_CLOCK_TIME_NONE;
   gst_query_parse_latency(query, &live, &min, &max);
-  GstClockTime ours = pfap::align::kLiveLatencyMs * GST_MSECOND;
-  switch (live_source(self)) {
-    case pfap::align::PhonemeSource::kRecognition:
-      ours = pfap::align::kLiveRecognitionLatencyMs * GST_MSECOND;
-      break;
-    case pfap::align::PhonemeSource::kVisemes:
-      ours = pfap::align::kLiveVisemeLatencyMs * GST_MSECOND;
-      break;
-    default:
-      break;
-  }
+  const GstClockTime ours = pfap::align::live_latency_ms(live_source(self)) * GST_MSECOND;
   GST_DEBUG_OBJECT(self, "upstream latency %" GST_TIME_FORMAT ", ours %" GST_TIME_FORMAT,
                    GST_TIME_ARGS(min), GST_TIME_ARGS(ours));
   gst_query_set_latency(query, live, min + ours,
@@ -623,9 +584,11 @@ static void push_pfap_start(GstPfapAlign* self, GstEvent* audio_start) {
   GST_OBJECT_LOCK(self);
   s.recognizer = self->recognizer;
   GST_OBJECT_UNLOCK(self);
-  const bool visemes = live_source(self) == pfap::align::PhonemeSource::kVisemes;
-  if (!visemes) s.recognizer = pfap::align::Recognizer::kPhonemes;
-  const std::string alphabet(visemes ? pfap::kOculusVisemeAlphabet : pfap::kArpabetAlphabet);
+  const pfap::align::PhonemeSource source = live_source(self);
+  if (source != pfap::align::PhonemeSource::kVisemes) {
+    s.recognizer = pfap::align::Recognizer::kPhonemes;
+  }
+  const std::string alphabet(pfap::align::alphabet_of(source));
   GstCaps* caps = gst_caps_from_string(PFAP_MARKUP_CAPS);
   gst_caps_set_simple(caps, "alphabet", G_TYPE_STRING, alphabet.c_str(), nullptr);
   gst_pad_push_event(self->pfappad, gst_event_new_caps(caps));
@@ -648,16 +611,15 @@ static gboolean gst_pfap_align_sink_event(GstPad* pad, GstObject* parent, GstEve
       if (static_cast<unsigned>(rate) != s.rate) {
         ended = end_audio(self, false);
         s.rate = static_cast<unsigned>(rate);
-        if (s.recognizer == pfap::align::Recognizer::kVisemes) {
-          if (!pfap::align::visemes_take_rate(s.rate)) {
-            GST_ELEMENT_WARNING(
-                self, STREAM, FORMAT,
-                ("Audio at %u Hz: the viseme detector cannot take it, its phonemes are pauses",
-                 s.rate),
-                ("the detector takes %u to %u Hz: put audioresample before",
-                 pfap::align::kMinVisemeInputRate, pfap::align::kMaxVisemeInputRate));
-          }
-        } else if (s.rate < pfap::align::kMinRate || s.rate > pfap::align::kMaxRate) {
+        const pfap::align::RateProblem problem = pfap::align::rate_problem(s.rate, s.recognizer);
+        if (problem == pfap::align::RateProblem::kCannotDetectVisemes) {
+          GST_ELEMENT_WARNING(
+              self, STREAM, FORMAT,
+              ("Audio at %u Hz: the viseme detector cannot take it, its phonemes are pauses",
+               s.rate),
+              ("the detector takes %u to %u Hz: put audioresample before",
+               pfap::align::kMinVisemeInputRate, pfap::align::kMaxVisemeInputRate));
+        } else if (problem == pfap::align::RateProblem::kCannotAlign) {
           GST_ELEMENT_WARNING(self, STREAM, FORMAT,
                               ("Audio at %u Hz cannot be aligned: its phonemes are pauses", s.rate),
                               ("the alignment takes %u to %u Hz: put audioresample before",

@@ -50,6 +50,65 @@ TEST(Utterances, TextsComeFirstThenTheRecognizerThenAPause) {
             PhonemeSource::kTexts);
 }
 
+// The detector's phonemes are its visemes; the rest x-pfap-arpabet. Live, each source
+// declares its own latency: a pause is aligned as a text is.
+TEST(Utterances, EachSourceHasItsAlphabetAndLiveLatency) {
+  using pfap::align::PhonemeSource;
+  EXPECT_EQ(pfap::align::alphabet_of(PhonemeSource::kVisemes), "x-pfap-oculus-viseme");
+  for (const PhonemeSource source :
+       {PhonemeSource::kTexts, PhonemeSource::kRecognition, PhonemeSource::kPause}) {
+    EXPECT_EQ(pfap::align::alphabet_of(source), "x-pfap-arpabet");
+  }
+  EXPECT_EQ(pfap::align::live_latency_ms(PhonemeSource::kTexts), 400u);
+  EXPECT_EQ(pfap::align::live_latency_ms(PhonemeSource::kPause), 400u);
+  EXPECT_EQ(pfap::align::live_latency_ms(PhonemeSource::kRecognition), 700u);
+  EXPECT_EQ(pfap::align::live_latency_ms(PhonemeSource::kVisemes), 95u);
+}
+
+// The aligner takes 16 to 48 kHz; the viseme detector, where it has the stream, 8 to 192.
+TEST(Utterances, RatesOutsideWhatHearsTheAudioAreAProblem) {
+  using pfap::align::RateProblem;
+  using pfap::align::Recognizer;
+  EXPECT_EQ(pfap::align::rate_problem(15999, Recognizer::kPhonemes), RateProblem::kCannotAlign);
+  EXPECT_EQ(pfap::align::rate_problem(16000, Recognizer::kPhonemes), RateProblem::kNone);
+  EXPECT_EQ(pfap::align::rate_problem(48000, Recognizer::kPhonemes), RateProblem::kNone);
+  EXPECT_EQ(pfap::align::rate_problem(48001, Recognizer::kPhonemes), RateProblem::kCannotAlign);
+  EXPECT_EQ(pfap::align::rate_problem(7999, Recognizer::kVisemes),
+            RateProblem::kCannotDetectVisemes);
+  EXPECT_EQ(pfap::align::rate_problem(8000, Recognizer::kVisemes), RateProblem::kNone);
+  EXPECT_EQ(pfap::align::rate_problem(192000, Recognizer::kVisemes), RateProblem::kNone);
+  EXPECT_EQ(pfap::align::rate_problem(192001, Recognizer::kVisemes),
+            RateProblem::kCannotDetectVisemes);
+}
+
+// Without a text, silence is heard as pauses by each source; a build without pocketsphinx
+// says it cannot recognize (kPause) or cannot load the model (kRecognition).
+TEST(Utterances, WithoutATextTheAudioIsHeardOrAPause) {
+  using pfap::align::PhonemeSource;
+  const unsigned rate = 16000;
+  const std::vector<int16_t> silence(rate, 0);
+  const bool available = pfap::align::recognition_available();
+  pfap::align::Heard heard;
+  std::string error;
+
+  ASSERT_TRUE(pfap::align::hear(silence, rate, PhonemeSource::kVisemes, heard, error));
+  pfap::align::testing::expect_tiles(heard.phonemes, silence.size(), rate);
+  EXPECT_FALSE(heard.cannot_recognize);
+
+  ASSERT_TRUE(pfap::align::hear(silence, rate, PhonemeSource::kPause, heard, error));
+  pfap::align::testing::expect_tiles(heard.phonemes, silence.size(), rate);
+  EXPECT_EQ(heard.cannot_recognize, !available);
+
+  EXPECT_EQ(pfap::align::hear(silence, rate, PhonemeSource::kRecognition, heard, error), available);
+  if (available) {
+    pfap::align::testing::expect_tiles(heard.phonemes, silence.size(), rate);
+    EXPECT_EQ(heard.problem, pfap::align::RecognitionProblem::kNoSpeech);
+    EXPECT_FALSE(heard.cannot_recognize);
+  } else {
+    EXPECT_FALSE(error.empty());
+  }
+}
+
 TEST(Utterances, NoTextAtAllIsToBeRecognized) {
   std::vector<TimedText> texts;
   std::vector<size_t> later;
@@ -245,6 +304,31 @@ TEST(Utterances, LivePhonemesCountFromTheStreamsStartAndTileIt) {
   live.reset();
   EXPECT_EQ(live.samples(), 0u);
   EXPECT_FALSE(live.is_open());
+}
+
+// Without a text, the live utterance is heard to the stream's end: by the viseme detector, or
+// by pocketsphinx where the build has it.
+TEST(Utterances, LiveUtterancesHeardWithoutATextAreTheRecognizersOrTheDetectors) {
+  const unsigned rate = 16000;
+  const std::vector<int16_t> silence(rate, 0);
+  std::vector<tts::SpokenPhoneme> out;
+  std::string error;
+  pfap::align::LiveUtterances visemes;
+  ASSERT_TRUE(visemes.start_heard(pfap::align::Recognizer::kVisemes, rate, error)) << error;
+  EXPECT_TRUE(visemes.is_open());
+  EXPECT_FALSE(visemes.is_recognizing());
+  visemes.push(silence, out);
+  visemes.end(out);
+  EXPECT_FALSE(visemes.is_open());
+  ASSERT_FALSE(out.empty());
+  EXPECT_EQ(out.front().start, 0u);
+  EXPECT_EQ(out.back().start + out.back().n_samples, silence.size());
+
+  pfap::align::LiveUtterances phonemes;
+  const bool available = pfap::align::recognition_available();
+  EXPECT_EQ(phonemes.start_heard(pfap::align::Recognizer::kPhonemes, rate, error), available);
+  EXPECT_EQ(phonemes.is_recognizing(), available);
+  EXPECT_EQ(error.empty(), available);
 }
 
 }  // namespace
