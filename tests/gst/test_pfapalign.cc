@@ -20,6 +20,7 @@
 #include "documented_commands.h"
 #include "markupbuffer.h"
 #include "pipeline.h"
+#include "speech_fixtures.h"
 #include "recognizer.h"
 #include "speech.h"
 #include "temp_dir.h"
@@ -50,12 +51,7 @@ std::string caps_at(unsigned rate, int channels = 1) {
 }
 
 pfap::tts::Speech say(const std::string& text, int rate = 140, int pitch = 30) {
-  std::vector<pfap::tts::BadBookmark> bad;
-  pfap::tts::Speech s;
-  std::string error;
-  EXPECT_TRUE(
-      pfap::tts::speak(pfap::tts::parse_utterance(text, bad), {"en", rate, pitch, 100}, s, error));
-  return s;
+  return pfap::align::testing::say(text, {"en", rate, pitch, 100});
 }
 
 // Runs pfapalign (espeak-ng voice `voice`, `recognizer` unless nullptr) over `samples` at

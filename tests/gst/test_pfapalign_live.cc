@@ -22,6 +22,7 @@
 #include "live.h"
 #include "markupbuffer.h"
 #include "pipeline.h"
+#include "speech_fixtures.h"
 #include "recognizer.h"
 #include "speech.h"
 #include "temp_dir.h"
@@ -42,13 +43,8 @@ constexpr GstClockTime kBound =
     (pfap::align::kLookaheadMs + pfap::align::kHoldMs + pfap::align::kStepMs) * GST_MSECOND +
     kBlock;
 
-pfap::tts::Speech say(const std::string& text, int rate, int pitch) {
-  std::vector<pfap::tts::BadBookmark> bad;
-  pfap::tts::Speech s;
-  std::string error;
-  EXPECT_TRUE(
-      pfap::tts::speak(pfap::tts::parse_utterance(text, bad), {"en", rate, pitch, 100}, s, error));
-  return s;
+pfap::tts::Speech say(const std::string& text, int rate = 140, int pitch = 30) {
+  return pfap::align::testing::say(text, {"en", rate, pitch, 100});
 }
 
 // Samples [i, i + n) of `audio` at `rate` as a buffer, with their PTS and duration.

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// What the align/ tests share: texts spoken by espeak-ng with known phoneme times, and the
-// check that phonemes tile the audio they were given, and resampling.
+// What the align/ and pfapalign tests share: texts spoken by espeak-ng with known phoneme
+// times, the check that phonemes tile the audio they were given, and resampling.
 #pragma once
 
 #include <gtest/gtest.h>
