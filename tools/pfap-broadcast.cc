@@ -18,7 +18,6 @@
 #include <glib-unix.h>
 #include <gst/app/gstappsink.h>
 #include <gst/gst.h>
-#include <gst/rtp/gstrtpbuffer.h>
 #include <gst/video/video-event.h>
 
 #include <csignal>
@@ -26,9 +25,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <mutex>
-#include <random>
-#include <span>
 #include <string>
 #include <vector>
 
@@ -36,8 +32,7 @@
 #include "launch_value.h"
 #include "pad_time.h"
 #include "pfap/model.h"
-#include "pfap/payload.h"
-#include "pfap/recovery.h"
+#include "sent_pfap.h"
 #include "speech_level.h"
 
 namespace {
@@ -117,19 +112,7 @@ struct Sender {
 
   int audio_packets = 0;  // the audio sink's thread
 
-  // The appsink's thread: the loss, and the state as sent (every packet, before the loss,
-  // through libpfap's receiver: what a lossless receiver holds).
-  std::mutex mutex;
-  std::mt19937 rng;
-  double drop = 0.0;
-  pfap::RecoveryReceiver sent;
-  pfap::Packet packet;
-  uint64_t packets = 0;
-  uint64_t dropped = 0;
-  uint64_t phonemes = 0;
-  uint64_t phonemes_dropped = 0;
-  int last_seqnum = -1;
-  bool ending = false;  // EOS has reached the payloader: the closing complete state comes
+  SentPfap sent;  // the appsink's thread, and the main loop's `done`
 };
 
 void send_datagram(Sender& s, const void* data, size_t size) {
@@ -173,16 +156,16 @@ GstPadProbeReturn on_audio_packet(GstPad* pad, GstPadProbeInfo* info, gpointer d
 // -- The PFAP stream ---------------------------------------------------------------------
 
 std::string state_json(Sender& s) {
-  std::lock_guard lock(s.mutex);
-  std::string json = "{\"type\":\"done\",\"ssrc\":" + std::to_string(s.ssrc) +
-                     ",\"packets\":" + std::to_string(s.packets) +
-                     ",\"dropped\":" + std::to_string(s.dropped) +
-                     ",\"phonemes\":" + std::to_string(s.phonemes) +
-                     ",\"phonemesDropped\":" + std::to_string(s.phonemes_dropped) +
-                     ",\"lastSequenceNumber\":" + std::to_string(s.last_seqnum) + ",\"settled\":[";
-  for (int i = pfap::kMinFapIndex; i <= pfap::kMaxFapIndex; ++i) {
-    json += (i == pfap::kMinFapIndex ? "" : ",") + std::to_string(s.sent.state().settled(i));
-  }
+  std::string json = "{\"type\":\"done\",\"ssrc\":" + std::to_string(s.ssrc);
+  s.sent.read([&](const SentPfap::Counts& c, const pfap::FapState& state) {
+    json += ",\"packets\":" + std::to_string(c.packets) + ",\"dropped\":" +
+            std::to_string(c.dropped) + ",\"phonemes\":" + std::to_string(c.phonemes) +
+            ",\"phonemesDropped\":" + std::to_string(c.phonemes_dropped) +
+            ",\"lastSequenceNumber\":" + std::to_string(c.last_seqnum) + ",\"settled\":[";
+    for (int i = pfap::kMinFapIndex; i <= pfap::kMaxFapIndex; ++i) {
+      json += (i == pfap::kMinFapIndex ? "" : ",") + std::to_string(state.settled(i));
+    }
+  });
   return json + "]}";
 }
 
@@ -193,39 +176,10 @@ GstFlowReturn on_pfap_packet(GstAppSink* sink, gpointer data) {
   GstSample* sample = gst_app_sink_pull_sample(sink);
   if (sample == nullptr) return GST_FLOW_EOS;
   GstBuffer* buffer = gst_sample_get_buffer(sample);
-  GstRTPBuffer rtp = GST_RTP_BUFFER_INIT;
-  if (gst_rtp_buffer_map(buffer, GST_MAP_READ, &rtp)) {
-    const uint16_t seqnum = gst_rtp_buffer_get_seq(&rtp);
-    const uint32_t timestamp = gst_rtp_buffer_get_timestamp(&rtp);
-    std::span<const uint8_t> payload(static_cast<const uint8_t*>(gst_rtp_buffer_get_payload(&rtp)),
-                                     gst_rtp_buffer_get_payload_len(&rtp));
-    bool lose = false;
-    {
-      std::lock_guard lock(s.mutex);
-      size_t phonemes = 0;
-      if (pfap::decode_payload(payload, s.packet).ok()) {
-        const int64_t time_ns = static_cast<int64_t>(
-            gst_util_uint64_scale_int(timestamp - s.pfap_ts_offset, GST_SECOND, kPfapClockRate));
-        s.sent.receive(s.packet, seqnum, time_ns);
-        phonemes = s.packet.phonemes.size();
-        s.phonemes += phonemes;
-      }
-      ++s.packets;
-      s.last_seqnum = seqnum;
-      // The closing complete state is never lost (on_pfap_eos): the last word on the state.
-      const bool closing = s.ending && s.packet.recovery_kind == pfap::RecoveryKind::kComplete;
-      lose = !closing && std::uniform_real_distribution<double>(0.0, 1.0)(s.rng) < s.drop;
-      if (lose) {
-        ++s.dropped;
-        s.phonemes_dropped += phonemes;
-      }
-    }
-    gst_rtp_buffer_unmap(&rtp);
-    GstMapInfo map;
-    if (!lose && gst_buffer_map(buffer, &map, GST_MAP_READ)) {
-      send_datagram(s, map.data, map.size);
-      gst_buffer_unmap(buffer, &map);
-    }
+  GstMapInfo map;
+  if (s.sent.take(buffer, kPfapClockRate) && gst_buffer_map(buffer, &map, GST_MAP_READ)) {
+    send_datagram(s, map.data, map.size);
+    gst_buffer_unmap(buffer, &map);
   }
   gst_sample_unref(sample);
   return GST_FLOW_OK;
@@ -240,11 +194,7 @@ GstFlowReturn on_pfap_packet(GstAppSink* sink, gpointer data) {
 // stream's last word on the face's state.
 GstPadProbeReturn on_pfap_eos(GstPad*, GstPadProbeInfo* info, gpointer data) {
   if (GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) != GST_EVENT_EOS) return GST_PAD_PROBE_OK;
-  {
-    auto& s = *static_cast<Sender*>(data);
-    std::lock_guard lock(s.mutex);
-    s.ending = true;
-  }
+  static_cast<Sender*>(data)->sent.keep_closing_state();
   GThread* thread = g_thread_new(
       "request-complete",
       [](gpointer pay) -> gpointer {
@@ -301,10 +251,9 @@ int main(int argc, char** argv) {
   Options o;
   if (const int status = parse_options(&argc, &argv, o); status != 0) return status;
   Sender s;
-  s.drop = o.drop;
-  s.rng.seed(o.seed);
   s.ssrc = g_random_int();
   s.pfap_ts_offset = g_random_int();
+  s.sent.configure(o.drop, o.seed, s.pfap_ts_offset);
 
   const std::string source =
       !o.source.empty() ? o.source

@@ -24,7 +24,6 @@
 #include <gst/app/gstappsink.h>
 #include <gst/app/gstappsrc.h>
 #include <gst/gst.h>
-#include <gst/rtp/gstrtpbuffer.h>
 #include <gst/sdp/sdp.h>
 #include <gst/video/video-event.h>
 #define GST_USE_UNSTABLE_API
@@ -42,8 +41,6 @@
 #include <cstring>
 #include <functional>
 #include <memory>
-#include <mutex>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -52,9 +49,8 @@
 #include "pfap-web-signal.h"
 #include "pfap-web-stun.h"
 #include "pfap/model.h"
-#include "pfap/payload.h"
-#include "pfap/recovery.h"
 #include "ratelimit.h"
+#include "sent_pfap.h"
 #include "speech_level.h"
 
 namespace {
@@ -114,17 +110,7 @@ struct Session : std::enable_shared_from_this<Session> {
   uint32_t audio_ts_offset = 0;
   uint32_t pfap_ts_offset = 0;
 
-  // Touched by the appsink's thread: the loss, and the state as sent (every packet, before
-  // the loss, through libpfap's receiver: what a lossless receiver holds).
-  std::mutex mutex;
-  std::mt19937 rng;
-  double drop = 0.0;
-  pfap::RecoveryReceiver sent;
-  pfap::Packet packet;
-  uint64_t packets = 0;
-  uint64_t dropped = 0;
-  uint64_t phonemes = 0;
-  int last_seqnum = -1;
+  SentPfap sent;  // the appsink's thread, and the main loop's state messages
 };
 
 std::string text_of(JsonNode* node) {
@@ -275,17 +261,18 @@ bool set_answer(Session& s, const std::string& sdp_text) {
 // The sender's FAP state and counts, after the last packet of a text or a complete state.
 void send_state(Session& s, const char* type) {
   JsonBuilder* b = message(type);
-  std::lock_guard lock(s.mutex);
-  member(b, "packets", static_cast<int64_t>(s.packets));
-  member(b, "dropped", static_cast<int64_t>(s.dropped));
-  member(b, "phonemes", static_cast<int64_t>(s.phonemes));
-  member(b, "lastSequenceNumber", s.last_seqnum);
-  json_builder_set_member_name(b, "settled");
-  json_builder_begin_array(b);
-  for (int i = pfap::kMinFapIndex; i <= pfap::kMaxFapIndex; ++i) {
-    json_builder_add_int_value(b, s.sent.state().settled(i));
-  }
-  json_builder_end_array(b);
+  s.sent.read([&](const SentPfap::Counts& c, const pfap::FapState& state) {
+    member(b, "packets", static_cast<int64_t>(c.packets));
+    member(b, "dropped", static_cast<int64_t>(c.dropped));
+    member(b, "phonemes", static_cast<int64_t>(c.phonemes));
+    member(b, "lastSequenceNumber", c.last_seqnum);
+    json_builder_set_member_name(b, "settled");
+    json_builder_begin_array(b);
+    for (int i = pfap::kMinFapIndex; i <= pfap::kMaxFapIndex; ++i) {
+      json_builder_add_int_value(b, state.settled(i));
+    }
+    json_builder_end_array(b);
+  });
   finish(s, b);
 }
 
@@ -296,37 +283,13 @@ GstFlowReturn on_pfap_packet(GstAppSink* sink, gpointer data) {
   if (sample == nullptr) return GST_FLOW_EOS;
   std::shared_ptr<Session> session = session_of(data);
   GstBuffer* buffer = gst_sample_get_buffer(sample);
-  GstRTPBuffer rtp = GST_RTP_BUFFER_INIT;
-  if (session != nullptr && gst_rtp_buffer_map(buffer, GST_MAP_READ, &rtp)) {
-    Session& s = *session;
-    const uint16_t seqnum = gst_rtp_buffer_get_seq(&rtp);
-    const uint32_t timestamp = gst_rtp_buffer_get_timestamp(&rtp);
-    std::span<const uint8_t> payload(static_cast<const uint8_t*>(gst_rtp_buffer_get_payload(&rtp)),
-                                     gst_rtp_buffer_get_payload_len(&rtp));
-    bool lose = false;
-    {
-      std::lock_guard lock(s.mutex);
-      if (pfap::decode_payload(payload, s.packet).ok()) {
-        const int64_t time_ns = static_cast<int64_t>(
-            gst_util_uint64_scale_int(timestamp - s.pfap_ts_offset, GST_SECOND, kPfapClockRate));
-        s.sent.receive(s.packet, seqnum, time_ns);
-        s.phonemes += s.packet.phonemes.size();
-      }
-      ++s.packets;
-      s.last_seqnum = seqnum;
-      lose = std::uniform_real_distribution<double>(0.0, 1.0)(s.rng) < s.drop;
-      if (lose) ++s.dropped;
-    }
-    gst_rtp_buffer_unmap(&rtp);
-    if (!lose && s.channel != nullptr) {
-      GstMapInfo map;
-      if (gst_buffer_map(buffer, &map, GST_MAP_READ)) {
-        GBytes* bytes = g_bytes_new(map.data, map.size);
-        g_signal_emit_by_name(s.channel, "send-data", bytes);
-        g_bytes_unref(bytes);
-        gst_buffer_unmap(buffer, &map);
-      }
-    }
+  GstMapInfo map;
+  if (session != nullptr && session->sent.take(buffer, kPfapClockRate) &&
+      session->channel != nullptr && gst_buffer_map(buffer, &map, GST_MAP_READ)) {
+    GBytes* bytes = g_bytes_new(map.data, map.size);
+    g_signal_emit_by_name(session->channel, "send-data", bytes);
+    g_bytes_unref(bytes);
+    gst_buffer_unmap(buffer, &map);
   }
   gst_sample_unref(sample);
   return GST_FLOW_OK;
@@ -728,10 +691,10 @@ std::shared_ptr<Session> open_session(Server& server, SoupWebsocketConnection* w
   auto s = std::make_shared<Session>();
   s->id = ++server.sessions;
   s->server = &server;
-  s->drop = server.options.drop;
-  s->rng.seed(server.options.seed + static_cast<uint32_t>(s->id));
   s->audio_ts_offset = g_random_int();
   s->pfap_ts_offset = g_random_int();
+  s->sent.configure(server.options.drop, server.options.seed + static_cast<uint32_t>(s->id),
+                    s->pfap_ts_offset);
   if (!make_pipeline(*s)) return nullptr;
   s->ws = SOUP_WEBSOCKET_CONNECTION(g_object_ref(ws));
   configure_webrtc(*s);
