@@ -220,6 +220,7 @@ async def main():
             await wait_for_janus(janus)
             idle = resources(janus.pid)
             peak = list(idle)
+            cpu_all_start = cpu_s(janus.pid)
             all_open = [asyncio.Event() for _ in range(count)]
             viewers = asyncio.gather(*(viewer(i + 1, all_open, 60 + count) for i in range(count)))
             for e in all_open:
@@ -232,6 +233,7 @@ async def main():
             out, err = await asyncio.to_thread(sender.communicate)
             cpu, took = cpu_s(janus.pid) - cpu_start, time.monotonic() - start
             results = await viewers
+            cpu_all = cpu_s(janus.pid) - cpu_all_start  # sessions set up, the text, closing
             if sender.returncode != 0:
                 raise SystemExit(f'pfap-broadcast exited {sender.returncode}: {err[-2000:]}')
             sent = json.loads(out.strip().split('\n')[-1])
@@ -249,6 +251,7 @@ async def main():
     good = sum(load.whole(r) and r['sender'] == sent for r in results)
     if row:
         print(f'| {count} | {good} | {cpu / took / count * 100:.2f} % | {cpu * 1000 / count:.1f} ms | '
+              f'{cpu_all * 1000 / count:.1f} ms | '
               f'{(peak[0] - idle[0]) / count:.1f} | {(peak[1] - idle[1]) / count:.1f} | '
               f'{left[0] - idle[0]}, {left[1] - idle[1]} |')
     for r in results:
@@ -262,6 +265,7 @@ async def main():
     if not row:
         print(f'Janus: CPU {cpu:.2f} s while the sender spoke ({took:.1f} s): '
               f'{cpu / took / count * 100:.2f} % of a core, {cpu * 1000 / count:.1f} ms per viewer; '
+              f'{cpu_all * 1000 / count:.1f} ms per viewer in all (set up, the text, leaving); '
               f'fds and threads {idle[0]} and {idle[1]} idle, at most {peak[0]} and {peak[1]} '
               f'with the viewers, {left[0]} and {left[1]} after they left')
         print(f'{good} of {count} viewers whole ({sent["packets"]} PFAP packets, '
