@@ -152,10 +152,7 @@ async def viewer(number, all_open, deadline_s):
             await all_open[number - 1].wait()
             result['stage'] = 'the data stream'
             await done.wait()
-            for receiver in pc.getReceivers():
-                for stats in (await receiver.getStats()).values():
-                    if stats.type == 'inbound-rtp' and stats.kind == 'audio':
-                        result['audio_packets'] = stats.packetsReceived
+            result['audio_packets'] = await load.audio_packets(pc)
     except Exception as e:  # noqa: BLE001 (reported per viewer)
         result['error'] = f"{type(e).__name__} waiting for {result['stage']}: {e}"
         all_open[number - 1].set()  # the others go on
