@@ -148,16 +148,23 @@ async def session(port, number, deadline_s):
             end = time.monotonic() + 2
             while result['last_seq'] != m['lastSequenceNumber'] and time.monotonic() < end:
                 await asyncio.sleep(0.05)
-            for receiver in pc.getReceivers():
-                for stats in (await receiver.getStats()).values():
-                    if stats.type == 'inbound-rtp' and stats.kind == 'audio':
-                        result['audio_packets'] = stats.packetsReceived
+            result['audio_packets'] = await audio_packets(pc)
     except Exception as e:  # noqa: BLE001 (reported per session)
         result['error'] = f'{type(e).__name__}: {e}'
     finally:
         await pc.close()
         ws.writer.close()
     return result
+
+
+async def audio_packets(pc):
+    """The Opus RTP packets a peer connection has received (its receivers' stats)."""
+    count = 0
+    for receiver in pc.getReceivers():
+        for stats in (await receiver.getStats()).values():
+            if stats.type == 'inbound-rtp' and stats.kind == 'audio':
+                count += stats.packetsReceived
+    return count
 
 
 async def say_playing_when_open(ws, channel_open):

@@ -14,7 +14,8 @@ import { writeFileSync } from 'node:fs';
 import { after, before, test } from 'node:test';
 
 import {
-  COMPLETE_INTERVAL_MS, DATA_PORT, exited, figures, launchChromium, openViewer, servePages, startJanus, startSender, stop,
+  COMPLETE_INTERVAL_MS, DATA_PORT, describeFds, exited, figures, launchChromium, openViewer, resources, servePages, settledResources,
+  startJanus, startSender, stop, watching,
 } from './janus.js';
 
 // Sharp onsets after silence for the lip-sync measurement (each "pa" sounds as its closed
@@ -28,11 +29,34 @@ const TEXT = 'pa. pa. <FAP 2 1 40 0 0 800 3> pa. pa. <FAP 48 6000 400 2> pa. pa.
 let browser;
 let janus;
 let pageServer;
+let idleJanus;  // Janus's fds and threads once a first viewer has come and gone
+
+// Once every page of a test has left, Janus is back at its idle fds and threads: nothing of
+// the viewers' sessions is left behind (it frees a session's ICE thread and sockets a few
+// seconds after the viewer leaves).
+async function assertJanusIdle() {
+  const now = await settledResources(janus.pid, idleJanus);
+  assert.ok(now.fds <= idleJanus.fds && now.threads <= idleJanus.threads,
+    `Janus back at its idle fds and threads once every viewer has left: ${JSON.stringify(now)}, idle ${JSON.stringify(idleJanus)}; fds ${JSON.stringify(describeFds(janus.pid))}`);
+}
+
+// Janus's idle figures, after one viewer: its first viewer starts what stays for good (GLib's
+// worker thread and a thread pool, a socket and an eventfd), measured on Janus 1.1.2.
+async function measureIdleJanus() {
+  const viewer = await openViewer(browser, pageServer, janus);
+  const sender = startSender('pa.');
+  await figures(viewer);
+  assert.equal(await exited(sender), 0, sender.log);
+  await new Promise((r) => setTimeout(r, 5000));  // Janus frees the session
+  idleJanus = resources(janus.pid);
+  console.log(`idle Janus: ${JSON.stringify(idleJanus)}`);
+}
 
 before(async () => {
   janus = await startJanus();
   pageServer = await servePages();
   browser = await launchChromium();
+  await measureIdleJanus();
 });
 
 after(async () => {
@@ -95,6 +119,41 @@ test('three viewers through Janus, a tenth of the PFAP datagrams dropped before 
   const s = all[3];
   assert.ok(s.phonemes > 0 && s.phonemes < sent.phonemes - sent.phonemesDropped, JSON.stringify(s));
   assert.ok(s.wholeAfterMs !== null && s.wholeAfterMs <= COMPLETE_INTERVAL_MS + 500, `whole after ${s.wholeAfterMs} ms`);
+  await assertJanusIdle();
+});
+
+test('a viewer drops mid-sentence and rejoins: whole again within a complete-state interval of rejoining; the others stay whole', async () => {
+  const open = () => openViewer(browser, pageServer, janus);
+  const viewers = await Promise.all([open(), open(), open()]);
+  const sender = startSender(TEXT);
+  await new Promise((r) => setTimeout(r, 2500));
+  // The third reloads, as a viewer whose tab is reloaded: janus.js destroys its session as the
+  // page unloads (its handle, PeerConnection and data channel go), and the new page watches
+  // the mountpoint afresh, mid-sentence.
+  const rejoiner = viewers[2];
+  await rejoiner.reload();
+  await watching(rejoiner, janus);
+  const all = await Promise.all(viewers.map((page) => figures(page)));
+  assert.equal(await exited(sender), 0, sender.log);
+  const sent = JSON.parse(sender.out.trim().split('\n').at(-1));
+  for (const [i, s] of all.entries()) {
+    const which = `page ${i + 1}: ${JSON.stringify(s)}`;
+    assert.equal(s.streams, 1, which);
+    assert.deepEqual(s.sender.settled, sent.settled, which);
+    assert.equal(s.fapStateMatchesSender, true, which);
+    assert.ok(s.matched, which);
+    if (i === 2) continue;
+    // The others lose nothing while one viewer leaves and comes back.
+    assert.equal(s.phonemes, sent.phonemes, which);
+    assert.equal(s.packets, sent.packets, which);
+  }
+  // The rejoined page: part of the speech, whole from the first complete state after its
+  // first packet.
+  const s = all[2];
+  console.log(`rejoined: ${s.phonemes} of ${sent.phonemes} phonemes, whole after ${s.wholeAfterMs} ms`);
+  assert.ok(s.phonemes > 0 && s.phonemes < sent.phonemes, JSON.stringify(s));
+  assert.ok(s.wholeAfterMs !== null && s.wholeAfterMs <= COMPLETE_INTERVAL_MS + 500, `whole after ${s.wholeAfterMs} ms`);
+  await assertJanusIdle();
 });
 
 test('the sender restarts mid-sentence: each viewer takes the new stream and ends whole with it', async () => {
@@ -114,6 +173,7 @@ test('the sender restarts mid-sentence: each viewer takes the new stream and end
     assert.equal(s.fapStateMatchesSender, true, which);
     assert.ok(s.matched, which);
   }
+  await assertJanusIdle();
 });
 
 test('Janus restarts mid-sentence: each viewer watches again and ends whole with the stream', async () => {
@@ -121,9 +181,12 @@ test('Janus restarts mid-sentence: each viewer watches again and ends whole with
   const viewers = await Promise.all([open(), open()]);
   const sender = startSender(TEXT);
   await new Promise((r) => setTimeout(r, 2000));
+  const senderBefore = resources(sender.pid);
   assert.equal(await stop(janus), 0, janus.log);
   janus.cleanup();
   janus = await startJanus();
+  // The sender went on sending to ports nobody listened on: it holds what it held.
+  assert.deepEqual(resources(sender.pid), senderBefore, 'the sender\'s fds and threads across the restart');
   const all = await Promise.all(viewers.map((page) => figures(page)));
   assert.equal(await exited(sender), 0, sender.log);
   const sent = JSON.parse(sender.out.trim().split('\n').at(-1));
@@ -134,4 +197,6 @@ test('Janus restarts mid-sentence: each viewer watches again and ends whole with
     assert.equal(s.fapStateMatchesSender, true, which);
     assert.ok(s.matched, which);
   }
+  // The new Janus too, against the idle figures of the first (the same configuration).
+  await assertJanusIdle();
 });

@@ -5,7 +5,7 @@
 // Debian's chromium and the viewers. All run inside the network namespace that
 // tests/web/janus-broadcast.sh makes (its ports are the namespace's own).
 import { execFileSync, spawn } from 'node:child_process';
-import { createReadStream, existsSync, mkdtempSync, readFileSync, rmSync, statSync } from 'node:fs';
+import { createReadStream, existsSync, mkdtempSync, readdirSync, readFileSync, readlinkSync, rmSync, statSync } from 'node:fs';
 import http from 'node:http';
 import os from 'node:os';
 import path from 'node:path';
@@ -57,6 +57,58 @@ export function exited(child) {
 export function cpuSeconds(pid) {
   const fields = readFileSync(`/proc/${pid}/stat`, 'utf8').split(') ')[1].split(' ');
   return (Number(fields[11]) + Number(fields[12])) / 100;  // utime, stime in clock ticks (USER_HZ 100)
+}
+
+// The sockets of process `pid` by inode: 'tcp ESTABLISHED' and the like, 'udp', 'unix', 'netlink'.
+function socketsOf(pid) {
+  const tcpStates = { '01': 'ESTABLISHED', '06': 'TIME_WAIT', '08': 'CLOSE_WAIT', '0A': 'LISTEN' };
+  const sockets = {};
+  for (const proto of ['tcp', 'udp', 'unix', 'netlink']) {
+    for (const line of readFileSync(`/proc/${pid}/net/${proto}`, 'utf8').split('\n').slice(1)) {
+      const f = line.trim().split(/\s+/);
+      if (f.length < 8) continue;
+      const inode = { unix: f[6], netlink: f[8] }[proto] ?? f[9];
+      sockets[inode] = proto === 'tcp' ? `tcp ${tcpStates[f[3]] ?? f[3]}` : proto;
+    }
+  }
+  return sockets;
+}
+
+/** What the fds of process `pid` are (sockets by protocol and state), for a failure's message. */
+export function describeFds(pid) {
+  const sockets = socketsOf(pid);
+  return readdirSync(`/proc/${pid}/fd`).map((fd) => {
+    try {
+      const target = readlinkSync(`/proc/${pid}/fd/${fd}`);
+      return sockets[target.match(/^socket:\[(\d+)\]$/)?.[1]] ?? target;
+    } catch {
+      return '?';
+    }
+  });
+}
+
+/**
+ * The open file descriptors and threads of process `pid`. The fds leave out TCP connections
+ * that the peer has closed (CLOSE_WAIT): those are Janus's long polls, each held until Janus
+ * answers it (30 s at most) after the page that asked has gone.
+ */
+export function resources(pid) {
+  const fds = describeFds(pid).filter((d) => d !== 'tcp CLOSE_WAIT').length;
+  return { fds, threads: readdirSync(`/proc/${pid}/task`).length };
+}
+
+/**
+ * Resolves to the resources of process `pid` once they are back at `baseline` (Janus frees a
+ * session's handle, its ICE thread and sockets, a little after the viewer leaves), or to the
+ * last reading after `timeoutMs`.
+ */
+export async function settledResources(pid, baseline, timeoutMs = 10000) {
+  let now = resources(pid);
+  for (let waited = 0; waited < timeoutMs && (now.fds > baseline.fds || now.threads > baseline.threads); waited += 200) {
+    await new Promise((r) => setTimeout(r, 200));
+    now = resources(pid);
+  }
+  return now;
 }
 
 /** Starts Janus in a temporary directory; resolves once its API answers. */
@@ -133,18 +185,25 @@ export async function newPage(browser, url) {
   return page;
 }
 
+/** Resolves once the viewer page receives the mountpoint's data stream. */
+export async function watching(page, janus) {
+  await page.waitForFunction(() => window.pfapStats?.dataOpen, null, { timeout: 30000, polling: 100 })
+    .catch((e) => { throw new Error(`${e.message}\npage: ${page.messages.join('\n')}\njanus: ${janus.out}${janus.log}`); });
+}
+
 /** Opens a viewer page; resolves once it receives the mountpoint's data stream. */
 export async function openViewer(browser, pageServer, janus) {
   const { port } = pageServer.address();
   const page = await newPage(browser, `http://127.0.0.1:${port}/broadcast/?janus=http://127.0.0.1:${JANUS_PORT}/janus`);
-  await page.waitForFunction(() => window.pfapStats?.dataOpen, null, { timeout: 30000, polling: 100 })
-    .catch((e) => { throw new Error(`${e.message}\npage: ${page.messages.join('\n')}\njanus: ${janus.out}${janus.log}`); });
+  await watching(page, janus);
   return page;
 }
 
 /**
  * Waits until the page has the sender's state at the end and has played the audio past the
  * last phoneme (pfap-web's page and the viewer page alike); its figures (lip sync measured).
+ * The page then leaves as a viewer closing the tab does: navigating away runs its unload
+ * handlers (janus.js destroys its session with Janus there), which closing it alone does not.
  */
 export async function figures(page, { timeout = 30000 } = {}) {
   const read = () => page.evaluate(() => {
@@ -160,6 +219,7 @@ export async function figures(page, { timeout = 30000 } = {}) {
   } catch (e) {
     throw new Error(`${e.message}\n${JSON.stringify(await read())}\npage: ${page.messages.join('\n')}`);
   } finally {
+    await page.goto('about:blank').catch(() => {});
     await page.close();
   }
 }
