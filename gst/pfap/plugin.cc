@@ -6,12 +6,12 @@
 
 #include <string>
 
-#include "gstfapparse.h"
 #include "gstpfapfapenc.h"
+#include "gstpfapfapparse.h"
 #include "gstpfapmarksenc.h"
 #include "gstpfapmarksparse.h"
-#include "gstpfapparse.h"
 #include "gstpfaptextenc.h"
+#include "gstpfaptextparse.h"
 #include "gstpfaptypefind.h"
 #include "gstrtppfapdepay.h"
 #include "gstrtppfappay.h"
@@ -23,13 +23,16 @@ namespace {
 
 // A factory name the readers had before they were named pfap<format>parse, as the writers
 // are pfap<format>enc (docs/elements.md, "Names").
+// Its type keeps the old type name, so that an element made by the old name gets the old
+// default object name (`pfapparse0`).
 struct DeprecatedName {
   const char* name;
   const char* replacement;
+  const char* type_name;
 };
 
-constexpr DeprecatedName kPfapParse{"pfapparse", "pfaptextparse"};
-constexpr DeprecatedName kFapParse{"fapparse", "pfapfapparse"};
+constexpr DeprecatedName kPfapParse{"pfapparse", "pfaptextparse", "GstPfapParse"};
+constexpr DeprecatedName kFapParse{"fapparse", "pfapfapparse", "GstFapParse"};
 
 void deprecated_class_init(gpointer klass, gpointer data) {
   const auto* names = static_cast<const DeprecatedName*>(data);
@@ -52,8 +55,7 @@ void deprecated_instance_init(GTypeInstance* instance, gpointer klass) {
 gboolean register_deprecated_name(GstPlugin* plugin, const DeprecatedName& names, GType type) {
   GTypeQuery query;
   g_type_query(type, &query);
-  const std::string type_name = std::string(g_type_name(type)) + "DeprecatedName";
-  GType deprecated = g_type_from_name(type_name.c_str());
+  GType deprecated = g_type_from_name(names.type_name);
   if (deprecated == 0) {
     const GTypeInfo info = {static_cast<guint16>(query.class_size),
                             nullptr,
@@ -65,7 +67,7 @@ gboolean register_deprecated_name(GstPlugin* plugin, const DeprecatedName& names
                             0,
                             deprecated_instance_init,
                             nullptr};
-    deprecated = g_type_register_static(type, type_name.c_str(), &info, GTypeFlags(0));
+    deprecated = g_type_register_static(type, names.type_name, &info, GTypeFlags(0));
     g_type_set_qdata(deprecated, g_quark_from_static_string("pfap-deprecated"),
                      const_cast<DeprecatedName*>(&names));
   }
@@ -86,8 +88,8 @@ static gboolean plugin_init(GstPlugin* plugin) {
   ok &= GST_TYPE_FIND_REGISTER(pfap, plugin);
   ok &= GST_ELEMENT_REGISTER(pfapmarksenc, plugin);
   ok &= GST_ELEMENT_REGISTER(pfapmarksparse, plugin);
-  ok &= register_deprecated_name(plugin, kPfapParse, GST_TYPE_PFAP_PARSE);
-  ok &= register_deprecated_name(plugin, kFapParse, GST_TYPE_FAP_PARSE);
+  ok &= register_deprecated_name(plugin, kPfapParse, GST_TYPE_PFAP_TEXT_PARSE);
+  ok &= register_deprecated_name(plugin, kFapParse, GST_TYPE_PFAP_FAP_PARSE);
   return ok;
 }
 

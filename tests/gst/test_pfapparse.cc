@@ -582,7 +582,21 @@ TEST(DeprecatedNames, OldReaderNamesMakeTheSameElement) {
     EXPECT_TRUE(g_type_is_a(G_OBJECT_TYPE(element), gst_element_factory_get_element_type(factory)))
         << old_name;
     EXPECT_EQ(gst_element_get_factory(element), old_factory) << old_name;
+    // Default object names follow the name typed: `pfapparse0` from pfapparse,
+    // `pfaptextparse0` from pfaptextparse.
+    gchar* object_name = gst_element_get_name(element);
+    EXPECT_EQ(std::string(object_name).rfind(old_name, 0), 0u) << object_name;
+    EXPECT_EQ(std::string(object_name).find_first_of("0123456789"), std::string(old_name).size())
+        << object_name;
+    g_free(object_name);
     gst_object_unref(element);
+    GstElement* renamed = gst_element_factory_create(factory, nullptr);
+    object_name = gst_element_get_name(renamed);
+    EXPECT_EQ(std::string(object_name).rfind(name, 0), 0u) << object_name;
+    EXPECT_EQ(std::string(object_name).find_first_of("0123456789"), std::string(name).size())
+        << object_name;
+    g_free(object_name);
+    gst_object_unref(renamed);
 
     std::string out[2];
     for (int i = 0; i < 2; ++i) {

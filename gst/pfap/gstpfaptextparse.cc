@@ -22,7 +22,7 @@
  * A bad line (a field that does not parse, time going back, bad bookmarks, invalid UTF-8,
  * more than 65536 bytes without its line end, or a time past about 292 years) is an error
  * naming its line, its column (in bytes, from 1) and what is wrong, and nothing after it is
- * read; with #GstPfapParse:skip-bad-lines it is a warning instead (at the 1st, 2nd, 4th, ...
+ * read; with #GstPfapTextParse:skip-bad-lines it is a warning instead (at the 1st, 2nd, 4th, ...
  * bad line, all counted in the stats property's bad-lines), and the lines after it are read
  * as usual. Input
  * that arrives from sources without caps (filesrc, fdsrc) is taken as .pfap text; caps, when
@@ -41,7 +41,7 @@
  * ]| Reads .pfap text from standard input, warns about bad lines and dumps each event.
  */
 // clang-format on
-#include "gstpfapparse.h"
+#include "gstpfaptextparse.h"
 
 #include <string>
 #include <string_view>
@@ -60,7 +60,7 @@ enum { PROP_0, PROP_SKIP_BAD_LINES, PROP_ALPHABET, PROP_BAD_LINES };
 
 }  // namespace
 
-struct _GstPfapParse {
+struct _GstPfapTextParse {
   GstPfapBaseParse parent;
   gchar* alphabet;  // under the object lock; NULL when unset
   // The streaming thread's. GObject runs no C++ constructors, so it lives behind a pointer
@@ -78,17 +78,18 @@ static GstStaticPadTemplate sink_template =
 static GstStaticPadTemplate src_template =
     GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
 
-G_DEFINE_TYPE(GstPfapParse, gst_pfap_parse, GST_TYPE_PFAP_BASE_PARSE)
+G_DEFINE_TYPE(GstPfapTextParse, gst_pfap_text_parse, GST_TYPE_PFAP_BASE_PARSE)
 // A rank, so that decodebin plugs it for text/x-pfap (gst-play-1.0 file.pfap).
-GST_ELEMENT_REGISTER_DEFINE(pfaptextparse, "pfaptextparse", GST_RANK_SECONDARY, GST_TYPE_PFAP_PARSE)
+GST_ELEMENT_REGISTER_DEFINE(pfaptextparse, "pfaptextparse", GST_RANK_SECONDARY,
+                            GST_TYPE_PFAP_TEXT_PARSE)
 
 // Back to the start of a stream (READY to PAUSED, FLUSH_STOP).
-static void gst_pfap_parse_reset(GstPfapBaseParse* parse) {
-  GST_PFAP_PARSE(parse)->reader->reset();
+static void gst_pfap_text_parse_reset(GstPfapBaseParse* parse) {
+  GST_PFAP_TEXT_PARSE(parse)->reader->reset();
 }
 
-static GstCaps* gst_pfap_parse_output_caps(GstPfapBaseParse* parse) {
-  GstPfapParse* self = GST_PFAP_PARSE(parse);
+static GstCaps* gst_pfap_text_parse_output_caps(GstPfapBaseParse* parse) {
+  GstPfapTextParse* self = GST_PFAP_TEXT_PARSE(parse);
   GstCaps* caps = gst_static_pad_template_get_caps(&src_template);
   GST_OBJECT_LOCK(self);
   if (self->alphabet != nullptr) {
@@ -99,7 +100,7 @@ static GstCaps* gst_pfap_parse_output_caps(GstPfapBaseParse* parse) {
   return caps;
 }
 
-static GstFlowReturn gst_pfap_parse_read_line(GstPfapBaseParse* parse, std::string_view line) {
+static GstFlowReturn gst_pfap_text_parse_read_line(GstPfapBaseParse* parse, std::string_view line) {
   const gchar* valid_end = nullptr;
   if (!g_utf8_validate(line.data(), static_cast<gssize>(line.size()), &valid_end)) {
     return gst_pfap_base_parse_bad_line(parse, static_cast<size_t>(valid_end - line.data()),
@@ -107,7 +108,8 @@ static GstFlowReturn gst_pfap_parse_read_line(GstPfapBaseParse* parse, std::stri
   }
   pfap::TextEvent event;
   bool has_event = false;
-  const pfap::TextResult result = GST_PFAP_PARSE(parse)->reader->read_line(line, event, has_event);
+  const pfap::TextResult result =
+      GST_PFAP_TEXT_PARSE(parse)->reader->read_line(line, event, has_event);
   if (!result.ok()) {
     std::string what = pfap::to_string(result.status);
     if (result.status == pfap::TextStatus::kBadBookmark) {
@@ -118,9 +120,9 @@ static GstFlowReturn gst_pfap_parse_read_line(GstPfapBaseParse* parse, std::stri
   return has_event ? gst_pfap_base_parse_push(parse, event) : GST_FLOW_OK;
 }
 
-static void gst_pfap_parse_set_property(GObject* object, guint prop_id, const GValue* value,
-                                        GParamSpec* pspec) {
-  GstPfapParse* self = GST_PFAP_PARSE(object);
+static void gst_pfap_text_parse_set_property(GObject* object, guint prop_id, const GValue* value,
+                                             GParamSpec* pspec) {
+  GstPfapTextParse* self = GST_PFAP_TEXT_PARSE(object);
   switch (prop_id) {
     case PROP_SKIP_BAD_LINES:
       gst_pfap_base_parse_set_skip_bad_lines(GST_PFAP_BASE_PARSE(self), g_value_get_boolean(value));
@@ -137,9 +139,9 @@ static void gst_pfap_parse_set_property(GObject* object, guint prop_id, const GV
   }
 }
 
-static void gst_pfap_parse_get_property(GObject* object, guint prop_id, GValue* value,
-                                        GParamSpec* pspec) {
-  GstPfapParse* self = GST_PFAP_PARSE(object);
+static void gst_pfap_text_parse_get_property(GObject* object, guint prop_id, GValue* value,
+                                             GParamSpec* pspec) {
+  GstPfapTextParse* self = GST_PFAP_TEXT_PARSE(object);
   switch (prop_id) {
     case PROP_SKIP_BAD_LINES:
       g_value_set_boolean(value, gst_pfap_base_parse_skips_bad_lines(GST_PFAP_BASE_PARSE(self)));
@@ -158,25 +160,25 @@ static void gst_pfap_parse_get_property(GObject* object, guint prop_id, GValue* 
   }
 }
 
-static void gst_pfap_parse_finalize(GObject* object) {
-  delete GST_PFAP_PARSE(object)->reader;
-  g_free(GST_PFAP_PARSE(object)->alphabet);
-  G_OBJECT_CLASS(gst_pfap_parse_parent_class)->finalize(object);
+static void gst_pfap_text_parse_finalize(GObject* object) {
+  delete GST_PFAP_TEXT_PARSE(object)->reader;
+  g_free(GST_PFAP_TEXT_PARSE(object)->alphabet);
+  G_OBJECT_CLASS(gst_pfap_text_parse_parent_class)->finalize(object);
 }
 
-static void gst_pfap_parse_class_init(GstPfapParseClass* klass) {
+static void gst_pfap_text_parse_class_init(GstPfapTextParseClass* klass) {
   GObjectClass* gobject_class = G_OBJECT_CLASS(klass);
   GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
   GstPfapBaseParseClass* parse_class = GST_PFAP_BASE_PARSE_CLASS(klass);
 
   GST_DEBUG_CATEGORY_INIT(pfapparse_debug, "pfaptextparse", 0, "PFAP text parser");
 
-  gobject_class->set_property = gst_pfap_parse_set_property;
-  gobject_class->get_property = gst_pfap_parse_get_property;
-  gobject_class->finalize = gst_pfap_parse_finalize;
+  gobject_class->set_property = gst_pfap_text_parse_set_property;
+  gobject_class->get_property = gst_pfap_text_parse_get_property;
+  gobject_class->finalize = gst_pfap_text_parse_finalize;
 
   /**
-   * GstPfapParse:skip-bad-lines:
+   * GstPfapTextParse:skip-bad-lines:
    *
    * What a bad line does: FALSE (the default) posts an error and stops the stream; TRUE
    * posts a warning naming the line and what is wrong with it (at the 1st, 2nd, 4th, 8th,
@@ -186,7 +188,7 @@ static void gst_pfap_parse_class_init(GstPfapParseClass* klass) {
                                   gst_pfap_base_parse_skip_bad_lines_spec());
 
   /**
-   * GstPfapParse:alphabet:
+   * GstPfapTextParse:alphabet:
    *
    * The name of the phoneme alphabet the file's symbol numbers come from (a .pfap file holds
    * numbers only). Set, it becomes the `alphabet` field of the output caps, which
@@ -202,9 +204,9 @@ static void gst_pfap_parse_class_init(GstPfapParseClass* klass) {
                                                    GST_PARAM_MUTABLE_READY)));
 
   /**
-   * GstPfapParse:bad-lines:
+   * GstPfapTextParse:bad-lines:
    *
-   * The bad lines skipped (#GstPfapParse:skip-bad-lines) since the element last went from
+   * The bad lines skipped (#GstPfapTextParse:skip-bad-lines) since the element last went from
    * READY to PAUSED: the bad-lines field of the stats property, which every parser has.
    *
    * Deprecated: read bad-lines in the stats property.
@@ -227,12 +229,12 @@ static void gst_pfap_parse_class_init(GstPfapParseClass* klass) {
       "gst-pfap developers");
 
   parse_class->line_name = ".pfap line";
-  parse_class->read_line = gst_pfap_parse_read_line;
-  parse_class->reset = gst_pfap_parse_reset;
-  parse_class->output_caps = gst_pfap_parse_output_caps;
+  parse_class->read_line = gst_pfap_text_parse_read_line;
+  parse_class->reset = gst_pfap_text_parse_reset;
+  parse_class->output_caps = gst_pfap_text_parse_output_caps;
 }
 
-static void gst_pfap_parse_init(GstPfapParse* self) {
+static void gst_pfap_text_parse_init(GstPfapTextParse* self) {
   self->alphabet = nullptr;
   self->reader = new pfap::TextReader{};
 }

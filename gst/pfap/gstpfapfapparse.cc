@@ -9,7 +9,7 @@
  * Reads an MPEG-4 FAP file (.fap, the FBA text format of Xface, Greta and other MPEG-4 face
  * players; docs/fap-files.md) and outputs its animation as application/x-pfap events, which
  * rtppfappay, pfapface and pfaptextenc take as they are. Frame k becomes a silence phoneme
- * (#GstFapParse:silence-symbol) at k / frame rate seconds, rounded to the ms, lasting until
+ * (#GstPfapFapParse:silence-symbol) at k / frame rate seconds, rounded to the ms, lasting until
  * the next frame, with a bookmark `<FAP n a 0 1>` (linear, T = 0) for each FAP whose value
  * changed since the frame before: a receiver's FAP state holds each frame's values from its
  * time to the next frame's, as MPEG-4 players show the file. More than 40 changes in a frame
@@ -20,7 +20,7 @@
  * 1st, 2nd, 4th, ... such frame), and the rest of the frame goes on.
  *
  * The output is a TIME segment from 0 with the first frame at 0; a sink with sync=true plays
- * the animation in real time. The caps carry `alphabet` (#GstFapParse:alphabet).
+ * the animation in real time. The caps carry `alphabet` (#GstPfapFapParse:alphabet).
  *
  * With the request pad `speech` linked to a phoneme stream (pfaptts, pfaptextparse), the file's
  * bookmarks go on the speech's phonemes instead (pfap::merge_with_speech): a phoneme that
@@ -49,7 +49,7 @@
  * ]| Smiles joy.fap's smile on the phonemes of a spoken sentence.
  */
 // clang-format on
-#include "gstfapparse.h"
+#include "gstpfapfapparse.h"
 
 #include <algorithm>
 #include <bit>
@@ -86,7 +86,7 @@ struct Stream {
 };
 
 // With a speech pad: both inputs kept until both have ended, then merged
-// (pfap::merge_with_speech). Under GstFapParse::merge_lock: the two pads stream in two threads.
+// (pfap::merge_with_speech). Under GstPfapFapParse::merge_lock: the two pads stream in two threads.
 struct Merge {
   Merge() { gst_segment_init(&speech_segment, GST_FORMAT_TIME); }
 
@@ -107,7 +107,7 @@ constexpr size_t kMergeWindowEvents = 4096;
 
 }  // namespace
 
-struct _GstFapParse {
+struct _GstPfapFapParse {
   GstPfapBaseParse parent;
   GstPad* speechpad;     // the request pad, or NULL
   guint silence_symbol;  // under the object lock
@@ -127,19 +127,19 @@ static GstStaticPadTemplate speech_template = GST_STATIC_PAD_TEMPLATE(
 static GstStaticPadTemplate src_template =
     GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(PFAP_MARKUP_CAPS));
 
-G_DEFINE_TYPE(GstFapParse, gst_fap_parse, GST_TYPE_PFAP_BASE_PARSE)
-GST_ELEMENT_REGISTER_DEFINE(pfapfapparse, "pfapfapparse", GST_RANK_NONE, GST_TYPE_FAP_PARSE)
+G_DEFINE_TYPE(GstPfapFapParse, gst_pfap_fap_parse, GST_TYPE_PFAP_BASE_PARSE)
+GST_ELEMENT_REGISTER_DEFINE(pfapfapparse, "pfapfapparse", GST_RANK_NONE, GST_TYPE_PFAP_FAP_PARSE)
 
 // Back to the start of a file (READY to PAUSED, FLUSH_STOP).
-static void gst_fap_parse_reset(GstPfapBaseParse* parse) {
-  GstFapParse* self = GST_FAP_PARSE(parse);
+static void gst_pfap_fap_parse_reset(GstPfapBaseParse* parse) {
+  GstPfapFapParse* self = GST_PFAP_FAP_PARSE(parse);
   *self->stream = Stream{};
   g_mutex_lock(&self->merge_lock);
   *self->merge = Merge{};
   g_mutex_unlock(&self->merge_lock);
 }
 
-static bool merging(GstFapParse* self) {
+static bool merging(GstPfapFapParse* self) {
   GST_OBJECT_LOCK(self);
   const bool speech = self->speechpad != nullptr;
   GST_OBJECT_UNLOCK(self);
@@ -147,13 +147,13 @@ static bool merging(GstFapParse* self) {
 }
 
 // The upstream file's name for messages.
-static const char* file_name(GstFapParse* self) {
+static const char* file_name(GstPfapFapParse* self) {
   const std::string& source = gst_pfap_base_parse_source(GST_PFAP_BASE_PARSE(self));
   return source.empty() ? "the FAP file" : source.c_str();
 }
 
-static GstCaps* gst_fap_parse_output_caps(GstPfapBaseParse* parse) {
-  GstFapParse* self = GST_FAP_PARSE(parse);
+static GstCaps* gst_pfap_fap_parse_output_caps(GstPfapBaseParse* parse) {
+  GstPfapFapParse* self = GST_PFAP_FAP_PARSE(parse);
   GstCaps* caps = gst_static_pad_template_get_caps(&src_template);
   // Merged, the phonemes are mostly the speech's: its alphabet, when it names one.
   g_mutex_lock(&self->merge_lock);
@@ -170,7 +170,7 @@ static GstCaps* gst_fap_parse_output_caps(GstPfapBaseParse* parse) {
 }
 
 // A FAP file's frames depend on the lines before: there is nothing to skip to.
-static GstFlowReturn bad_file(GstFapParse* self, const pfap::FapFileResult& result) {
+static GstFlowReturn bad_file(GstPfapFapParse* self, const pfap::FapFileResult& result) {
   GST_ELEMENT_ERROR(self, STREAM, DECODE,
                     ("Bad FAP file %s, %s", file_name(self), pfap::describe(result).c_str()),
                     ("docs/fap-files.md describes what is read"));
@@ -184,7 +184,7 @@ static bool passed_warning(uint64_t before, uint64_t now) {
 }
 
 // Warns about what a frame holds that the draft cannot carry, at the 1st, 2nd, 4th, ... one.
-static void report_not_carried(GstFapParse* self, const pfap::FapFrame& frame) {
+static void report_not_carried(GstPfapFapParse* self, const pfap::FapFrame& frame) {
   Stream& s = *self->stream;
   const pfap::NotCarried& now = s.markup->not_carried();
   if (passed_warning(s.reported.visemes, now.visemes)) {
@@ -213,7 +213,8 @@ static void report_not_carried(GstFapParse* self, const pfap::FapFrame& frame) {
 }
 
 // Pushes events; the output starts with the first frame, even one that gives none.
-static GstFlowReturn push_events(GstFapParse* self, const std::vector<pfap::TextEvent>& events) {
+static GstFlowReturn push_events(GstPfapFapParse* self,
+                                 const std::vector<pfap::TextEvent>& events) {
   GstPfapBaseParse* parse = GST_PFAP_BASE_PARSE(self);
   gst_pfap_base_parse_start_output(parse);
   for (const pfap::TextEvent& event : events) {
@@ -223,7 +224,7 @@ static GstFlowReturn push_events(GstFapParse* self, const std::vector<pfap::Text
   return GST_FLOW_OK;
 }
 
-static GstFlowReturn push_frame(GstFapParse* self, const pfap::FapFrame& frame) {
+static GstFlowReturn push_frame(GstPfapFapParse* self, const pfap::FapFrame& frame) {
   Stream& s = *self->stream;
   if (!s.markup) s.markup.emplace(s.reader.header());
   s.events.clear();
@@ -250,7 +251,7 @@ static GstFlowReturn push_frame(GstFapParse* self, const pfap::FapFrame& frame) 
 // merge_with_speech ends the text at each window's last phoneme, and starts a sentence with a
 // silence that opens a window. `carry` is what the whole merge has there: the end of text of
 // the last speech phoneme before the cut, none after a silence, and true before anything.
-static GstFlowReturn push_merged(GstFapParse* self, std::vector<pfap::TextEvent>& file,
+static GstFlowReturn push_merged(GstPfapFapParse* self, std::vector<pfap::TextEvent>& file,
                                  const std::vector<pfap::TextEvent>& speech, uint8_t symbol) {
   const auto is_phoneme = [](const pfap::TextEvent& e) {
     return e.event.kind == PFAP_EVENT_PHONEME;
@@ -314,7 +315,7 @@ static GstFlowReturn push_merged(GstFapParse* self, std::vector<pfap::TextEvent>
 
 // At the end of the file or of the speech: once both have ended, the merged events and EOS
 // go downstream. Returns whether this call sent them (else the other input's end will).
-static bool end_of_input(GstFapParse* self, bool file) {
+static bool end_of_input(GstPfapFapParse* self, bool file) {
   g_mutex_lock(&self->merge_lock);
   Merge& m = *self->merge;
   (file ? m.file_ended : m.speech_ended) = true;
@@ -333,8 +334,8 @@ static bool end_of_input(GstFapParse* self, bool file) {
   return true;
 }
 
-static GstFlowReturn gst_fap_parse_read_line(GstPfapBaseParse* parse, std::string_view line) {
-  GstFapParse* self = GST_FAP_PARSE(parse);
+static GstFlowReturn gst_pfap_fap_parse_read_line(GstPfapBaseParse* parse, std::string_view line) {
+  GstPfapFapParse* self = GST_PFAP_FAP_PARSE(parse);
   pfap::FapFrame frame;
   bool has_frame = false;
   const pfap::FapFileResult result = self->stream->reader.read_line(line, frame, has_frame);
@@ -342,15 +343,15 @@ static GstFlowReturn gst_fap_parse_read_line(GstPfapBaseParse* parse, std::strin
   return has_frame ? push_frame(self, frame) : GST_FLOW_OK;
 }
 
-static GstFlowReturn gst_fap_parse_line_too_long(GstPfapBaseParse* parse) {
-  GstFapParse* self = GST_FAP_PARSE(parse);
+static GstFlowReturn gst_pfap_fap_parse_line_too_long(GstPfapBaseParse* parse) {
+  GstPfapFapParse* self = GST_PFAP_FAP_PARSE(parse);
   return bad_file(self, {pfap::FapFileStatus::kLineTooLong, self->stream->reader.line() + 1, 0, 0});
 }
 
 // At EOS, after the last line: the file must be whole. Merging, EOS goes once the speech has
 // ended too.
-static GstFlowReturn gst_fap_parse_finish(GstPfapBaseParse* parse) {
-  GstFapParse* self = GST_FAP_PARSE(parse);
+static GstFlowReturn gst_pfap_fap_parse_finish(GstPfapBaseParse* parse) {
+  GstPfapFapParse* self = GST_PFAP_FAP_PARSE(parse);
   const pfap::FapFileResult result = self->stream->reader.finish();
   if (!result.ok()) return bad_file(self, result);
   if (merging(self)) {
@@ -361,8 +362,9 @@ static GstFlowReturn gst_fap_parse_finish(GstPfapBaseParse* parse) {
 }
 
 // Speech events are kept, timed in ms from the speech segment's start, until both inputs end.
-static GstFlowReturn gst_fap_parse_speech_chain(GstPad*, GstObject* parent, GstBuffer* buffer) {
-  GstFapParse* self = GST_FAP_PARSE(parent);
+static GstFlowReturn gst_pfap_fap_parse_speech_chain(GstPad*, GstObject* parent,
+                                                     GstBuffer* buffer) {
+  GstPfapFapParse* self = GST_PFAP_FAP_PARSE(parent);
   pfap::TextEvent event;
   const bool ok = pfap_buffer_read(buffer, event.event);
   g_mutex_lock(&self->merge_lock);
@@ -396,8 +398,8 @@ static GstFlowReturn gst_fap_parse_speech_chain(GstPad*, GstObject* parent, GstB
   return GST_FLOW_OK;
 }
 
-static gboolean gst_fap_parse_speech_event(GstPad*, GstObject* parent, GstEvent* event) {
-  GstFapParse* self = GST_FAP_PARSE(parent);
+static gboolean gst_pfap_fap_parse_speech_event(GstPad*, GstObject* parent, GstEvent* event) {
+  GstPfapFapParse* self = GST_PFAP_FAP_PARSE(parent);
   switch (GST_EVENT_TYPE(event)) {
     case GST_EVENT_CAPS: {
       GstCaps* caps = nullptr;
@@ -428,9 +430,9 @@ static gboolean gst_fap_parse_speech_event(GstPad*, GstObject* parent, GstEvent*
   return TRUE;
 }
 
-static GstPad* gst_fap_parse_request_new_pad(GstElement* element, GstPadTemplate* templ,
-                                             const gchar*, const GstCaps*) {
-  GstFapParse* self = GST_FAP_PARSE(element);
+static GstPad* gst_pfap_fap_parse_request_new_pad(GstElement* element, GstPadTemplate* templ,
+                                                  const gchar*, const GstCaps*) {
+  GstPfapFapParse* self = GST_PFAP_FAP_PARSE(element);
   GST_OBJECT_LOCK(self);
   const bool taken = self->speechpad != nullptr;
   GST_OBJECT_UNLOCK(self);
@@ -439,8 +441,8 @@ static GstPad* gst_fap_parse_request_new_pad(GstElement* element, GstPadTemplate
     return nullptr;
   }
   GstPad* pad = gst_pad_new_from_template(templ, "speech");
-  gst_pad_set_chain_function(pad, gst_fap_parse_speech_chain);
-  gst_pad_set_event_function(pad, gst_fap_parse_speech_event);
+  gst_pad_set_chain_function(pad, gst_pfap_fap_parse_speech_chain);
+  gst_pad_set_event_function(pad, gst_pfap_fap_parse_speech_event);
   GST_OBJECT_LOCK(self);
   self->speechpad = pad;
   GST_OBJECT_UNLOCK(self);
@@ -448,17 +450,17 @@ static GstPad* gst_fap_parse_request_new_pad(GstElement* element, GstPadTemplate
   return pad;
 }
 
-static void gst_fap_parse_release_pad(GstElement* element, GstPad* pad) {
-  GstFapParse* self = GST_FAP_PARSE(element);
+static void gst_pfap_fap_parse_release_pad(GstElement* element, GstPad* pad) {
+  GstPfapFapParse* self = GST_PFAP_FAP_PARSE(element);
   GST_OBJECT_LOCK(self);
   if (self->speechpad == pad) self->speechpad = nullptr;
   GST_OBJECT_UNLOCK(self);
   gst_element_remove_pad(element, pad);
 }
 
-static void gst_fap_parse_set_property(GObject* object, guint prop_id, const GValue* value,
-                                       GParamSpec* pspec) {
-  GstFapParse* self = GST_FAP_PARSE(object);
+static void gst_pfap_fap_parse_set_property(GObject* object, guint prop_id, const GValue* value,
+                                            GParamSpec* pspec) {
+  GstPfapFapParse* self = GST_PFAP_FAP_PARSE(object);
   GST_OBJECT_LOCK(self);
   switch (prop_id) {
     case PROP_SILENCE_SYMBOL:
@@ -475,9 +477,9 @@ static void gst_fap_parse_set_property(GObject* object, guint prop_id, const GVa
   GST_OBJECT_UNLOCK(self);
 }
 
-static void gst_fap_parse_get_property(GObject* object, guint prop_id, GValue* value,
-                                       GParamSpec* pspec) {
-  GstFapParse* self = GST_FAP_PARSE(object);
+static void gst_pfap_fap_parse_get_property(GObject* object, guint prop_id, GValue* value,
+                                            GParamSpec* pspec) {
+  GstPfapFapParse* self = GST_PFAP_FAP_PARSE(object);
   GST_OBJECT_LOCK(self);
   switch (prop_id) {
     case PROP_SILENCE_SYMBOL:
@@ -493,30 +495,30 @@ static void gst_fap_parse_get_property(GObject* object, guint prop_id, GValue* v
   GST_OBJECT_UNLOCK(self);
 }
 
-static void gst_fap_parse_finalize(GObject* object) {
-  delete GST_FAP_PARSE(object)->stream;
-  delete GST_FAP_PARSE(object)->merge;
-  g_mutex_clear(&GST_FAP_PARSE(object)->merge_lock);
-  g_free(GST_FAP_PARSE(object)->alphabet);
-  G_OBJECT_CLASS(gst_fap_parse_parent_class)->finalize(object);
+static void gst_pfap_fap_parse_finalize(GObject* object) {
+  delete GST_PFAP_FAP_PARSE(object)->stream;
+  delete GST_PFAP_FAP_PARSE(object)->merge;
+  g_mutex_clear(&GST_PFAP_FAP_PARSE(object)->merge_lock);
+  g_free(GST_PFAP_FAP_PARSE(object)->alphabet);
+  G_OBJECT_CLASS(gst_pfap_fap_parse_parent_class)->finalize(object);
 }
 
-static void gst_fap_parse_class_init(GstFapParseClass* klass) {
+static void gst_pfap_fap_parse_class_init(GstPfapFapParseClass* klass) {
   GObjectClass* gobject_class = G_OBJECT_CLASS(klass);
   GstElementClass* element_class = GST_ELEMENT_CLASS(klass);
   GstPfapBaseParseClass* parse_class = GST_PFAP_BASE_PARSE_CLASS(klass);
 
   GST_DEBUG_CATEGORY_INIT(fapparse_debug, "pfapfapparse", 0, "MPEG-4 FAP file parser");
 
-  gobject_class->set_property = gst_fap_parse_set_property;
-  gobject_class->get_property = gst_fap_parse_get_property;
-  gobject_class->finalize = gst_fap_parse_finalize;
+  gobject_class->set_property = gst_pfap_fap_parse_set_property;
+  gobject_class->get_property = gst_pfap_fap_parse_get_property;
+  gobject_class->finalize = gst_pfap_fap_parse_finalize;
 
   /**
-   * GstFapParse:silence-symbol:
+   * GstPfapFapParse:silence-symbol:
    *
    * The phoneme symbol of the silence phonemes that carry the frames: 0, the pause of
-   * x-pfap-arpabet, by default. Set it with #GstFapParse:alphabet for another alphabet.
+   * x-pfap-arpabet, by default. Set it with #GstPfapFapParse:alphabet for another alphabet.
    */
   g_object_class_install_property(
       gobject_class, PROP_SILENCE_SYMBOL,
@@ -527,9 +529,9 @@ static void gst_fap_parse_class_init(GstFapParseClass* klass) {
                                                  GST_PARAM_MUTABLE_READY)));
 
   /**
-   * GstFapParse:alphabet:
+   * GstPfapFapParse:alphabet:
    *
-   * The phoneme alphabet of #GstFapParse:silence-symbol, for the `alphabet` field of the
+   * The phoneme alphabet of #GstPfapFapParse:silence-symbol, for the `alphabet` field of the
    * output caps (rtppfappay carries it to the SDP). Empty: no alphabet field.
    */
   g_object_class_install_property(
@@ -550,16 +552,16 @@ static void gst_fap_parse_class_init(GstFapParseClass* klass) {
       "gst-pfap developers");
 
   parse_class->max_line_bytes = pfap::kMaxFapFileLineBytes;
-  parse_class->read_line = gst_fap_parse_read_line;
-  parse_class->line_too_long = gst_fap_parse_line_too_long;
-  parse_class->finish = gst_fap_parse_finish;
-  parse_class->reset = gst_fap_parse_reset;
-  parse_class->output_caps = gst_fap_parse_output_caps;
-  element_class->request_new_pad = gst_fap_parse_request_new_pad;
-  element_class->release_pad = gst_fap_parse_release_pad;
+  parse_class->read_line = gst_pfap_fap_parse_read_line;
+  parse_class->line_too_long = gst_pfap_fap_parse_line_too_long;
+  parse_class->finish = gst_pfap_fap_parse_finish;
+  parse_class->reset = gst_pfap_fap_parse_reset;
+  parse_class->output_caps = gst_pfap_fap_parse_output_caps;
+  element_class->request_new_pad = gst_pfap_fap_parse_request_new_pad;
+  element_class->release_pad = gst_pfap_fap_parse_release_pad;
 }
 
-static void gst_fap_parse_init(GstFapParse* self) {
+static void gst_pfap_fap_parse_init(GstPfapFapParse* self) {
   self->silence_symbol = kDefaultSilenceSymbol;
   self->alphabet = g_strdup(kDefaultAlphabet);
   self->stream = new Stream{};
