@@ -47,7 +47,7 @@ export function start({ canvas, audio, status, janusServer }) {
   // The stream of one SSRC: PFAP timestamps as ms from the first one seen (`ref`).
   let stream = null;
   const newStream = (ssrc, timestamp) => {
-    stream = { ssrc, ref: timestamp, firstPfapMs: null, clocks: [], firstReading: null };
+    stream = { ssrc, ref: timestamp, firstPfapMs: null, clocks: [], firstReading: null, estimates: [] };
     clock.reset();
     drawnPhonemes.reset();
     stats.sender = null;
@@ -145,6 +145,7 @@ export function start({ canvas, audio, status, janusServer }) {
       const estimate = estimateMs(handedAt);
       if (estimate === null) return null;
       stream.base = estimate - rtpMs;
+      if (stream.estimates.length < 120) stream.estimates.push({ t: now, handedAt, rtpMs, jitterBufferMs, latencyMs: clock.latencyMs(), estimate });
     }
     // The chunk it names is heard from its timestamp plus the output's latency on.
     const heardFrom = handedAt + clock.latencyMs();
@@ -162,6 +163,7 @@ export function start({ canvas, audio, status, janusServer }) {
   drawInTime({ receiver, canvas, stats, streamNs, drawn: drawnPhonemes });
   stats.measureLipSync = () => {
     stats.corrections = clock.corrections;
+    stats.start = { trace: clock.startTrace, estimates: stream?.estimates, clocks: stream?.clocks.slice(0, 10), firstPfapMs: stream?.firstPfapMs, phonemes: drawnPhonemes.phonemes.slice(0, 6) };
     stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames);
   };
 

@@ -47,6 +47,9 @@ export class PlayoutClock {
     this.matched = null;  // {m: running time less heard time, stretch: the stretch then}
     this.corrections = [];  // {t: heard time, lag: ms}
     this.misses = 0;  // tap messages since the last match whose window held sound
+    // The stream's start, for the figures (docs/web.md, the first syllable): the running time
+    // each of the first frames was drawn at and whether it rested on a match.
+    this.startTrace = [];
   }
 
   /**
@@ -114,7 +117,9 @@ export class PlayoutClock {
   /** The running time (ms) heard at performance time `now`, or null before any reading. */
   runningMs(now) {
     const m = this.mappingAt(now);
-    return m === null ? null : now + m;
+    if (m === null) return null;
+    if (this.startTrace.length < 120) this.startTrace.push({ t: now, ms: now + m, matched: this.matched !== null });
+    return now + m;
   }
 
   // The last 150 ms of the audio played, found in the sender's level (clock.js).
