@@ -10,8 +10,9 @@
 // PFAP packets, as JSON messages (a first byte of '{', which no RTP packet has): the speech's
 // level by PFAP timestamp ("level", ahead of the audio), the PFAP timestamp of the audio as it
 // leaves ("clock") and the state as sent at the end ("done"). The first estimate of which PFAP
-// time is heard comes from the clock messages and the jitter buffer's delay; the level found
-// in the audio played makes it exact, as in pfap-web.
+// time is heard comes from the clock messages and the jitter buffer's delay: the level's first
+// match searches around it. Until that match the face is drawn from the stream's first sound
+// heard, put at the first sound sent (playout.js); the match makes it exact, as in pfap-web.
 //
 // window.pfapStats holds the figures the browser test reads.
 import { PfapReceiver, Viseme, parseRtp } from '../src/index.js';
@@ -137,7 +138,8 @@ export function start({ canvas, audio, status, janusServer }) {
     const source = audioReceiver.getSynchronizationSources()[0];
     if (!source) return null;
     // Janus's timestamps, from an origin of their own: ms since the first reading of the
-    // stream, put at PFAP time by the estimate until the level has been matched.
+    // stream, put at PFAP time by the estimate until the level has been matched (the readings
+    // say where the first match searches; the face waits for the sound).
     stream.firstReading ??= source.rtpTimestamp;
     const rtpMs = ((source.rtpTimestamp - stream.firstReading) >>> 0) / (AUDIO_CLOCK_RATE / 1000);
     const handedAt = source.timestamp - performance.timeOrigin;
@@ -157,13 +159,14 @@ export function start({ canvas, audio, status, janusServer }) {
       stats.jitterBufferMs = jitterBufferMs;
     }
     stats.matched = clock.matched !== null;
-    return Math.round((clock.runningMs(now) - stream.firstPfapMs) * 1e6);
+    const running = clock.runningMs(now);
+    return running === null ? null : Math.round((running - stream.firstPfapMs) * 1e6);
   }
 
   drawInTime({ receiver, canvas, stats, streamNs, drawn: drawnPhonemes });
   stats.measureLipSync = () => {
     stats.corrections = clock.corrections;
-    stats.start = { trace: clock.startTrace, estimates: stream?.estimates, clocks: stream?.clocks.slice(0, 10), firstPfapMs: stream?.firstPfapMs, phonemes: drawnPhonemes.phonemes.slice(0, 6) };
+    stats.start = { trace: clock.startTrace, firstSound: clock.firstSound, estimates: stream?.estimates, clocks: stream?.clocks.slice(0, 10), firstPfapMs: stream?.firstPfapMs, phonemes: drawnPhonemes.phonemes.slice(0, 6) };
     stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames);
   };
 
