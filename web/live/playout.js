@@ -60,7 +60,6 @@ export class PlayoutClock {
     this.firstSound = null;
     this.firstSoundTried = false;  // the first sound heard since the reset has been looked at
     this.scannedTo = this.envelope.at(-1)?.t ?? -Infinity;  // heard since the reset: after this
-    this.quietFrom = null;  // the first block heard since the reset
     this.corrections = [];  // {t: heard time, lag: ms}
     this.misses = 0;  // tap messages since the last match whose window held sound
     // The stream's start, for the figures (docs/web.md, the first syllable): the running time
@@ -150,7 +149,8 @@ export class PlayoutClock {
   }
 
   // The stream's first sound: the first block heard since the reset at FIRST_SOUND_RMS or more,
-  // after at least FIRST_SOUND_QUIET_MS of blocks under it, put at the first millisecond of the
+  // after at least FIRST_SOUND_QUIET_MS of blocks under it (heard before the reset too: the
+  // sender's first message leaves with its first audio), put at the first millisecond of the
   // sender's level at FIRST_SOUND_RMS or more, if that lies within ±firstSoundSearchMs of where
   // the readings put it. A page that came in mid-sound (a late joiner) has none and waits for
   // the level's match; so does one whose level holds no sound 1 s after it heard some.
@@ -160,14 +160,15 @@ export class PlayoutClock {
     while (i > 0 && env[i - 1].t > this.scannedTo) --i;
     for (; i < env.length; ++i) {
       const { t, rms } = env[i];
-      this.quietFrom ??= t;
       if (rms * 32768 >= FIRST_SOUND_RMS) {
         const reading = valueAt(this.readings, t, null);
         const sentMs = this.sent.firstAtLeast(FIRST_SOUND_RMS);
         if (sentMs === null && env.at(-1).t - t < 1000) return;  // its level may yet come
         this.firstSoundTried = true;
-        if (t - this.quietFrom >= FIRST_SOUND_QUIET_MS && sentMs !== null &&
-            Math.abs(sentMs - (t + reading)) <= this.firstSoundSearchMs) {
+        let j = i - 1;
+        while (j >= 0 && env[j].t >= t - FIRST_SOUND_QUIET_MS && env[j].rms * 32768 < FIRST_SOUND_RMS) --j;
+        const quiet = j >= 0 && env[j].t < t - FIRST_SOUND_QUIET_MS;
+        if (quiet && sentMs !== null && Math.abs(sentMs - (t + reading)) <= this.firstSoundSearchMs) {
           this.firstSound = { m: sentMs - t, stretch: valueAt(this.stretches, t, 0), t };
         }
         return;

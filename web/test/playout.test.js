@@ -66,9 +66,10 @@ const FRAME_MS = 1000 / 60;
 const PA_MS = 49;
 const paLevel = (ms) => (ms < PA_MS ? 0 : level(ms - PA_MS));
 
-function startOfStream({ heardAt, readingsOffMs, hearFromMs = 0, sentFromMs = 0, untilMs = 1500 }) {
+function startOfStream({ heardAt, readingsOffMs, hearFromMs = 0, sentFromMs = 0, untilMs = 1500, resetAtMs = null }) {
   const clock = new PlayoutClock({ envelope: [], firstSearchMs: 150 });
-  clock.sent.add(sentFromMs * 1e6, Array.from({ length: 8000 }, (_, i) => paLevel(sentFromMs + i)));
+  const sending = () => clock.sent.add(sentFromMs * 1e6, Array.from({ length: 8000 }, (_, i) => paLevel(sentFromMs + i)));
+  sending();
   const frames = [];
   const drawn = new DrawnPhonemes(frames);
   for (let k = 0; k < 20; ++k) {
@@ -79,6 +80,11 @@ function startOfStream({ heardAt, readingsOffMs, hearFromMs = 0, sentFromMs = 0,
   let nextFrame = heardAt + hearFromMs - 300;
   for (let now = heardAt + hearFromMs - 500; now < heardAt + untilMs; ++now) {
     // The tap: the block heard at now + RENDER_AHEAD_MS (silence before the stream's audio).
+    // The stream's first message (its level) comes as it begins: the clock starts over.
+    if (now === heardAt + resetAtMs) {
+      clock.reset();
+      sending();
+    }
     const t = now + RENDER_AHEAD_MS;
     const running = t - heardAt;
     clock.envelope.push({ t, rms: running < hearFromMs ? 0 : paLevel(running) / 32768 });
@@ -118,6 +124,16 @@ test('a stream\'s first syllable is drawn with its sound, whatever the readings 
       assert.ok(e !== null && e >= 0 && e <= FRAME_MS + 1, `readings ${readingsOffMs} ms off: first frames pressed ${errors.map((x) => x?.toFixed(1))} ms after the onsets`);
     }
   }
+});
+
+test('a stream whose first message comes 20 ms before its sound is heard is drawn with its sound', () => {
+  // The sender's first level message leaves with its first audio (its queue is empty then):
+  // the page starts the stream over shortly before the sound, after a silence of its own.
+  const heardAt = 2000;
+  const { clock, frames } = startOfStream({ heardAt, readingsOffMs: 65, resetAtMs: -20 });
+  assert.ok(clock.firstSound !== null);
+  const errors = pressedAfterOnsets(frames, heardAt);
+  for (const e of errors) assert.ok(e !== null && e >= 0 && e <= FRAME_MS + 1, `${errors.map((x) => x?.toFixed(1))}`);
 });
 
 test('a late joiner, whose level begins 1 s after what it hears first, draws from the level\'s match', () => {
