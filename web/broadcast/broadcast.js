@@ -147,7 +147,10 @@ export function start({ canvas, audio, status, janusServer }) {
       const estimate = estimateMs(handedAt);
       if (estimate === null) return null;
       stream.base = estimate - rtpMs;
-      if (stream.estimates.length < 120) stream.estimates.push({ t: now, handedAt, rtpMs, jitterBufferMs, latencyMs: clock.latencyMs(), estimate });
+      // For the figures (docs/web.md, "The first syllable").
+      if (stream.estimates.length < 120) {
+        stream.estimates.push({ t: now, handedAt, rtpMs, jitterBufferMs, latencyMs: clock.latencyMs(), estimate });
+      }
     }
     // The chunk it names is heard from its timestamp plus the output's latency on.
     const heardFrom = handedAt + clock.latencyMs();
@@ -166,7 +169,11 @@ export function start({ canvas, audio, status, janusServer }) {
   drawInTime({ receiver, canvas, stats, streamNs, drawn: drawnPhonemes });
   stats.measureLipSync = () => {
     stats.corrections = clock.corrections;
-    stats.start = { trace: clock.startTrace, firstSound: clock.firstSound, estimates: stream?.estimates, clocks: stream?.clocks.slice(0, 10), firstPfapMs: stream?.firstPfapMs, phonemes: drawnPhonemes.phonemes.slice(0, 6) };
+    // The stream's start (docs/web.md, "The first syllable").
+    stats.start = {
+      trace: clock.startTrace, firstSound: clock.firstSound, estimates: stream?.estimates,
+      clocks: stream?.clocks.slice(0, 10), firstPfapMs: stream?.firstPfapMs, phonemes: drawnPhonemes.phonemes.slice(0, 6),
+    };
     stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames);
   };
 
