@@ -10,9 +10,11 @@
 // PFAP packets, as JSON messages (a first byte of '{', which no RTP packet has): the speech's
 // level by PFAP timestamp ("level", ahead of the audio), the PFAP timestamp of the audio as it
 // leaves ("clock") and the state as sent at the end ("done"). The first estimate of which PFAP
-// time is heard comes from the clock messages and the jitter buffer's delay: the level's first
-// match searches around it. Until that match the face is drawn from the stream's first sound
-// heard, put at the first sound sent (playout.js); the match makes it exact, as in pfap-web.
+// time is heard comes from the clock messages and the jitter buffer's delay; the level found
+// in the audio played makes it exact, as in pfap-web.
+//
+// The estimate only says where the level's first match searches: until that match the face
+// is drawn from the stream's first sound heard, put at the first sound sent (playout.js).
 //
 // window.pfapStats holds the figures the browser test reads.
 import { PfapReceiver, Viseme, parseRtp } from '../src/index.js';
