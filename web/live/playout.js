@@ -126,8 +126,8 @@ export class PlayoutClock {
   /**
    * Running time (ms) less performance time, at performance time t, as the sound says: from the
    * last match, else from the stream's first sound; null before either. The readings alone
-   * are not enough to draw by: through Janus they put a stream's start tens to hundreds of ms ahead of
-   * its sound (docs/web.md, "The first syllable").
+   * are not enough to draw by: through Janus they put a stream's start tens to hundreds of ms
+   * ahead of its sound (docs/web.md, "The first syllable").
    */
   mappingAt(t) {
     const from = this.matched ?? this.firstSound;
