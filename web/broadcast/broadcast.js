@@ -13,6 +13,9 @@
 // time is heard comes from the clock messages and the jitter buffer's delay; the level found
 // in the audio played makes it exact, as in pfap-web.
 //
+// The estimate only says where the level's first match searches: until that match the face
+// is drawn from the stream's first sound heard, put at the first sound sent (playout.js).
+//
 // window.pfapStats holds the figures the browser test reads.
 import { PfapReceiver, Viseme, parseRtp } from '../src/index.js';
 import { decodeLevels } from '../live/clock.js';
@@ -47,7 +50,7 @@ export function start({ canvas, audio, status, janusServer }) {
   // The stream of one SSRC: PFAP timestamps as ms from the first one seen (`ref`).
   let stream = null;
   const newStream = (ssrc, timestamp) => {
-    stream = { ssrc, ref: timestamp, firstPfapMs: null, clocks: [], firstReading: null };
+    stream = { ssrc, ref: timestamp, firstPfapMs: null, clocks: [], firstReading: null, estimates: [] };
     clock.reset();
     drawnPhonemes.reset();
     stats.sender = null;
@@ -137,7 +140,8 @@ export function start({ canvas, audio, status, janusServer }) {
     const source = audioReceiver.getSynchronizationSources()[0];
     if (!source) return null;
     // Janus's timestamps, from an origin of their own: ms since the first reading of the
-    // stream, put at PFAP time by the estimate until the level has been matched.
+    // stream, put at PFAP time by the estimate until the level has been matched (the readings
+    // say where the first match searches; the face waits for the sound).
     stream.firstReading ??= source.rtpTimestamp;
     const rtpMs = ((source.rtpTimestamp - stream.firstReading) >>> 0) / (AUDIO_CLOCK_RATE / 1000);
     const handedAt = source.timestamp - performance.timeOrigin;
@@ -145,6 +149,10 @@ export function start({ canvas, audio, status, janusServer }) {
       const estimate = estimateMs(handedAt);
       if (estimate === null) return null;
       stream.base = estimate - rtpMs;
+      // For the figures (docs/web.md, "The first syllable").
+      if (stream.estimates.length < 120) {
+        stream.estimates.push({ t: now, handedAt, rtpMs, jitterBufferMs, latencyMs: clock.latencyMs(), estimate });
+      }
     }
     // The chunk it names is heard from its timestamp plus the output's latency on.
     const heardFrom = handedAt + clock.latencyMs();
@@ -156,12 +164,18 @@ export function start({ canvas, audio, status, janusServer }) {
       stats.jitterBufferMs = jitterBufferMs;
     }
     stats.matched = clock.matched !== null;
-    return Math.round((clock.runningMs(now) - stream.firstPfapMs) * 1e6);
+    const running = clock.runningMs(now);
+    return running === null ? null : Math.round((running - stream.firstPfapMs) * 1e6);
   }
 
   drawInTime({ receiver, canvas, stats, streamNs, drawn: drawnPhonemes });
   stats.measureLipSync = () => {
     stats.corrections = clock.corrections;
+    // The stream's start (docs/web.md, "The first syllable").
+    stats.start = {
+      trace: clock.startTrace, firstSound: clock.firstSound, estimates: stream?.estimates,
+      clocks: stream?.clocks.slice(0, 10), firstPfapMs: stream?.firstPfapMs, phonemes: drawnPhonemes.phonemes.slice(0, 6),
+    };
     stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames);
   };
 

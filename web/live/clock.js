@@ -47,6 +47,15 @@ export class SentLevel {
     this.found = null;
   }
 
+  /** The first running time (ms) whose level is `rms` or more, or null. */
+  firstAtLeast(rms) {
+    for (const { startMs, levels } of this.segments) {
+      const k = levels.findIndex((v) => v >= rms);
+      if (k >= 0) return startMs + k;
+    }
+    return null;
+  }
+
   /** The level at running time `ms` (between two blocks' starts, interpolated), 0 where none was sent. */
   at(ms) {
     // Lookups come in runs of nearby times: the segment found last first.

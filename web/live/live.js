@@ -235,9 +235,10 @@ export function start({ canvas, audio, form, input, status, saying }) {
     const heardFrom = source.timestamp - performance.timeOrigin + clock.latencyMs();
     const rtpMs = ((source.rtpTimestamp - timing.audioTimestampOffset) >>> 0) / timing.audioClockRate * 1000;
     clock.reading(heardFrom, rtpMs);
-    const running = clock.runningMs(now) / 1000;
+    const running = clock.runningMs(now);
+    if (running === null) return null;  // not before the sound says (playout.js)
     const first = ((firstPfapTimestamp - timing.pfapTimestampOffset) >>> 0) / timing.pfapClockRate;
-    return Math.round((running - first) * 1e9);
+    return Math.round((running / 1000 - first) * 1e9);
   }
 
   drawInTime({ receiver, canvas, stats, streamNs, drawn: drawnPhonemes });

@@ -19,22 +19,32 @@ const remember = (history, from, value) => {
   if (history.length > 1000) history.splice(0, 500);
 };
 
+// The stream's first sound (PlayoutClock.findFirstSound): a level of 100 in S16 RMS units
+// (-50 dBFS), which a "pa"'s p passes within 2 ms of its onset, after 100 ms under it.
+const FIRST_SOUND_RMS = 100;
+const FIRST_SOUND_QUIET_MS = 100;
+
 export class PlayoutClock {
   /**
    * @param {{envelope: {t: number, rms: number}[], audioClockRate?: number, searchMs?: number,
-   *   firstSearchMs?: number}} options `envelope` receives the tap's level of what is heard
-   *   (1 ms blocks, performance time); the first match searches ±firstSearchMs around the
-   *   readings, later ones ±searchMs around the last match, and ±lostSearchMs after 300 ms of
-   *   sound heard without a match (the clock is lost: NetEq's concealment when packets come
-   *   late moves the audio by more than the search, and getStats' stretch counts leave it
-   *   out).
+   *   firstSearchMs?: number, lostSearchMs?: number, firstSoundSearchMs?: number}} options
+   *   `envelope` receives the tap's level of what is heard (1 ms blocks, performance time);
+   *   the first match searches ±firstSearchMs around the readings, later ones ±searchMs around
+   *   the last match, and ±lostSearchMs after 300 ms of sound heard without a match (the clock
+   *   is lost: NetEq's concealment when packets come late moves the audio by more than the
+   *   search, and getStats' stretch counts leave it out). Until the first match the clock
+   *   draws from the stream's first sound, if it lies within ±firstSoundSearchMs of where the
+   *   readings put it (findFirstSound), and not at all without it.
    */
-  constructor({ envelope, audioClockRate = 48000, searchMs = 50, firstSearchMs = searchMs, lostSearchMs = 150 }) {
+  constructor({
+    envelope, audioClockRate = 48000, searchMs = 50, firstSearchMs = searchMs, lostSearchMs = 150, firstSoundSearchMs = 500,
+  }) {
     this.envelope = envelope;
     this.audioClockRate = audioClockRate;
     this.searchMs = searchMs;
     this.firstSearchMs = firstSearchMs;
     this.lostSearchMs = lostSearchMs;
+    this.firstSoundSearchMs = firstSoundSearchMs;
     this.context = null;
     this.reset();
   }
@@ -45,8 +55,16 @@ export class PlayoutClock {
     this.readings = [];  // [heard from, running time less heard time]
     this.stretches = [];  // [heard from, samples removed less inserted]
     this.matched = null;  // {m: running time less heard time, stretch: the stretch then}
+    // The stream's first sound heard put at the first sound sent: the mapping from the sound
+    // until the level's first match ({m, stretch} as `matched`, and `t`, when it is heard).
+    this.firstSound = null;
+    this.firstSoundTried = false;  // the first sound heard since the reset has been looked at
+    this.scannedTo = this.envelope.at(-1)?.t ?? -Infinity;  // heard since the reset: after this
     this.corrections = [];  // {t: heard time, lag: ms}
     this.misses = 0;  // tap messages since the last match whose window held sound
+    // The stream's start, for the figures (docs/web.md, the first syllable): the running time
+    // each of the first frames was drawn at and whether it rested on a match.
+    this.startTrace = [];
   }
 
   /**
@@ -105,26 +123,69 @@ export class PlayoutClock {
     }, 25);
   }
 
-  /** Running time (ms) less performance time, at performance time t; null before any reading. */
+  /**
+   * Running time (ms) less performance time, at performance time t, as the sound says: from the
+   * last match, else from the stream's first sound; null before either. The readings alone
+   * are not enough to draw by: through Janus they put a stream's start tens to hundreds of ms
+   * ahead of its sound (docs/web.md, "The first syllable").
+   */
   mappingAt(t) {
-    if (!this.matched) return valueAt(this.readings, t, null);
-    return this.matched.m + (valueAt(this.stretches, t, 0) - this.matched.stretch) / (this.audioClockRate / 1000);
+    const from = this.matched ?? this.firstSound;
+    if (!from) return null;
+    return from.m + (valueAt(this.stretches, t, 0) - from.stretch) / (this.audioClockRate / 1000);
   }
 
-  /** The running time (ms) heard at performance time `now`, or null before any reading. */
+  /** The running time (ms) heard at performance time `now`, or null until the sound says. */
   runningMs(now) {
     const m = this.mappingAt(now);
-    return m === null ? null : now + m;
+    if (m === null) return null;
+    if (this.startTrace.length < 120) this.startTrace.push({ t: now, ms: now + m, matched: this.matched !== null });
+    return now + m;
+  }
+
+  // The first match searches around the readings, later ones around the last match.
+  searchMappingAt(t) {
+    return this.matched ? this.mappingAt(t) : valueAt(this.readings, t, null);
+  }
+
+  // The stream's first sound: the first block heard since the reset at FIRST_SOUND_RMS or more,
+  // after at least FIRST_SOUND_QUIET_MS of blocks under it (heard before the reset too: the
+  // sender's first message leaves with its first audio), put at the first millisecond of the
+  // sender's level at FIRST_SOUND_RMS or more, if that lies within ±firstSoundSearchMs of where
+  // the readings put it. A page that came in mid-sound (a late joiner) has none and waits for
+  // the level's match; so does one whose level holds no sound 1 s after it heard some.
+  findFirstSound() {
+    const env = this.envelope;
+    let i = env.length;
+    while (i > 0 && env[i - 1].t > this.scannedTo) --i;
+    for (; i < env.length; ++i) {
+      const { t, rms } = env[i];
+      if (rms * 32768 >= FIRST_SOUND_RMS) {
+        const reading = valueAt(this.readings, t, null);
+        const sentMs = this.sent.firstAtLeast(FIRST_SOUND_RMS);
+        if (sentMs === null && env.at(-1).t - t < 1000) return;  // its level may yet come
+        this.firstSoundTried = true;
+        let j = i - 1;
+        while (j >= 0 && env[j].t >= t - FIRST_SOUND_QUIET_MS && env[j].rms * 32768 < FIRST_SOUND_RMS) --j;
+        const quiet = j >= 0 && env[j].t < t - FIRST_SOUND_QUIET_MS;
+        if (quiet && sentMs !== null && Math.abs(sentMs - (t + reading)) <= this.firstSoundSearchMs) {
+          this.firstSound = { m: sentMs - t, stretch: valueAt(this.stretches, t, 0), t };
+        }
+        return;
+      }
+      this.scannedTo = t;
+    }
   }
 
   // The last 150 ms of the audio played, found in the sender's level (clock.js).
   matchHeard() {
     const env = this.envelope;
     if (env.length === 0 || this.readings.length === 0) return;
+    if (!this.firstSoundTried) this.findFirstSound();
     const newest = env.at(-1).t;
     const heard = [];
     for (let i = env.length - 1; i >= 0 && env[i].t >= newest - 150; --i) {
-      heard.push({ x: env[i].t + this.mappingAt(env[i].t), rms: env[i].rms });
+      heard.push({ x: env[i].t + this.searchMappingAt(env[i].t), rms: env[i].rms });
     }
     const searchMs = !this.matched ? this.firstSearchMs : this.misses >= 30 ? this.lostSearchMs : this.searchMs;
     const lag = matchLevels(heard.reverse(), (ms) => this.sent.at(ms), { searchMs });
@@ -134,7 +195,7 @@ export class PlayoutClock {
       return;
     }
     this.misses = 0;
-    this.matched = { m: this.mappingAt(newest) + lag, stretch: valueAt(this.stretches, newest, 0) };
+    this.matched = { m: this.searchMappingAt(newest) + lag, stretch: valueAt(this.stretches, newest, 0) };
     // Each match's correction, for the figures (docs/web.md).
     this.corrections.push({ t: newest, lag });
     if (this.corrections.length > 2000) this.corrections.splice(0, 1000);

@@ -47,6 +47,17 @@ test('SentLevel keeps the last 30 s', () => {
   assert.equal(sent.at(31000), 2);
 });
 
+test('SentLevel.firstAtLeast: the first ms of any message at a level, null before any', () => {
+  const sent = new SentLevel();
+  assert.equal(sent.firstAtLeast(100), null);
+  sent.add(50e6, [0, 20, 99]);
+  assert.equal(sent.firstAtLeast(100), null);
+  sent.add(60e6, [0, 0, 150, 4000]);
+  sent.add(20e6, [0, 0, 0, 0, 0, 0, 0, 0]);  // earlier, silent
+  assert.equal(sent.firstAtLeast(100), 62);
+  assert.equal(sent.firstAtLeast(20), 51);
+});
+
 test('matchLevels finds the lag at an onset, to a fraction of a millisecond', () => {
   const levels = speech(2000);
   const sent = new SentLevel();

@@ -206,12 +206,20 @@ export async function openViewer(browser, pageServer, janus) {
  * handlers (janus.js destroys its session with Janus there), which closing it alone does not.
  */
 export async function figures(page, { timeout = 30000 } = {}) {
-  const read = () => page.evaluate(() => {
+  // With a figures file asked for, also the played level and the frames of the stream's first
+  // 1.5 s of drawing (the first syllable: docs/web.md).
+  const withStart = Boolean(process.env.PFAP_BROADCAST_OUT || process.env.PFAP_BENCH_OUT);
+  const read = () => page.evaluate((withStart) => {
     const s = window.pfapStats;
     s.measureLipSync();
     const { envelope, frames, ...rest } = s;
+    const from = s.start?.trace[0]?.t;
+    if (withStart && from !== undefined) {
+      const within = (e) => e.t >= from - 300 && e.t < from + 1500;
+      rest.start = { ...s.start, envelope: envelope.filter(within), frames: frames.filter(within) };
+    }
     return rest;
-  });
+  }, withStart);
   try {
     await page.waitForFunction(() => window.pfapStats.done >= 1 && window.pfapStats.streamNs > window.pfapStats.endNs + 3e8,
       null, { timeout, polling: 100 });

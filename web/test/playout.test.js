@@ -6,7 +6,7 @@
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 
-import { PlayoutClock } from '../live/playout.js';
+import { DrawnPhonemes, PlayoutClock } from '../live/playout.js';
 
 // "pa. pa. pa.": a sharp onset every 337 ms, a vowel that decays, silence between (S16 RMS).
 const level = (ms) => {
@@ -52,4 +52,102 @@ test('silence does not count as lost: no match, no wider search', () => {
     if (t % 10 === 9) clock.matchHeard();
   }
   assert.equal(clock.misses, 0);
+});
+
+// -- A stream's start (docs/web.md, "The first syllable") -----------------------------------
+// The events a stream's start produces in a page, ms by ms of performance time: the audio of
+// running time r is heard at r + heardAt, after silence; the tap renders RENDER_AHEAD_MS before
+// it is heard and posts every 10 ms; the readings put the audio `readingsOffMs` ahead of the
+// sound (through Janus, the estimate from the clock messages: 35 to 200 ms ahead at the start,
+// measured); frames every 16.7 ms draw the phoneme at clock.runningMs(now). The "pa"s' p
+// starts as its onset sounds, at running time PA_MS + k × 337.
+const RENDER_AHEAD_MS = 30;  // what the pages' AudioContext showed (42 ms of latency)
+const FRAME_MS = 1000 / 60;
+const PA_MS = 49;
+const paLevel = (ms) => (ms < PA_MS ? 0 : level(ms - PA_MS));
+
+function startOfStream({ heardAt, readingsOffMs, hearFromMs = 0, sentFromMs = 0, untilMs = 1500, resetAtMs = null }) {
+  const clock = new PlayoutClock({ envelope: [], firstSearchMs: 150 });
+  const sending = () => clock.sent.add(sentFromMs * 1e6, Array.from({ length: 8000 }, (_, i) => paLevel(sentFromMs + i)));
+  sending();
+  const frames = [];
+  const drawn = new DrawnPhonemes(frames);
+  for (let k = 0; k < 20; ++k) {
+    drawn.add((PA_MS + k * 337 - 20) * 1e6, false);  // the pause before
+    drawn.add((PA_MS + k * 337) * 1e6, true);  // p
+    drawn.add((PA_MS + k * 337 + 30) * 1e6, false);  // a
+  }
+  let nextFrame = heardAt + hearFromMs - 300;
+  for (let now = heardAt + hearFromMs - 500; now < heardAt + untilMs; ++now) {
+    // The tap: the block heard at now + RENDER_AHEAD_MS (silence before the stream's audio).
+    // The stream's first message (its level) comes as it begins: the clock starts over.
+    if (now === heardAt + resetAtMs) {
+      clock.reset();
+      sending();
+    }
+    const t = now + RENDER_AHEAD_MS;
+    const running = t - heardAt;
+    clock.envelope.push({ t, rms: running < hearFromMs ? 0 : paLevel(running) / 32768 });
+    if (now % 10 === 0) clock.matchHeard();
+    // The synchronization source's reading: the audio handed to playout now is heard now on.
+    if (running >= hearFromMs) clock.reading(now, now - heardAt + readingsOffMs);
+    if (now >= nextFrame) {
+      nextFrame += FRAME_MS;
+      const ms = clock.runningMs(now);
+      if (ms !== null) drawn.frame(now, Math.round(ms * 1e6));
+    }
+  }
+  return { clock, frames };
+}
+
+// Each onset heard after silence (running time PA_MS + k × 337 heard at heardAt + that) and the
+// first frame that draws the lips pressed for it: ms after the onset (negative: early).
+function pressedAfterOnsets(frames, heardAt, fromMs = 0) {
+  const errors = [];
+  for (let k = 0; k < 4; ++k) {
+    const onset = heardAt + PA_MS + k * 337;
+    if (onset < heardAt + fromMs) continue;
+    const closure = frames.find((f, i) => f.pressed && !frames[i - 1]?.pressed && Math.abs(f.t - onset) < 150);
+    errors.push(closure ? closure.t - onset : null);
+  }
+  return errors;
+}
+
+test('a stream\'s first syllable is drawn with its sound, whatever the readings say before the first match', () => {
+  // Through Janus the estimate put the audio 35 to 200 ms ahead at a stream's start, and the
+  // first "pa" was drawn 27 to 61 ms early, before the level's first match.
+  for (const readingsOffMs of [65, 200, -40, 0]) {
+    const heardAt = 2000;
+    const { frames } = startOfStream({ heardAt, readingsOffMs });
+    const errors = pressedAfterOnsets(frames, heardAt);
+    for (const e of errors) {
+      assert.ok(e !== null && e >= 0 && e <= FRAME_MS + 1, `readings ${readingsOffMs} ms off: first frames pressed ${errors.map((x) => x?.toFixed(1))} ms after the onsets`);
+    }
+  }
+});
+
+test('a stream whose first message comes 20 ms before its sound is heard is drawn with its sound', () => {
+  // The sender's first level message leaves with its first audio (its queue is empty then):
+  // the page starts the stream over shortly before the sound, after a silence of its own.
+  const heardAt = 2000;
+  const { clock, frames } = startOfStream({ heardAt, readingsOffMs: 65, resetAtMs: -20 });
+  assert.ok(clock.firstSound !== null);
+  const errors = pressedAfterOnsets(frames, heardAt);
+  for (const e of errors) assert.ok(e !== null && e >= 0 && e <= FRAME_MS + 1, `${errors.map((x) => x?.toFixed(1))}`);
+});
+
+test('a late joiner, whose level begins 1 s after what it hears first, draws from the level\'s match', () => {
+  // It hears the stream from running time 1000 on, after its own silence, and the level it
+  // received begins at 2000 (sent ahead): the first sound it hears is not the first it was
+  // sent, so it draws nothing by the readings (70 ms ahead) and waits for the match.
+  const heardAt = 2000;
+  const { clock, frames } = startOfStream({ heardAt, readingsOffMs: 70, hearFromMs: 1000, sentFromMs: 2000, untilMs: 3500 });
+  assert.equal(clock.firstSound, null);
+  const firstMatch = clock.corrections[0];
+  assert.ok(firstMatch && firstMatch.t > heardAt + 2000, JSON.stringify(clock.corrections.slice(0, 2)));
+  assert.ok(frames.length > 0 && frames[0].t >= firstMatch.t - RENDER_AHEAD_MS - 11, `first frame at ${frames[0]?.t}, match at ${firstMatch.t}`);
+  for (const [k, onset] of [2071, 2408, 2745, 3082].entries()) {
+    const closure = frames.find((f, i) => f.pressed && !frames[i - 1]?.pressed && Math.abs(f.t - (heardAt + onset)) < 150);
+    assert.ok(closure && closure.t - (heardAt + onset) >= 0 && closure.t - (heardAt + onset) <= FRAME_MS + 1, `onset ${k}: ${closure?.t}`);
+  }
 });
