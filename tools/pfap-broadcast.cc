@@ -34,6 +34,7 @@
 #include "pfap/model.h"
 #include "sent_pfap.h"
 #include "speech_level.h"
+#include "speech_opus.h"
 
 namespace {
 
@@ -45,8 +46,8 @@ constexpr uint32_t kPfapClockRate = 44100;
 // PFAP packets go this far ahead of their time (as pfap-web's): the page holds their events
 // until the audio reaches them.
 constexpr GstClockTimeDiff kPfapLead = 400 * GST_MSECOND;
-// A "clock" message every this many audio packets (10 ms each).
-constexpr int kClockEvery = 10;
+// A "clock" message every this many audio packets (one Opus frame each): every 100 ms.
+constexpr int kClockEvery = static_cast<int>(100 * GST_MSECOND / kOpusFrame);
 
 struct Options {
   int audio_port = 0;
@@ -262,7 +263,8 @@ int main(int argc, char** argv) {
   const std::string description =
       source +
       " audio. ! audioconvert ! audioresample ! audio/x-raw,format=S16LE,rate=48000,channels=1 "
-      "! queue name=level ! opusenc frame-size=10 ! rtpopuspay pt=111 "
+      "! queue name=level ! " +
+      opus_encoder_description() + " ! rtpopuspay pt=111 "
       "! udpsink name=audiosink host=127.0.0.1 port=" +
       std::to_string(o.audio_port) +
       " pfap. ! rtppfappay name=pay pt=96 ! application/x-rtp,clock-rate=44100 "

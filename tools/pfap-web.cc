@@ -52,6 +52,7 @@
 #include "ratelimit.h"
 #include "sent_pfap.h"
 #include "speech_level.h"
+#include "speech_opus.h"
 
 namespace {
 
@@ -588,24 +589,23 @@ gboolean on_connect_timeout(gpointer data) {
 
 // One session's pipeline. The mixer makes the audio's pace alone (force-live: it mixes on the
 // clock with no live source upstream), silence between the texts, so no silent source runs
-// beside it. Opus frames of 20 ms at complexity 5: the encoder's instructions 0.59× those of
-// 10 ms at complexity 10, and half the packets to protect and send, for the same lip sync
-// (docs/performance.md, "pfap-web: sessions per server"); 5 is what libwebrtc gives Opus on
-// phones. The mixer's output buffers are one Opus frame each.
-constexpr const char* kSessionPipeline =
-    "webrtcbin name=webrtc bundle-policy=max-bundle "
-    "audiomixer name=mix force-live=true output-buffer-duration=20000000 "
-    "! audio/x-raw,format=S16LE,rate=48000,channels=1 ! opusenc frame-size=20 complexity=5 "
-    "! rtpopuspay name=apay pt=111 "
-    "! application/x-rtp,media=audio,encoding-name=OPUS,clock-rate=48000,payload=111 "
-    "! valve name=gate drop=true drop-mode=forward-sticky-events ! webrtc. "
-    "rtppfappay name=pay pt=96 ! application/x-rtp,clock-rate=44100 "
-    "! appsink name=pfapsink sync=true async=false";
+// beside it. Its output buffers are one Opus frame each (speech_opus.h).
+std::string session_pipeline() {
+  return "webrtcbin name=webrtc bundle-policy=max-bundle "
+         "audiomixer name=mix force-live=true output-buffer-duration=" +
+         std::to_string(kOpusFrame) + " ! audio/x-raw,format=S16LE,rate=48000,channels=1 ! " +
+         opus_encoder_description() +
+         " ! rtpopuspay name=apay pt=111 "
+         "! application/x-rtp,media=audio,encoding-name=OPUS,clock-rate=48000,payload=111 "
+         "! valve name=gate drop=true drop-mode=forward-sticky-events ! webrtc. "
+         "rtppfappay name=pay pt=96 ! application/x-rtp,clock-rate=44100 "
+         "! appsink name=pfapsink sync=true async=false";
+}
 
 // The session's pipeline, its elements found and set: false if it cannot be made.
 bool make_pipeline(Session& s) {
   GError* error = nullptr;
-  s.pipeline = gst_parse_launch(kSessionPipeline, &error);
+  s.pipeline = gst_parse_launch(session_pipeline().c_str(), &error);
   if (s.pipeline == nullptr) {
     g_printerr("pfap-web: %s\n", error->message);
     g_error_free(error);
