@@ -33,7 +33,9 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
@@ -41,7 +43,9 @@
 #include <cstring>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "command_line.h"
@@ -83,6 +87,7 @@ struct Options {
   std::string web_dir;
   int max_sessions = 0;  // 0: as many as the file descriptor limit allows
   double connect_timeout_s = 30.0;
+  double stop_timeout_s = 10.0;
   std::vector<std::string> allowed_origins;  // besides the server's own
 };
 
@@ -909,6 +914,7 @@ int parse_options(int* argc, char*** argv, Options& o) {
   gdouble drop = o.drop;
   gint max_sessions = -1;  // not given
   gdouble connect_timeout_s = o.connect_timeout_s;
+  gdouble stop_timeout_s = o.stop_timeout_s;
   gchar *text = nullptr, *web_dir = nullptr;
   gchar** origins = nullptr;
   const GOptionEntry entries[] = {
@@ -929,6 +935,10 @@ int parse_options(int* argc, char*** argv, Options& o) {
       {"connect-timeout", 0, 0, G_OPTION_ARG_DOUBLE, &connect_timeout_s,
        "Close a session whose page has not answered the offer and opened the data channel in S "
        "seconds, above 0 up to 86400 (default 30)",
+       "S"},
+      {"stop-timeout", 0, 0, G_OPTION_ARG_DOUBLE, &stop_timeout_s,
+       "On SIGTERM or SIGINT, exit with status 3 if the sessions have not stopped in S seconds, "
+       "naming those that did not, above 0 up to 3600 (default 10)",
        "S"},
       {"allow-origin", 0, 0, G_OPTION_ARG_STRING_ARRAY, &origins,
        "Accept WebSockets from ORIGIN (scheme://host[:port], or null) besides the page's own "
@@ -954,6 +964,8 @@ int parse_options(int* argc, char*** argv, Options& o) {
     } else if (!(connect_timeout_s > 0 && connect_timeout_s <= 86400)) {
       status = usage_error("--connect-timeout wants seconds, above 0 up to 86400: %g",
                            connect_timeout_s);
+    } else if (!(stop_timeout_s > 0 && stop_timeout_s <= 3600)) {
+      status = usage_error("--stop-timeout wants seconds, above 0 up to 3600: %g", stop_timeout_s);
     } else if (*argc > 1) {
       status = usage_error("takes no operands: %s", (*argv)[1]);
     }
@@ -970,6 +982,7 @@ int parse_options(int* argc, char*** argv, Options& o) {
     o.port = port;
     o.max_sessions = max_sessions == -1 ? 0 : max_sessions;
     o.connect_timeout_s = connect_timeout_s;
+    o.stop_timeout_s = stop_timeout_s;
     o.drop = drop;
     o.seed = static_cast<uint32_t>(seed);
     if (text != nullptr) o.text = text;
@@ -1001,12 +1014,107 @@ int session_cap(int wanted) {
   return wanted != 0 ? std::min(wanted, allowed) : allowed;
 }
 
+// A bound on stopping (docs/web.md, "Stopping"). The SCTP of webrtcbin 1.22 (usrsctp, bundled
+// with gst-plugins-bad) has been seen to block a pipeline's change to NULL for good; a server
+// that never exits is worse than one that exits without finishing. If stopping has not
+// finished by the deadline, a watchdog thread names what it was stopping and ends the process
+// with status 3, skipping the exit handlers, which could block as well.
+class StopDeadline {
+ public:
+  explicit StopDeadline(double seconds) : watchdog_([this, seconds] { watch(seconds); }) {}
+  ~StopDeadline() {
+    {
+      std::lock_guard lock(mutex_);
+      finished_ = true;
+    }
+    changed_.notify_one();
+    watchdog_.join();
+  }
+  StopDeadline(const StopDeadline&) = delete;
+  StopDeadline& operator=(const StopDeadline&) = delete;
+
+  // What is being stopped now, as the message would name it.
+  void now(std::string what) {
+    std::lock_guard lock(mutex_);
+    what_ = std::move(what);
+  }
+
+ private:
+  void watch(double seconds) {
+    std::unique_lock lock(mutex_);
+    if (changed_.wait_for(lock, std::chrono::duration<double>(seconds),
+                          [this] { return finished_; })) {
+      return;
+    }
+    char s[G_ASCII_DTOSTR_BUF_SIZE];
+    g_ascii_dtostr(s, sizeof s, seconds);
+    std::fprintf(stderr,
+                 "pfap-web: not stopped within %s s (--stop-timeout), at %s; exiting anyway "
+                 "(docs/web.md, \"Stopping\")\n",
+                 s, what_.c_str());
+    std::fflush(stderr);
+    std::_Exit(3);
+  }
+
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  bool finished_ = false;
+  std::string what_ = "its start";
+  std::thread watchdog_;  // last: it starts once the rest is made
+};
+
+// "session 3's pipeline going to NULL; sessions 4, 7 not stopped yet".
+std::string stopping_what(int id, const std::vector<int>& after) {
+  std::string what = "session " + std::to_string(id) + "'s pipeline going to NULL";
+  if (after.empty()) return what;
+  what += after.size() == 1 ? "; session " : "; sessions ";
+  for (size_t i = 0; i < after.size(); ++i) {
+    what += (i == 0 ? "" : ", ") + std::to_string(after[i]);
+  }
+  return what + " not stopped yet";
+}
+
+// The threads of this process (/proc/self/status), or -1.
+int thread_count() {
+  gchar* status = nullptr;
+  int threads = -1;
+  if (g_file_get_contents("/proc/self/status", &status, nullptr, nullptr)) {
+    if (const char* line = std::strstr(status, "\nThreads:")) threads = std::atoi(line + 9);
+  }
+  g_free(status);
+  return threads;
+}
+
+// Ends the streaming threads that the sessions left idle in GLib's shared thread pool, and
+// waits until they are gone (their number unchanged for 20 ms). Left to end on their own,
+// some ended while the exit handlers ran, and their thread-exit destructors used what
+// OpenSSL's exit handler (DTLS) had freed: the heap was corrupted, SIGABRT or SIGSEGV at
+// exit, in 2 of 14 stops with 45 sessions open (docs/web.md, "Stopping").
+void end_idle_threads() {
+  g_thread_pool_set_max_unused_threads(0);
+  g_thread_pool_stop_unused_threads();
+  while (g_thread_pool_get_num_unused_threads() > 0) g_usleep(1000);
+  for (int last = thread_count(), unchanged = 0; unchanged < 20;) {
+    g_usleep(1000);
+    const int now = thread_count();
+    unchanged = now == last ? unchanged + 1 : 0;
+    last = now;
+  }
+}
+
 // Ctrl-C or SIGTERM: each session's pipeline stops, its browser is told, and what the
 // sessions and the server hold is freed.
-void stop(Server& server, SoupServer* soup) {
+void stop(Server& server, SoupServer* soup, StopDeadline& deadline) {
+  std::vector<std::shared_ptr<Session>> open;
   for (const std::weak_ptr<Session>& weak : server.open) {
-    std::shared_ptr<Session> s = weak.lock();
-    if (s == nullptr) continue;
+    if (std::shared_ptr<Session> s = weak.lock()) open.push_back(std::move(s));
+  }
+  server.open.clear();
+  for (size_t i = 0; i < open.size(); ++i) {
+    std::vector<int> after;
+    for (size_t j = i + 1; j < open.size(); ++j) after.push_back(open[j]->id);
+    deadline.now(stopping_what(open[i]->id, after));
+    std::shared_ptr<Session> s = std::move(open[i]);
     auto* ws = SOUP_WEBSOCKET_CONNECTION(g_object_ref(s->ws));
     close_session(s);
     s.reset();
@@ -1020,7 +1128,7 @@ void stop(Server& server, SoupServer* soup) {
     }
     g_object_unref(ws);
   }
-  server.open.clear();
+  deadline.now("the HTTP and STUN servers closing");
   g_source_destroy(server.stun_source);
   g_source_unref(server.stun_source);
   g_object_unref(server.stun);
@@ -1093,9 +1201,15 @@ int main(int argc, char** argv) {
   g_main_loop_run(loop);
   g_source_remove(on_sigint);
   g_source_remove(on_sigterm);
-  stop(server, soup);
-  g_main_loop_unref(loop);
-  gst_deinit();
+  {
+    StopDeadline deadline(server.options.stop_timeout_s);
+    stop(server, soup, deadline);
+    g_main_loop_unref(loop);
+    deadline.now("GStreamer deinitializing (gst_deinit)");
+    gst_deinit();
+    deadline.now("the sessions' idle streaming threads ending");
+    end_idle_threads();
+  }
   g_print("pfap-web: stopped\n");
   return 0;
 }
