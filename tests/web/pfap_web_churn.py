@@ -25,8 +25,8 @@ import sys
 import threading
 import time
 
-from pfap_web_load import (WebSocket, enter_network_namespace, rss_kib, skip_opus_decoding,
-                           start_server)
+from pfap_web_load import (WebSocket, add_candidate, answer_offer, enter_network_namespace,
+                           rss_kib, skip_opus_decoding, start_server)
 
 WARM_UP = 9
 # Alive at exit whatever the sessions did: dtlsdec keeps one agent for its generated
@@ -47,8 +47,7 @@ async def never_answers(port):
 
 
 async def connects(port, to_the_end):
-    from aiortc import RTCPeerConnection, RTCSessionDescription
-    from aiortc.sdp import candidate_from_sdp
+    from aiortc import RTCPeerConnection
 
     pc = RTCPeerConnection()
     ws = await WebSocket.connect(port)
@@ -72,14 +71,9 @@ async def connects(port, to_the_end):
                 w.cancel()
             m = receiving.result()
             if m['type'] == 'offer':
-                await pc.setRemoteDescription(RTCSessionDescription(m['sdp'], 'offer'))
-                await pc.setLocalDescription(await pc.createAnswer())
-                ws.send({'type': 'answer', 'sdp': pc.localDescription.sdp})
+                await answer_offer(pc, ws, m)
             elif m['type'] == 'ice' and m['candidate']:
-                c = candidate_from_sdp(m['candidate'].split(':', 1)[1])
-                c.sdpMLineIndex = m['sdpMLineIndex']
-                c.sdpMid = str(m['sdpMLineIndex'])
-                await pc.addIceCandidate(c)
+                await add_candidate(pc, m)
             elif m['type'] in ('done', 'error'):
                 return
     finally:

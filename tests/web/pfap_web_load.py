@@ -101,7 +101,6 @@ class WebSocket:
 
 async def session(port, number, deadline_s):
     from aiortc import RTCPeerConnection, RTCSessionDescription
-    from aiortc.sdp import candidate_from_sdp
 
     result = {'session': number, 'audio_packets': 0, 'packets': 0, 'last_seq': None,
               'sender': None, 'error': None, 'messages': [], 'pfap_times': [],
@@ -135,10 +134,7 @@ async def session(port, number, deadline_s):
                     # The server starts the audio and the text once the page plays.
                     asyncio.ensure_future(say_playing_when_open(ws, channel_open))
                 elif m['type'] == 'ice' and m['candidate']:
-                    c = candidate_from_sdp(m['candidate'].split(':', 1)[1])
-                    c.sdpMLineIndex = m['sdpMLineIndex']
-                    c.sdpMid = str(m['sdpMLineIndex'])
-                    await pc.addIceCandidate(c)
+                    await add_candidate(pc, m)
                 elif m['type'] == 'error':
                     raise ConnectionError(m['message'])
                 elif m['type'] == 'done':
@@ -155,6 +151,23 @@ async def session(port, number, deadline_s):
         await pc.close()
         ws.writer.close()
     return result
+
+
+async def answer_offer(pc, ws, m):
+    """Answers the server's offer `m`."""
+    from aiortc import RTCSessionDescription
+    await pc.setRemoteDescription(RTCSessionDescription(m['sdp'], 'offer'))
+    await pc.setLocalDescription(await pc.createAnswer())
+    ws.send({'type': 'answer', 'sdp': pc.localDescription.sdp})
+
+
+async def add_candidate(pc, m):
+    """Adds the server's ICE candidate `m` (an "ice" message with a candidate)."""
+    from aiortc.sdp import candidate_from_sdp
+    c = candidate_from_sdp(m['candidate'].split(':', 1)[1])
+    c.sdpMLineIndex = m['sdpMLineIndex']
+    c.sdpMid = str(m['sdpMLineIndex'])
+    await pc.addIceCandidate(c)
 
 
 async def audio_packets(pc):

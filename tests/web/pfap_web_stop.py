@@ -21,7 +21,8 @@ import subprocess
 import sys
 import time
 
-from pfap_web_load import WebSocket, enter_network_namespace, skip_opus_decoding, start_server
+from pfap_web_load import (WebSocket, add_candidate, answer_offer, enter_network_namespace,
+                           skip_opus_decoding, start_server)
 
 TEXT = ' '.join(['One, <FAP 3 100 400 1> two, three, four, five, six, seven, eight.'] * 6)
 STOP_TIMEOUT_S = 5
@@ -32,8 +33,7 @@ BOUND_S = STOP_TIMEOUT_S + 5
 async def open_session(port, first_packet, leave):
     """A peer that connects and says it plays; sets `first_packet` at its first PFAP packet and
     then only reads, until the server closes the WebSocket (True) or `leave` is set (False)."""
-    from aiortc import RTCPeerConnection, RTCSessionDescription
-    from aiortc.sdp import candidate_from_sdp
+    from aiortc import RTCPeerConnection
 
     pc = RTCPeerConnection()
     ws = await WebSocket.connect(port)
@@ -54,14 +54,9 @@ async def open_session(port, first_packet, leave):
             leaving.cancel()
             m = receiving.result()
             if m['type'] == 'offer':
-                await pc.setRemoteDescription(RTCSessionDescription(m['sdp'], 'offer'))
-                await pc.setLocalDescription(await pc.createAnswer())
-                ws.send({'type': 'answer', 'sdp': pc.localDescription.sdp})
+                await answer_offer(pc, ws, m)
             elif m['type'] == 'ice' and m['candidate']:
-                c = candidate_from_sdp(m['candidate'].split(':', 1)[1])
-                c.sdpMLineIndex = m['sdpMLineIndex']
-                c.sdpMid = str(m['sdpMLineIndex'])
-                await pc.addIceCandidate(c)
+                await add_candidate(pc, m)
     except (ConnectionError, asyncio.IncompleteReadError):
         return True
     finally:
