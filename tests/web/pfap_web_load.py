@@ -170,6 +170,42 @@ async def add_candidate(pc, m):
     await pc.addIceCandidate(c)
 
 
+async def playing_peer(port, first_packet, leave, until=()):
+    """A peer that connects, answers the offer, says it plays once its data channel opens, and
+    sets `first_packet` at its first PFAP packet. It leaves (closes its peer connection and
+    WebSocket) when `leave` is set, returning 'left', or at the first message whose type is in
+    `until`, returning that type. Raises what the WebSocket raises when the server closes it."""
+    from aiortc import RTCPeerConnection
+
+    pc = RTCPeerConnection()
+    ws = await WebSocket.connect(port)
+
+    @pc.on('datachannel')
+    def on_datachannel(channel):
+        ws.send({'type': 'playing'})
+        channel.on('message', lambda message: first_packet.set())
+
+    try:
+        while True:
+            receiving = asyncio.ensure_future(ws.receive())
+            leaving = asyncio.ensure_future(leave.wait())
+            await asyncio.wait([receiving, leaving], return_when=asyncio.FIRST_COMPLETED)
+            if not receiving.done():
+                receiving.cancel()
+                return 'left'
+            leaving.cancel()
+            m = receiving.result()
+            if m['type'] == 'offer':
+                await answer_offer(pc, ws, m)
+            elif m['type'] == 'ice' and m['candidate']:
+                await add_candidate(pc, m)
+            elif m['type'] in until:
+                return m['type']
+    finally:
+        await pc.close()
+        ws.writer.close()
+
+
 async def audio_packets(pc):
     """The Opus RTP packets a peer connection has received (its receivers' stats)."""
     count = 0

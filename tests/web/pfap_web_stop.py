@@ -21,8 +21,7 @@ import subprocess
 import sys
 import time
 
-from pfap_web_load import (WebSocket, add_candidate, answer_offer, enter_network_namespace,
-                           skip_opus_decoding, start_server)
+from pfap_web_load import enter_network_namespace, playing_peer, skip_opus_decoding, start_server
 
 TEXT = ' '.join(['One, <FAP 3 100 400 1> two, three, four, five, six, seven, eight.'] * 6)
 STOP_TIMEOUT_S = 5
@@ -31,38 +30,15 @@ BOUND_S = STOP_TIMEOUT_S + 5
 
 
 async def open_session(port, first_packet, leave):
-    """A peer that connects and says it plays; sets `first_packet` at its first PFAP packet and
-    then only reads, until the server closes the WebSocket (True) or `leave` is set (False)."""
-    from aiortc import RTCPeerConnection
-
-    pc = RTCPeerConnection()
-    ws = await WebSocket.connect(port)
-
-    @pc.on('datachannel')
-    def on_datachannel(channel):
-        ws.send({'type': 'playing'})
-        channel.on('message', lambda message: first_packet.set())
-
+    """A playing peer (pfap_web_load.playing_peer) that waits until the server closes its
+    WebSocket (True) or `leave` is set (False)."""
     try:
-        while True:
-            receiving = asyncio.ensure_future(ws.receive())
-            leaving = asyncio.ensure_future(leave.wait())
-            await asyncio.wait([receiving, leaving], return_when=asyncio.FIRST_COMPLETED)
-            if not receiving.done():
-                receiving.cancel()
-                return False
-            leaving.cancel()
-            m = receiving.result()
-            if m['type'] == 'offer':
-                await answer_offer(pc, ws, m)
-            elif m['type'] == 'ice' and m['candidate']:
-                await add_candidate(pc, m)
+        await playing_peer(port, first_packet, leave)
+        return False
     except (ConnectionError, asyncio.IncompleteReadError):
         return True
     finally:
         first_packet.set()  # the others go on
-        await pc.close()
-        ws.writer.close()
 
 
 def stacks(pid):
