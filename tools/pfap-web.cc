@@ -91,6 +91,91 @@ struct Options {
   std::vector<std::string> allowed_origins;  // besides the server's own
 };
 
+// SIGINT and SIGTERM, and a bound on stopping (docs/web.md, "Stopping"). The signals are taken
+// on a thread of its own, not by the main loop: the main thread may be what blocks. The SCTP
+// of webrtcbin 1.22 (usrsctp, bundled with gst-plugins-bad) has been seen to block a
+// pipeline's change to NULL for good, as a session closed when its page left. At a signal the
+// watch quits the main loop, which then stops the sessions, and gives the whole stop
+// `seconds`; if it has not finished by then, the watch names what the main thread was doing
+// and ends the process with status 3, skipping the exit handlers, which could block as well.
+// A server that never exits is worse than one that exits without finishing.
+class StopWatch {
+ public:
+  StopWatch(GMainLoop* loop, double seconds)
+      : loop_(loop), seconds_(seconds), thread_([this] { watch(); }) {}
+  // Once the stop has finished.
+  ~StopWatch() {
+    {
+      std::lock_guard lock(mutex_);
+      finished_ = true;
+    }
+    changed_.notify_one();
+    g_main_context_wakeup(context_);
+    thread_.join();
+    g_main_context_unref(context_);
+  }
+  StopWatch(const StopWatch&) = delete;
+  StopWatch& operator=(const StopWatch&) = delete;
+
+  // What the main thread is doing now, and what it has yet to do, as the message would say.
+  void now(std::string what) {
+    std::lock_guard lock(mutex_);
+    what_ = std::move(what);
+  }
+  void yet(std::string rest) {
+    std::lock_guard lock(mutex_);
+    rest_ = std::move(rest);
+  }
+
+ private:
+  void watch() {
+    bool signalled = false;
+    for (int signal : {SIGINT, SIGTERM}) {
+      GSource* source = g_unix_signal_source_new(signal);
+      g_source_set_callback(
+          source,
+          [](gpointer signalled) -> gboolean {
+            *static_cast<bool*>(signalled) = true;
+            return G_SOURCE_CONTINUE;
+          },
+          &signalled, nullptr);
+      g_source_attach(source, context_);
+      g_source_unref(source);
+    }
+    while (!signalled && !finished()) g_main_context_iteration(context_, TRUE);
+    if (!signalled) return;
+    g_main_loop_quit(loop_);
+    std::unique_lock lock(mutex_);
+    if (changed_.wait_for(lock, std::chrono::duration<double>(seconds_),
+                          [this] { return finished_; })) {
+      return;
+    }
+    char s[G_ASCII_DTOSTR_BUF_SIZE];
+    g_ascii_dtostr(s, sizeof s, seconds_);
+    std::fprintf(stderr,
+                 "pfap-web: not stopped within %s s (--stop-timeout), at %s%s; exiting anyway "
+                 "(docs/web.md, \"Stopping\")\n",
+                 s, what_.c_str(), rest_.c_str());
+    std::fflush(stderr);
+    std::_Exit(3);
+  }
+
+  bool finished() {
+    std::lock_guard lock(mutex_);
+    return finished_;
+  }
+
+  GMainLoop* loop_;
+  double seconds_;
+  GMainContext* context_ = g_main_context_new();
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  bool finished_ = false;
+  std::string what_ = "the main loop";
+  std::string rest_;
+  std::thread thread_;  // last: it starts once the rest is made
+};
+
 struct Server;
 
 // A WebRTC session with one browser. Lives on the main thread; GStreamer's threads post
@@ -470,6 +555,7 @@ void request_complete(Session& s) {
 
 struct Server {
   Options options;
+  StopWatch* stop_watch = nullptr;  // from the main loop's start to the end of the stop
   int sessions = 0;
   std::vector<std::weak_ptr<Session>> open;  // stopped when the server stops
   int max_sessions = 0;
@@ -560,7 +646,11 @@ void close_session(const std::shared_ptr<Session>& s) {
   s->closed = true;
   if (s->connect_timer != 0) g_source_remove(s->connect_timer);
   s->connect_timer = 0;
+  StopWatch* watch = s->server->stop_watch;
+  if (watch != nullptr)
+    watch->now("session " + std::to_string(s->id) + "'s pipeline going to NULL");
   gst_element_set_state(s->pipeline, GST_STATE_NULL);
+  if (watch != nullptr) watch->now("the main loop");
   gst_bus_remove_watch(GST_ELEMENT_BUS(s->pipeline));
   if (s->speaker_mixer_pad != nullptr) gst_object_unref(s->speaker_mixer_pad);
   if (s->channel != nullptr) g_object_unref(s->channel);
@@ -1014,64 +1104,12 @@ int session_cap(int wanted) {
   return wanted != 0 ? std::min(wanted, allowed) : allowed;
 }
 
-// A bound on stopping (docs/web.md, "Stopping"). The SCTP of webrtcbin 1.22 (usrsctp, bundled
-// with gst-plugins-bad) has been seen to block a pipeline's change to NULL for good; a server
-// that never exits is worse than one that exits without finishing. If stopping has not
-// finished by the deadline, a watchdog thread names what it was stopping and ends the process
-// with status 3, skipping the exit handlers, which could block as well.
-class StopDeadline {
- public:
-  explicit StopDeadline(double seconds) : watchdog_([this, seconds] { watch(seconds); }) {}
-  ~StopDeadline() {
-    {
-      std::lock_guard lock(mutex_);
-      finished_ = true;
-    }
-    changed_.notify_one();
-    watchdog_.join();
-  }
-  StopDeadline(const StopDeadline&) = delete;
-  StopDeadline& operator=(const StopDeadline&) = delete;
-
-  // What is being stopped now, as the message would name it.
-  void now(std::string what) {
-    std::lock_guard lock(mutex_);
-    what_ = std::move(what);
-  }
-
- private:
-  void watch(double seconds) {
-    std::unique_lock lock(mutex_);
-    if (changed_.wait_for(lock, std::chrono::duration<double>(seconds),
-                          [this] { return finished_; })) {
-      return;
-    }
-    char s[G_ASCII_DTOSTR_BUF_SIZE];
-    g_ascii_dtostr(s, sizeof s, seconds);
-    std::fprintf(stderr,
-                 "pfap-web: not stopped within %s s (--stop-timeout), at %s; exiting anyway "
-                 "(docs/web.md, \"Stopping\")\n",
-                 s, what_.c_str());
-    std::fflush(stderr);
-    std::_Exit(3);
-  }
-
-  std::mutex mutex_;
-  std::condition_variable changed_;
-  bool finished_ = false;
-  std::string what_ = "its start";
-  std::thread watchdog_;  // last: it starts once the rest is made
-};
-
-// "session 3's pipeline going to NULL; sessions 4, 7 not stopped yet".
-std::string stopping_what(int id, const std::vector<int>& after) {
-  std::string what = "session " + std::to_string(id) + "'s pipeline going to NULL";
-  if (after.empty()) return what;
-  what += after.size() == 1 ? "; session " : "; sessions ";
-  for (size_t i = 0; i < after.size(); ++i) {
-    what += (i == 0 ? "" : ", ") + std::to_string(after[i]);
-  }
-  return what + " not stopped yet";
+// "; sessions 4, 7 not stopped yet", or nothing.
+std::string not_stopped_yet(const std::vector<int>& ids) {
+  if (ids.empty()) return "";
+  std::string rest = ids.size() == 1 ? "; session " : "; sessions ";
+  for (size_t i = 0; i < ids.size(); ++i) rest += (i == 0 ? "" : ", ") + std::to_string(ids[i]);
+  return rest + " not stopped yet";
 }
 
 // The threads of this process (/proc/self/status), or -1.
@@ -1104,16 +1142,18 @@ void end_idle_threads() {
 
 // Ctrl-C or SIGTERM: each session's pipeline stops, its browser is told, and what the
 // sessions and the server hold is freed.
-void stop(Server& server, SoupServer* soup, StopDeadline& deadline) {
+void stop(Server& server, SoupServer* soup) {
+  // A session closed before has given its WebSocket back: only the open ones.
   std::vector<std::shared_ptr<Session>> open;
   for (const std::weak_ptr<Session>& weak : server.open) {
-    if (std::shared_ptr<Session> s = weak.lock()) open.push_back(std::move(s));
+    std::shared_ptr<Session> s = weak.lock();
+    if (s != nullptr && !s->closed) open.push_back(std::move(s));
   }
   server.open.clear();
   for (size_t i = 0; i < open.size(); ++i) {
     std::vector<int> after;
     for (size_t j = i + 1; j < open.size(); ++j) after.push_back(open[j]->id);
-    deadline.now(stopping_what(open[i]->id, after));
+    server.stop_watch->yet(not_stopped_yet(after));
     std::shared_ptr<Session> s = std::move(open[i]);
     auto* ws = SOUP_WEBSOCKET_CONNECTION(g_object_ref(s->ws));
     close_session(s);
@@ -1128,7 +1168,8 @@ void stop(Server& server, SoupServer* soup, StopDeadline& deadline) {
     }
     g_object_unref(ws);
   }
-  deadline.now("the HTTP and STUN servers closing");
+  server.stop_watch->yet("");
+  server.stop_watch->now("the HTTP and STUN servers closing");
   g_source_destroy(server.stun_source);
   g_source_unref(server.stun_source);
   g_object_unref(server.stun);
@@ -1192,22 +1233,15 @@ int main(int argc, char** argv) {
   g_print("pfap-web: at most %d sessions at once\n", server.max_sessions);
   g_print("pfap-web: open http://127.0.0.1:%u/ in a browser (Ctrl-C stops)\n", port);
   GMainLoop* loop = g_main_loop_new(nullptr, FALSE);
-  auto quit = [](gpointer loop) -> gboolean {
-    g_main_loop_quit(static_cast<GMainLoop*>(loop));
-    return G_SOURCE_CONTINUE;  // removed below
-  };
-  const guint on_sigint = g_unix_signal_add(SIGINT, quit, loop);
-  const guint on_sigterm = g_unix_signal_add(SIGTERM, quit, loop);
-  g_main_loop_run(loop);
-  g_source_remove(on_sigint);
-  g_source_remove(on_sigterm);
   {
-    StopDeadline deadline(server.options.stop_timeout_s);
-    stop(server, soup, deadline);
+    StopWatch watch(loop, server.options.stop_timeout_s);
+    server.stop_watch = &watch;
+    g_main_loop_run(loop);
+    stop(server, soup);
     g_main_loop_unref(loop);
-    deadline.now("GStreamer deinitializing (gst_deinit)");
+    watch.now("GStreamer deinitializing (gst_deinit)");
     gst_deinit();
-    deadline.now("the sessions' idle streaming threads ending");
+    watch.now("the sessions' idle streaming threads ending");
     end_idle_threads();
   }
   g_print("pfap-web: stopped\n");
