@@ -9,7 +9,7 @@
 // the level of the speech it sends (the RMS of each millisecond, by running time); the page
 // finds the level of what it plays in it, and so learns the remaining lag.
 
-/** Codes per octave of the sender's level (tools/speech_level.h, encode_levels). */
+/** Codes per octave of the sender's level (tools/speech_level.h, level_codes). */
 export const LEVEL_CODES_PER_OCTAVE = 16;
 
 /** One level's code (one byte) back to RMS in S16 units, within 2.2 % of the sender's. */
