@@ -8,12 +8,12 @@
 //   SOURCE.pfap  ! rtppfappay ! appsink (sync) ─(a share P dropped)─ one datagram each ─▶ :DATA
 //
 // Janus rewrites the audio's RTP timestamps per viewer, so the viewer page cannot map the
-// audio it plays to PFAP time by them. The data port also carries, as JSON datagrams whose
-// first byte ('{') cannot start an RTP packet, what the page needs instead: the speech's level
-// by PFAP timestamp ("level", sent ahead, as pfap-web's "envelope"), the PFAP timestamp of the
-// audio as it leaves ("clock", the page's first estimate) and, at the end, the state as sent
-// ("done", compared by the page). Janus relays each datagram as one binary data-channel
-// message.
+// audio it plays to PFAP time by them. The data port also carries, as datagrams whose first
+// byte cannot start an RTP packet, what the page needs instead: the speech's level by PFAP
+// timestamp (binary level messages, speech_level.h, sent ahead as pfap-web's "envelope"), and
+// as JSON the PFAP timestamp of the audio as it leaves ("clock", the page's first estimate)
+// and, at the end, the state as sent ("done", compared by the page). Janus relays each
+// datagram as one binary data-channel message.
 #include <gio/gio.h>
 #include <glib-unix.h>
 #include <gst/app/gstappsink.h>
@@ -34,6 +34,7 @@
 #include "pfap/model.h"
 #include "sent_pfap.h"
 #include "speech_level.h"
+#include "speech_opus.h"
 
 namespace {
 
@@ -45,8 +46,8 @@ constexpr uint32_t kPfapClockRate = 44100;
 // PFAP packets go this far ahead of their time (as pfap-web's): the page holds their events
 // until the audio reaches them.
 constexpr GstClockTimeDiff kPfapLead = 400 * GST_MSECOND;
-// A "clock" message every this many audio packets (10 ms each).
-constexpr int kClockEvery = 10;
+// A "clock" message every this many audio packets (one Opus frame each): every 100 ms.
+constexpr int kClockEvery = static_cast<int>(100 * GST_MSECOND / kOpusFrame);
 
 struct Options {
   int audio_port = 0;
@@ -66,7 +67,7 @@ int parse_options(int* argc, char*** argv, Options& o) {
   const GOptionEntry entries[] = {
       {"audio-port", 0, 0, G_OPTION_ARG_INT, &audio_port, "Janus's audio port (Opus RTP)", "N"},
       {"data-port", 0, 0, G_OPTION_ARG_INT, &data_port,
-       "Janus's data port (PFAP RTP packets, and the level, clock and state as JSON)", "N"},
+       "Janus's data port (PFAP RTP packets, the level, and the clock and state as JSON)", "N"},
       {"text", 0, 0, G_OPTION_ARG_STRING, &text, "What pfaptts says (MPEG-4 bookmarks welcome)",
        "TEXT"},
       {"source", 0, 0, G_OPTION_ARG_STRING, &source,
@@ -80,7 +81,7 @@ int parse_options(int* argc, char*** argv, Options& o) {
       argc, argv, "",
       "Speaks TEXT with pfaptts (or plays DESC) in real time and sends it to Janus's streaming\n"
       "plugin on 127.0.0.1: Opus RTP to the audio port, each PFAP RTP packet as one datagram\n"
-      "to the data port, with the speech's level and clock as JSON datagrams. At the end it\n"
+      "to the data port, with the speech's level and clock beside them. At the end it\n"
       "prints the state as sent (JSON) and exits.",
       entries, gst_init_get_option_group());
   if (text != nullptr) o.text = text;
@@ -134,15 +135,14 @@ uint32_t pfap_timestamp(const Sender& s, GstClockTime running) {
 // -- The level: the RMS of each ms by PFAP timestamp, sent as the audio enters the queue ------
 
 void send_levels(Sender& s, GstClockTime start, const std::vector<int64_t>& levels) {
-  send_text(s, "{\"type\":\"level\",\"ssrc\":" + std::to_string(s.ssrc) +
-                   ",\"timestamp\":" + std::to_string(pfap_timestamp(s, start)) + ",\"level\":\"" +
-                   encode_levels(levels) + "\"}");
+  const std::vector<uint8_t> message = level_message(s.ssrc, pfap_timestamp(s, start), levels);
+  send_datagram(s, message.data(), message.size());
 }
 
 // -- The clock: the PFAP timestamp of the audio as it goes to the audio port -----------------
 
 // The udpsink's pad sees each packet as the sink begins to wait for its time: at most one
-// packet (10 ms) before it leaves.
+// packet (one Opus frame) before it leaves.
 GstPadProbeReturn on_audio_packet(GstPad* pad, GstPadProbeInfo* info, gpointer data) {
   auto& s = *static_cast<Sender*>(data);
   if (s.audio_packets++ % kClockEvery != 0) return GST_PAD_PROBE_OK;
@@ -262,7 +262,8 @@ int main(int argc, char** argv) {
   const std::string description =
       source +
       " audio. ! audioconvert ! audioresample ! audio/x-raw,format=S16LE,rate=48000,channels=1 "
-      "! queue name=level ! opusenc frame-size=10 ! rtpopuspay pt=111 "
+      "! queue name=level ! " +
+      opus_encoder_description() + " ! rtpopuspay pt=111 "
       "! udpsink name=audiosink host=127.0.0.1 port=" +
       std::to_string(o.audio_port) +
       " pfap. ! rtppfappay name=pay pt=96 ! application/x-rtp,clock-rate=44100 "

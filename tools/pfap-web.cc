@@ -33,7 +33,9 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
@@ -41,7 +43,9 @@
 #include <cstring>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "command_line.h"
@@ -52,6 +56,7 @@
 #include "ratelimit.h"
 #include "sent_pfap.h"
 #include "speech_level.h"
+#include "speech_opus.h"
 
 namespace {
 
@@ -82,7 +87,93 @@ struct Options {
   std::string web_dir;
   int max_sessions = 0;  // 0: as many as the file descriptor limit allows
   double connect_timeout_s = 30.0;
+  double stop_timeout_s = 10.0;
   std::vector<std::string> allowed_origins;  // besides the server's own
+};
+
+// SIGINT and SIGTERM, and a bound on stopping (docs/web.md, "Stopping"). The signals are taken
+// on a thread of its own, not by the main loop: the main thread may be what blocks. The SCTP
+// of webrtcbin 1.22 (usrsctp, bundled with gst-plugins-bad) has been seen to block a
+// pipeline's change to NULL for good, as a session closed when its page left. At a signal the
+// watch quits the main loop, which then stops the sessions, and gives the whole stop
+// `seconds`; if it has not finished by then, the watch names what the main thread was doing
+// and ends the process with status 3, skipping the exit handlers, which could block as well.
+// A server that never exits is worse than one that exits without finishing.
+class StopWatch {
+ public:
+  StopWatch(GMainLoop* loop, double seconds)
+      : loop_(loop), seconds_(seconds), thread_([this] { watch(); }) {}
+  // Once the stop has finished.
+  ~StopWatch() {
+    {
+      std::lock_guard lock(mutex_);
+      finished_ = true;
+    }
+    changed_.notify_one();
+    g_main_context_wakeup(context_);
+    thread_.join();
+    g_main_context_unref(context_);
+  }
+  StopWatch(const StopWatch&) = delete;
+  StopWatch& operator=(const StopWatch&) = delete;
+
+  // What the main thread is doing now, and what it has yet to do, as the message would say.
+  void now(std::string what) {
+    std::lock_guard lock(mutex_);
+    what_ = std::move(what);
+  }
+  void yet(std::string rest) {
+    std::lock_guard lock(mutex_);
+    rest_ = std::move(rest);
+  }
+
+ private:
+  void watch() {
+    bool signalled = false;
+    for (int signal : {SIGINT, SIGTERM}) {
+      GSource* source = g_unix_signal_source_new(signal);
+      g_source_set_callback(
+          source,
+          [](gpointer signalled) -> gboolean {
+            *static_cast<bool*>(signalled) = true;
+            return G_SOURCE_CONTINUE;
+          },
+          &signalled, nullptr);
+      g_source_attach(source, context_);
+      g_source_unref(source);
+    }
+    while (!signalled && !finished()) g_main_context_iteration(context_, TRUE);
+    if (!signalled) return;
+    g_main_loop_quit(loop_);
+    std::unique_lock lock(mutex_);
+    if (changed_.wait_for(lock, std::chrono::duration<double>(seconds_),
+                          [this] { return finished_; })) {
+      return;
+    }
+    char s[G_ASCII_DTOSTR_BUF_SIZE];
+    g_ascii_dtostr(s, sizeof s, seconds_);
+    std::fprintf(stderr,
+                 "pfap-web: not stopped within %s s (--stop-timeout), at %s%s; exiting anyway "
+                 "(docs/web.md, \"Stopping\")\n",
+                 s, what_.c_str(), rest_.c_str());
+    std::fflush(stderr);
+    std::_Exit(3);
+  }
+
+  bool finished() {
+    std::lock_guard lock(mutex_);
+    return finished_;
+  }
+
+  GMainLoop* loop_;
+  double seconds_;
+  GMainContext* context_ = g_main_context_new();
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  bool finished_ = false;
+  std::string what_ = "the main loop";
+  std::string rest_;
+  std::thread thread_;  // last: it starts once the rest is made
 };
 
 struct Server;
@@ -464,6 +555,7 @@ void request_complete(Session& s) {
 
 struct Server {
   Options options;
+  StopWatch* stop_watch = nullptr;  // from the main loop's start to the end of the stop
   int sessions = 0;
   std::vector<std::weak_ptr<Session>> open;  // stopped when the server stops
   int max_sessions = 0;
@@ -554,7 +646,11 @@ void close_session(const std::shared_ptr<Session>& s) {
   s->closed = true;
   if (s->connect_timer != 0) g_source_remove(s->connect_timer);
   s->connect_timer = 0;
+  StopWatch* watch = s->server->stop_watch;
+  if (watch != nullptr)
+    watch->now("session " + std::to_string(s->id) + "'s pipeline going to NULL");
   gst_element_set_state(s->pipeline, GST_STATE_NULL);
+  if (watch != nullptr) watch->now("the main loop");
   gst_bus_remove_watch(GST_ELEMENT_BUS(s->pipeline));
   if (s->speaker_mixer_pad != nullptr) gst_object_unref(s->speaker_mixer_pad);
   if (s->channel != nullptr) g_object_unref(s->channel);
@@ -588,24 +684,23 @@ gboolean on_connect_timeout(gpointer data) {
 
 // One session's pipeline. The mixer makes the audio's pace alone (force-live: it mixes on the
 // clock with no live source upstream), silence between the texts, so no silent source runs
-// beside it. Opus frames of 20 ms at complexity 5: the encoder's instructions 0.59× those of
-// 10 ms at complexity 10, and half the packets to protect and send, for the same lip sync
-// (docs/performance.md, "pfap-web: sessions per server"); 5 is what libwebrtc gives Opus on
-// phones. The mixer's output buffers are one Opus frame each.
-constexpr const char* kSessionPipeline =
-    "webrtcbin name=webrtc bundle-policy=max-bundle "
-    "audiomixer name=mix force-live=true output-buffer-duration=20000000 "
-    "! audio/x-raw,format=S16LE,rate=48000,channels=1 ! opusenc frame-size=20 complexity=5 "
-    "! rtpopuspay name=apay pt=111 "
-    "! application/x-rtp,media=audio,encoding-name=OPUS,clock-rate=48000,payload=111 "
-    "! valve name=gate drop=true drop-mode=forward-sticky-events ! webrtc. "
-    "rtppfappay name=pay pt=96 ! application/x-rtp,clock-rate=44100 "
-    "! appsink name=pfapsink sync=true async=false";
+// beside it. Its output buffers are one Opus frame each (speech_opus.h).
+std::string session_pipeline() {
+  return "webrtcbin name=webrtc bundle-policy=max-bundle "
+         "audiomixer name=mix force-live=true output-buffer-duration=" +
+         std::to_string(kOpusFrame) + " ! audio/x-raw,format=S16LE,rate=48000,channels=1 ! " +
+         opus_encoder_description() +
+         " ! rtpopuspay name=apay pt=111 "
+         "! application/x-rtp,media=audio,encoding-name=OPUS,clock-rate=48000,payload=111 "
+         "! valve name=gate drop=true drop-mode=forward-sticky-events ! webrtc. "
+         "rtppfappay name=pay pt=96 ! application/x-rtp,clock-rate=44100 "
+         "! appsink name=pfapsink sync=true async=false";
+}
 
 // The session's pipeline, its elements found and set: false if it cannot be made.
 bool make_pipeline(Session& s) {
   GError* error = nullptr;
-  s.pipeline = gst_parse_launch(kSessionPipeline, &error);
+  s.pipeline = gst_parse_launch(session_pipeline().c_str(), &error);
   if (s.pipeline == nullptr) {
     g_printerr("pfap-web: %s\n", error->message);
     g_error_free(error);
@@ -909,6 +1004,7 @@ int parse_options(int* argc, char*** argv, Options& o) {
   gdouble drop = o.drop;
   gint max_sessions = -1;  // not given
   gdouble connect_timeout_s = o.connect_timeout_s;
+  gdouble stop_timeout_s = o.stop_timeout_s;
   gchar *text = nullptr, *web_dir = nullptr;
   gchar** origins = nullptr;
   const GOptionEntry entries[] = {
@@ -929,6 +1025,10 @@ int parse_options(int* argc, char*** argv, Options& o) {
       {"connect-timeout", 0, 0, G_OPTION_ARG_DOUBLE, &connect_timeout_s,
        "Close a session whose page has not answered the offer and opened the data channel in S "
        "seconds, above 0 up to 86400 (default 30)",
+       "S"},
+      {"stop-timeout", 0, 0, G_OPTION_ARG_DOUBLE, &stop_timeout_s,
+       "On SIGTERM or SIGINT, exit with status 3 if the sessions have not stopped in S seconds, "
+       "naming those that did not, above 0 up to 3600 (default 10)",
        "S"},
       {"allow-origin", 0, 0, G_OPTION_ARG_STRING_ARRAY, &origins,
        "Accept WebSockets from ORIGIN (scheme://host[:port], or null) besides the page's own "
@@ -954,6 +1054,8 @@ int parse_options(int* argc, char*** argv, Options& o) {
     } else if (!(connect_timeout_s > 0 && connect_timeout_s <= 86400)) {
       status = usage_error("--connect-timeout wants seconds, above 0 up to 86400: %g",
                            connect_timeout_s);
+    } else if (!(stop_timeout_s > 0 && stop_timeout_s <= 3600)) {
+      status = usage_error("--stop-timeout wants seconds, above 0 up to 3600: %g", stop_timeout_s);
     } else if (*argc > 1) {
       status = usage_error("takes no operands: %s", (*argv)[1]);
     }
@@ -970,6 +1072,7 @@ int parse_options(int* argc, char*** argv, Options& o) {
     o.port = port;
     o.max_sessions = max_sessions == -1 ? 0 : max_sessions;
     o.connect_timeout_s = connect_timeout_s;
+    o.stop_timeout_s = stop_timeout_s;
     o.drop = drop;
     o.seed = static_cast<uint32_t>(seed);
     if (text != nullptr) o.text = text;
@@ -1001,12 +1104,57 @@ int session_cap(int wanted) {
   return wanted != 0 ? std::min(wanted, allowed) : allowed;
 }
 
+// "; sessions 4, 7 not stopped yet", or nothing.
+std::string not_stopped_yet(const std::vector<int>& ids) {
+  if (ids.empty()) return "";
+  std::string rest = ids.size() == 1 ? "; session " : "; sessions ";
+  for (size_t i = 0; i < ids.size(); ++i) rest += (i == 0 ? "" : ", ") + std::to_string(ids[i]);
+  return rest + " not stopped yet";
+}
+
+// The threads of this process (/proc/self/status), or -1.
+int thread_count() {
+  gchar* status = nullptr;
+  int threads = -1;
+  if (g_file_get_contents("/proc/self/status", &status, nullptr, nullptr)) {
+    if (const char* line = std::strstr(status, "\nThreads:")) threads = std::atoi(line + 9);
+  }
+  g_free(status);
+  return threads;
+}
+
+// Ends the streaming threads that the sessions left idle in GLib's shared thread pool, and
+// waits until they are gone (their number unchanged for 20 ms). Left to end on their own,
+// some ended while the exit handlers ran, and their thread-exit destructors used what
+// OpenSSL's exit handler (DTLS) had freed: the heap was corrupted, SIGABRT or SIGSEGV at
+// exit, in 2 of 14 stops with 45 sessions open (docs/web.md, "Stopping").
+void end_idle_threads() {
+  g_thread_pool_set_max_unused_threads(0);
+  g_thread_pool_stop_unused_threads();
+  while (g_thread_pool_get_num_unused_threads() > 0) g_usleep(1000);
+  for (int last = thread_count(), unchanged = 0; unchanged < 20;) {
+    g_usleep(1000);
+    const int now = thread_count();
+    unchanged = now == last ? unchanged + 1 : 0;
+    last = now;
+  }
+}
+
 // Ctrl-C or SIGTERM: each session's pipeline stops, its browser is told, and what the
 // sessions and the server hold is freed.
 void stop(Server& server, SoupServer* soup) {
+  // A session closed before has given its WebSocket back: only the open ones.
+  std::vector<std::shared_ptr<Session>> open;
   for (const std::weak_ptr<Session>& weak : server.open) {
     std::shared_ptr<Session> s = weak.lock();
-    if (s == nullptr) continue;
+    if (s != nullptr && !s->closed) open.push_back(std::move(s));
+  }
+  server.open.clear();
+  for (size_t i = 0; i < open.size(); ++i) {
+    std::vector<int> after;
+    for (size_t j = i + 1; j < open.size(); ++j) after.push_back(open[j]->id);
+    server.stop_watch->yet(not_stopped_yet(after));
+    std::shared_ptr<Session> s = std::move(open[i]);
     auto* ws = SOUP_WEBSOCKET_CONNECTION(g_object_ref(s->ws));
     close_session(s);
     s.reset();
@@ -1020,7 +1168,8 @@ void stop(Server& server, SoupServer* soup) {
     }
     g_object_unref(ws);
   }
-  server.open.clear();
+  server.stop_watch->yet("");
+  server.stop_watch->now("the HTTP and STUN servers closing");
   g_source_destroy(server.stun_source);
   g_source_unref(server.stun_source);
   g_object_unref(server.stun);
@@ -1084,18 +1233,17 @@ int main(int argc, char** argv) {
   g_print("pfap-web: at most %d sessions at once\n", server.max_sessions);
   g_print("pfap-web: open http://127.0.0.1:%u/ in a browser (Ctrl-C stops)\n", port);
   GMainLoop* loop = g_main_loop_new(nullptr, FALSE);
-  auto quit = [](gpointer loop) -> gboolean {
-    g_main_loop_quit(static_cast<GMainLoop*>(loop));
-    return G_SOURCE_CONTINUE;  // removed below
-  };
-  const guint on_sigint = g_unix_signal_add(SIGINT, quit, loop);
-  const guint on_sigterm = g_unix_signal_add(SIGTERM, quit, loop);
-  g_main_loop_run(loop);
-  g_source_remove(on_sigint);
-  g_source_remove(on_sigterm);
-  stop(server, soup);
-  g_main_loop_unref(loop);
-  gst_deinit();
+  {
+    StopWatch watch(loop, server.options.stop_timeout_s);
+    server.stop_watch = &watch;
+    g_main_loop_run(loop);
+    stop(server, soup);
+    g_main_loop_unref(loop);
+    watch.now("GStreamer deinitializing (gst_deinit)");
+    gst_deinit();
+    watch.now("the sessions' idle streaming threads ending");
+    end_idle_threads();
+  }
   g_print("pfap-web: stopped\n");
   return 0;
 }

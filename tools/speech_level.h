@@ -49,24 +49,61 @@ class SpeechLevel {
   int count_ = 0;
 };
 
-// The levels as the pages read them (web/live/clock.js, decodeLevels): one byte a level, the
-// code round(kLevelCodesPerOctave × log2(1 + rms)) (at most 240 for S16's 32767; a step is
-// 4.4 % of the level, well within what the page's correlation tells apart), in base64. Half
-// the bytes of the levels as a JSON array of integers, whose numbers run to 4 and 5 digits.
+// The levels as the pages read them (web/live/clock.js): one byte a level, the code
+// round(kLevelCodesPerOctave × log2(1 + rms)) (at most 240 for S16's 32767; a step is 4.4 % of
+// the level, well within what the page's correlation tells apart).
 constexpr double kLevelCodesPerOctave = 16.0;
 
-inline std::string encode_levels(std::span<const int64_t> levels) {
-  std::vector<guchar> codes;
+inline std::vector<uint8_t> level_codes(std::span<const int64_t> levels) {
+  std::vector<uint8_t> codes;
   codes.reserve(levels.size());
   for (int64_t rms : levels) {
     const double code =
         std::round(kLevelCodesPerOctave * std::log2(1.0 + std::max<int64_t>(rms, 0)));
-    codes.push_back(static_cast<guchar>(std::min(code, 255.0)));
+    codes.push_back(static_cast<uint8_t>(std::min(code, 255.0)));
   }
+  return codes;
+}
+
+// The codes in base64, for pfap-web's "envelope" on its WebSocket, a JSON text channel
+// (decodeLevels). Half the bytes of the levels as a JSON array of integers.
+inline std::string encode_levels(std::span<const int64_t> levels) {
+  const std::vector<uint8_t> codes = level_codes(levels);
   gchar* base64 = g_base64_encode(codes.data(), codes.size());
   std::string out = base64;
   g_free(base64);
   return out;
+}
+
+// A level message on pfap-broadcast's data stream (docs/web.md, "The level message"; read by
+// decodeLevelMessage in web/live/clock.js): a 12-byte header, big-endian, then the codes.
+//   byte 0      kLevelMessageType, whose top two bits (RTP's version, 0) and value ('{' is
+//               0x7b) tell it from the stream's RTP packets and JSON messages
+//   byte 1      0
+//   bytes 2-3   the number of levels, 1 to 65535
+//   bytes 4-7   the SSRC of the PFAP stream
+//   bytes 8-11  the PFAP timestamp of the first level's millisecond
+//   bytes 12-   one code a millisecond
+constexpr uint8_t kLevelMessageType = 0x01;
+constexpr size_t kLevelHeaderSize = 12;
+static_assert(SpeechLevel::kLevelsPerMessage <= 0xffff, "a level message's count has 16 bits");
+
+// `levels` holds at most kLevelsPerMessage levels, as the probe below gives them.
+inline std::vector<uint8_t> level_message(uint32_t ssrc, uint32_t timestamp,
+                                          std::span<const int64_t> levels) {
+  std::vector<uint8_t> message = {kLevelMessageType, 0};
+  message.reserve(kLevelHeaderSize + levels.size());
+  auto put = [&](uint32_t value, int bytes) {
+    for (int shift = 8 * (bytes - 1); shift >= 0; shift -= 8) {
+      message.push_back(static_cast<uint8_t>(value >> shift));
+    }
+  };
+  put(static_cast<uint32_t>(levels.size()), 2);
+  put(ssrc, 4);
+  put(timestamp, 4);
+  const std::vector<uint8_t> codes = level_codes(levels);
+  message.insert(message.end(), codes.begin(), codes.end());
+  return message;
 }
 
 // What the probe gives on: `levels[i]` is the RMS of the ms from running time start + i ms.

@@ -41,6 +41,7 @@ DATA_PORT = 5004
 MOUNTPOINT = 1
 ICE_ADDRESS = '10.99.0.1'
 JSON_FIRST_BYTE = ord('{')  # the sender's JSON messages beside the PFAP packets
+LEVEL_MESSAGE_TYPE = 0x01  # and its level messages (tools/speech_level.h)
 SOURCE_ROOT = os.environ.get('PFAP_SOURCE_ROOT') or os.path.join(
     os.path.dirname(os.path.abspath(__file__)), '..', '..')
 
@@ -131,6 +132,8 @@ async def viewer(number, all_open, deadline_s):
             if m['type'] == 'done':
                 result['sender'] = m
                 done.set()
+            return
+        if message[0] == LEVEL_MESSAGE_TYPE:
             return
         result['packets'] += 1
         result['last_seq'] = struct.unpack('!H', message[2:4])[0]

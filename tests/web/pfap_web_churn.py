@@ -25,8 +25,8 @@ import sys
 import threading
 import time
 
-from pfap_web_load import (WebSocket, enter_network_namespace, rss_kib, skip_opus_decoding,
-                           start_server)
+from pfap_web_load import (WebSocket, enter_network_namespace, playing_peer, rss_kib,
+                           skip_opus_decoding, start_server)
 
 WARM_UP = 9
 # Alive at exit whatever the sessions did: dtlsdec keeps one agent for its generated
@@ -47,44 +47,11 @@ async def never_answers(port):
 
 
 async def connects(port, to_the_end):
-    from aiortc import RTCPeerConnection, RTCSessionDescription
-    from aiortc.sdp import candidate_from_sdp
-
-    pc = RTCPeerConnection()
-    ws = await WebSocket.connect(port)
+    """A playing peer (pfap_web_load.playing_peer) that leaves at its first PFAP packet
+    (mid-sentence) or, `to_the_end`, at the text's end."""
     first_packet = asyncio.Event()
-
-    @pc.on('datachannel')
-    def on_datachannel(channel):
-        ws.send({'type': 'playing'})
-        channel.on('message', lambda message: first_packet.set())
-
-    try:
-        while True:
-            receiving = asyncio.ensure_future(ws.receive())
-            waiting = [receiving] + ([] if to_the_end else
-                                     [asyncio.ensure_future(first_packet.wait())])
-            done, _ = await asyncio.wait(waiting, return_when=asyncio.FIRST_COMPLETED)
-            if receiving not in done:  # mid-sentence: leave now
-                receiving.cancel()
-                return
-            for w in waiting[1:]:
-                w.cancel()
-            m = receiving.result()
-            if m['type'] == 'offer':
-                await pc.setRemoteDescription(RTCSessionDescription(m['sdp'], 'offer'))
-                await pc.setLocalDescription(await pc.createAnswer())
-                ws.send({'type': 'answer', 'sdp': pc.localDescription.sdp})
-            elif m['type'] == 'ice' and m['candidate']:
-                c = candidate_from_sdp(m['candidate'].split(':', 1)[1])
-                c.sdpMLineIndex = m['sdpMLineIndex']
-                c.sdpMid = str(m['sdpMLineIndex'])
-                await pc.addIceCandidate(c)
-            elif m['type'] in ('done', 'error'):
-                return
-    finally:
-        await pc.close()
-        ws.writer.close()
+    await playing_peer(port, first_packet, asyncio.Event() if to_the_end else first_packet,
+                       until=('done', 'error'))
 
 
 async def cycle(port, kind):

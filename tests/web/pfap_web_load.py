@@ -101,7 +101,6 @@ class WebSocket:
 
 async def session(port, number, deadline_s):
     from aiortc import RTCPeerConnection, RTCSessionDescription
-    from aiortc.sdp import candidate_from_sdp
 
     result = {'session': number, 'audio_packets': 0, 'packets': 0, 'last_seq': None,
               'sender': None, 'error': None, 'messages': [], 'pfap_times': [],
@@ -135,10 +134,7 @@ async def session(port, number, deadline_s):
                     # The server starts the audio and the text once the page plays.
                     asyncio.ensure_future(say_playing_when_open(ws, channel_open))
                 elif m['type'] == 'ice' and m['candidate']:
-                    c = candidate_from_sdp(m['candidate'].split(':', 1)[1])
-                    c.sdpMLineIndex = m['sdpMLineIndex']
-                    c.sdpMid = str(m['sdpMLineIndex'])
-                    await pc.addIceCandidate(c)
+                    await add_candidate(pc, m)
                 elif m['type'] == 'error':
                     raise ConnectionError(m['message'])
                 elif m['type'] == 'done':
@@ -155,6 +151,59 @@ async def session(port, number, deadline_s):
         await pc.close()
         ws.writer.close()
     return result
+
+
+async def answer_offer(pc, ws, m):
+    """Answers the server's offer `m`."""
+    from aiortc import RTCSessionDescription
+    await pc.setRemoteDescription(RTCSessionDescription(m['sdp'], 'offer'))
+    await pc.setLocalDescription(await pc.createAnswer())
+    ws.send({'type': 'answer', 'sdp': pc.localDescription.sdp})
+
+
+async def add_candidate(pc, m):
+    """Adds the server's ICE candidate `m` (an "ice" message with a candidate)."""
+    from aiortc.sdp import candidate_from_sdp
+    c = candidate_from_sdp(m['candidate'].split(':', 1)[1])
+    c.sdpMLineIndex = m['sdpMLineIndex']
+    c.sdpMid = str(m['sdpMLineIndex'])
+    await pc.addIceCandidate(c)
+
+
+async def playing_peer(port, first_packet, leave, until=()):
+    """A peer that connects, answers the offer, says it plays once its data channel opens, and
+    sets `first_packet` at its first PFAP packet. It leaves (closes its peer connection and
+    WebSocket) when `leave` is set, returning 'left', or at the first message whose type is in
+    `until`, returning that type. Raises what the WebSocket raises when the server closes it."""
+    from aiortc import RTCPeerConnection
+
+    pc = RTCPeerConnection()
+    ws = await WebSocket.connect(port)
+
+    @pc.on('datachannel')
+    def on_datachannel(channel):
+        ws.send({'type': 'playing'})
+        channel.on('message', lambda message: first_packet.set())
+
+    try:
+        while True:
+            receiving = asyncio.ensure_future(ws.receive())
+            leaving = asyncio.ensure_future(leave.wait())
+            await asyncio.wait([receiving, leaving], return_when=asyncio.FIRST_COMPLETED)
+            if not receiving.done():
+                receiving.cancel()
+                return 'left'
+            leaving.cancel()
+            m = receiving.result()
+            if m['type'] == 'offer':
+                await answer_offer(pc, ws, m)
+            elif m['type'] == 'ice' and m['candidate']:
+                await add_candidate(pc, m)
+            elif m['type'] in until:
+                return m['type']
+    finally:
+        await pc.close()
+        ws.writer.close()
 
 
 async def audio_packets(pc):

@@ -7,9 +7,10 @@
 //
 // Janus gives each viewer audio RTP timestamps of its own, so they say nothing of PFAP time.
 // The sender (tools/pfap-broadcast.cc) puts what the page needs on the data stream, beside the
-// PFAP packets, as JSON messages (a first byte of '{', which no RTP packet has): the speech's
-// level by PFAP timestamp ("level", ahead of the audio), the PFAP timestamp of the audio as it
-// leaves ("clock") and the state as sent at the end ("done"). The first estimate of which PFAP
+// PFAP packets: the speech's level by PFAP timestamp, ahead of the audio, as binary level
+// messages (a first byte of 1, docs/web.md, "The level message"), and as JSON messages (a first
+// byte of '{'; no RTP packet starts with either) the PFAP timestamp of the audio as it leaves
+// ("clock") and the state as sent at the end ("done"). The first estimate of which PFAP
 // time is heard comes from the clock messages and the jitter buffer's delay; the level found
 // in the audio played makes it exact, as in pfap-web.
 //
@@ -18,7 +19,7 @@
 //
 // window.pfapStats holds the figures the browser test reads.
 import { PfapReceiver, Viseme, parseRtp } from '../src/index.js';
-import { decodeLevels } from '../live/clock.js';
+import { LEVEL_MESSAGE_TYPE, decodeLevelMessage } from '../live/clock.js';
 import { lipSyncErrors } from '../live/live.js';
 import { DrawnPhonemes, PlayoutClock, drawInTime, showCounts } from '../live/playout.js';
 
@@ -32,7 +33,7 @@ export function start({ canvas, audio, status, janusServer }) {
     phonemes: 0, packets: 0, lost: 0, recovered: 0, complete: 0, uncertain: 0, late: 0,
     lipSyncErrorsMs: [], fapStateMatchesSender: false, sender: null, done: 0, streams: 0,
     wholeAfterMs: null,  // stream time from the first packet to a whole FAP state
-    malformed: 0,  // JSON messages dropped (PfapReceiver counts the RTP packets it drops)
+    malformed: 0,  // JSON and level messages dropped (PfapReceiver counts the RTP packets it drops)
     reconnects: 0,  // sessions with Janus lost and watched again
     connected: false, dataOpen: false, matched: false, streamNs: 0, endNs: 0,
     envelope: [], frames: [],
@@ -84,23 +85,33 @@ export function start({ canvas, audio, status, janusServer }) {
     stats.fapStateMatchesSender = stats.sender.settled.every((v, i) => state.settled(i + 3) === v);
   };
 
+  // Dropped whole and counted; the stream goes on.
+  const malformed = (e) => {
+    if ((++stats.malformed & (stats.malformed - 1)) === 0) console.warn(`dropped malformed message ${stats.malformed}: ${e.message}`);
+  };
+
   const onMessage = (bytes) => {
-    if (bytes[0] === JSON_FIRST_BYTE) {
+    if (bytes[0] === LEVEL_MESSAGE_TYPE) {
       let m;
-      let levels = null;
+      try {
+        m = decodeLevelMessage(bytes);
+      } catch (e) {
+        malformed(e);
+        return;
+      }
+      streamOf(m.ssrc, m.timestamp);
+      clock.sent.add(msOf(m.timestamp) * 1e6, m.levels);
+    } else if (bytes[0] === JSON_FIRST_BYTE) {
+      let m;
       try {
         m = JSON.parse(decoder.decode(bytes));
         if (!Number.isInteger(m.ssrc)) throw new Error('no ssrc');
-        if (m.type === 'level') levels = decodeLevels(m.level);
       } catch (e) {
-        // Dropped whole and counted; the stream goes on.
-        if ((++stats.malformed & (stats.malformed - 1)) === 0) console.warn(`dropped malformed message ${stats.malformed}: ${e.message}`);
+        malformed(e);
         return;
       }
       streamOf(m.ssrc, m.timestamp ?? 0);
-      if (m.type === 'level') {
-        clock.sent.add(msOf(m.timestamp) * 1e6, levels);
-      } else if (m.type === 'clock') {
+      if (m.type === 'clock') {
         stream.clocks.push({ arrived: performance.now(), ms: msOf(m.timestamp) });
         if (stream.clocks.length > 100) stream.clocks.splice(0, 50);
       } else if (m.type === 'done') {

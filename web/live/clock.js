@@ -9,11 +9,14 @@
 // the level of the speech it sends (the RMS of each millisecond, by running time); the page
 // finds the level of what it plays in it, and so learns the remaining lag.
 
-/** Codes per octave of the sender's level (tools/speech_level.h, encode_levels). */
+/** Codes per octave of the sender's level (tools/speech_level.h, level_codes). */
 export const LEVEL_CODES_PER_OCTAVE = 16;
 
+/** One level's code (one byte) back to RMS in S16 units, within 2.2 % of the sender's. */
+const levelOfCode = (code) => 2 ** (code / LEVEL_CODES_PER_OCTAVE) - 1;
+
 /**
- * The levels of a sender's message: base64, one byte a millisecond, the code
+ * The levels of pfap-web's "envelope": base64, one byte a millisecond, the code
  * round(16 × log2(1 + rms)), back to RMS in S16 units (within 2.2 % of the sender's).
  * Throws a TypeError if `base64` is not a string and a DOMException if it is not base64.
  * @param {string} base64
@@ -23,8 +26,33 @@ export function decodeLevels(base64) {
   if (typeof base64 !== 'string') throw new TypeError('level: not a base64 string');
   const bytes = atob(base64);
   const levels = new Float64Array(bytes.length);
-  for (let i = 0; i < bytes.length; ++i) levels[i] = 2 ** (bytes.charCodeAt(i) / LEVEL_CODES_PER_OCTAVE) - 1;
+  for (let i = 0; i < bytes.length; ++i) levels[i] = levelOfCode(bytes.charCodeAt(i));
   return levels;
+}
+
+/** The first byte of a level message (tools/speech_level.h, kLevelMessageType). */
+export const LEVEL_MESSAGE_TYPE = 0x01;
+const LEVEL_HEADER_SIZE = 12;
+
+/**
+ * A level message of pfap-broadcast's data stream (docs/web.md, "The level message"): a 12-byte
+ * header (the type, 0, the count, the SSRC, the PFAP timestamp of the first level; big-endian)
+ * and one code a millisecond, decoded as decodeLevels' codes. Throws a RangeError for a message
+ * that is not exactly one whole level message, so that it is dropped whole.
+ * @param {Uint8Array} bytes
+ * @returns {{ssrc: number, timestamp: number, levels: Float64Array}}
+ */
+export function decodeLevelMessage(bytes) {
+  if (bytes.length < LEVEL_HEADER_SIZE) throw new RangeError(`level message: ${bytes.length} bytes, shorter than its header`);
+  const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+  if (bytes[0] !== LEVEL_MESSAGE_TYPE || bytes[1] !== 0) throw new RangeError('level message: not one (type or reserved byte)');
+  const count = view.getUint16(2);
+  if (count === 0 || bytes.length !== LEVEL_HEADER_SIZE + count) {
+    throw new RangeError(`level message: ${count} levels in ${bytes.length - LEVEL_HEADER_SIZE} bytes`);
+  }
+  const levels = new Float64Array(count);
+  for (let i = 0; i < count; ++i) levels[i] = levelOfCode(bytes[LEVEL_HEADER_SIZE + i]);
+  return { ssrc: view.getUint32(4), timestamp: view.getUint32(8), levels };
 }
 
 /**

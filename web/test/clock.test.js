@@ -4,7 +4,7 @@
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 
-import { SentLevel, decodeLevels, matchLevels } from '../live/clock.js';
+import { LEVEL_MESSAGE_TYPE, SentLevel, decodeLevelMessage, decodeLevels, matchLevels } from '../live/clock.js';
 
 // "pa. pa. pa.": a sharp onset every 337 ms, a vowel that decays, silence between (S16 RMS).
 function speech(ms) {
@@ -96,6 +96,40 @@ test('decodeLevels: one byte a millisecond, 16 codes an octave, base64', () => {
   assert.throws(() => decodeLevels([1, 2, 3]), TypeError);
   assert.throws(() => decodeLevels(undefined), TypeError);
   assert.throws(() => decodeLevels('not base64!'));
+});
+
+// tools/speech_level.h's level_message(0x11223344, 0xfffffff0, {0, 1, 1023, 32767}), as
+// tests/web/test_speech_level.cc holds it.
+const LEVEL_MESSAGE = [1, 0, 0, 4, 0x11, 0x22, 0x33, 0x44, 0xff, 0xff, 0xff, 0xf0, 0, 16, 160, 240];
+
+test("decodeLevelMessage: the header's SSRC, timestamp and count, then the codes as decodeLevels reads them", () => {
+  assert.equal(LEVEL_MESSAGE_TYPE, 1);
+  const m = decodeLevelMessage(Uint8Array.from(LEVEL_MESSAGE));
+  assert.equal(m.ssrc, 0x11223344);
+  assert.equal(m.timestamp, 0xfffffff0);
+  assert.deepEqual(Array.from(m.levels), [0, 1, 1023, 32767]);
+  // A view into a larger buffer (as a data channel's may be) is read from its own start.
+  const larger = new Uint8Array(40).fill(0xaa);
+  larger.set(LEVEL_MESSAGE, 7);
+  assert.deepEqual(decodeLevelMessage(larger.subarray(7, 7 + LEVEL_MESSAGE.length)), m);
+  // The first byte tells it from RTP (version 2: 0x80 to 0xbf) and JSON ('{').
+  assert.ok(LEVEL_MESSAGE_TYPE >> 6 !== 2 && LEVEL_MESSAGE_TYPE !== '{'.charCodeAt(0));
+});
+
+test('decodeLevelMessage throws for any message that is not exactly one level message', () => {
+  const bad = {
+    'empty': [],
+    'a header cut short': LEVEL_MESSAGE.slice(0, 11),
+    'levels cut short': LEVEL_MESSAGE.slice(0, -1),
+    'a byte too many': [...LEVEL_MESSAGE, 0],
+    'no levels': [1, 0, 0, 0, 0x11, 0x22, 0x33, 0x44, 0, 0, 0, 0],
+    'another type': [2, ...LEVEL_MESSAGE.slice(1)],
+    'the reserved byte set': [1, 1, ...LEVEL_MESSAGE.slice(2)],
+    'a count of 65535 and 4 levels': [1, 0, 0xff, 0xff, ...LEVEL_MESSAGE.slice(4)],
+  };
+  for (const [what, bytes] of Object.entries(bad)) {
+    assert.throws(() => decodeLevelMessage(Uint8Array.from(bytes)), RangeError, what);
+  }
 });
 
 test('matchLevels finds the same lag in the level as the sender codes it', () => {

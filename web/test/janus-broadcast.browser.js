@@ -78,7 +78,9 @@ test('three viewers through Janus, a tenth of the PFAP datagrams dropped before 
   // messages whole, counts them, and goes on.
   await new Promise((r) => setTimeout(r, 1000));
   const socket = dgram.createSocket('udp4');
-  for (const bad of ['{not json', '{"type": "level", "rms": [1, 2, 3]}']) {
+  // A level message cut short: its header counts 50 levels, 10 follow.
+  const truncatedLevel = Buffer.from([1, 0, 0, 50, 1, 2, 3, 4, 0, 0, 0, 0, ...new Array(10).fill(100)]);
+  for (const bad of ['{not json', truncatedLevel]) {
     await new Promise((r) => socket.send(bad, DATA_PORT, '127.0.0.1', r));
   }
   socket.close();

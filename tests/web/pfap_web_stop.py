@@ -1,0 +1,120 @@
+#!/usr/bin/python3
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""tools/pfap-web stopped by SIGTERM with sessions open (issue 28; docs/web.md, "Stopping"):
+N aiortc peers (as tests/web/pfap_web_load.py) connect, say they play and wait mid-sentence,
+each until its first PFAP packet; then every second peer leaves (closes its peer connection and
+WebSocket) as the server gets SIGTERM, so that sessions closing as their peers leave and
+sessions stopped by the server meet. RUNS times with --stop-timeout=10: the server must exit 0
+with "pfap-web: stopped" within BOUND_S, and every peer that stayed must see its WebSocket
+closed. Then once with --stop-timeout=0.001, shorter than any stop: it must exit 3 within
+BOUND_S with the line naming the session it was stopping and those not stopped yet (or the
+main loop, if the signal came before the stop began). The server
+must print no GLib CRITICAL. A server that
+does not exit within 60 s has its threads' stacks printed (gdb) and is killed. Exits 1 if any
+of it fails.
+
+    pfap_web_stop.py [N] [RUNS]   (default 8 1; PFAP_WEB names the server; as root)
+
+In a network namespace with lo and a veth pair, as tests/web/pfap_web_load.py."""
+import asyncio
+import re
+import shutil
+import subprocess
+import sys
+import time
+
+from pfap_web_load import enter_network_namespace, playing_peer, skip_opus_decoding, start_server
+
+TEXT = ' '.join(['One, <FAP 3 100 400 1> two, three, four, five, six, seven, eight.'] * 6)
+# The server's default deadline: the sanitizer build's stops of 10 sessions took 1.3 to 3.2 s.
+STOP_TIMEOUT_S = 10
+# The deadline, and what the process's end may take after it.
+BOUND_S = STOP_TIMEOUT_S + 5
+
+
+async def open_session(port, first_packet, leave):
+    """A playing peer (pfap_web_load.playing_peer) that waits until the server closes its
+    WebSocket (True) or `leave` is set (False)."""
+    try:
+        await playing_peer(port, first_packet, leave)
+        return False
+    except (ConnectionError, asyncio.IncompleteReadError):
+        return True
+    finally:
+        first_packet.set()  # the others go on
+
+
+def stacks(pid):
+    """Where a server that does not exit is, by gdb if there is one."""
+    if shutil.which('gdb'):
+        subprocess.run(['gdb', '-p', str(pid), '-batch', '-ex', 'thread apply all bt'],
+                       stdout=sys.stderr, stderr=subprocess.DEVNULL, timeout=120)
+
+
+async def run(sessions, stop_timeout_s):
+    """One server with `sessions` open, stopped; its exit status and what it printed, or None
+    if it took longer than BOUND_S or not every peer that stayed saw its WebSocket closed."""
+    server, port = start_server([f'--text={TEXT}', f'--stop-timeout={stop_timeout_s}'])
+    packets = [asyncio.Event() for _ in range(sessions)]
+    leave = [asyncio.Event() for _ in range(sessions)]
+    peers = [asyncio.ensure_future(open_session(port, p, q)) for p, q in zip(packets, leave)]
+    await asyncio.wait_for(asyncio.gather(*(p.wait() for p in packets)), 60)
+    mid_sentence = sum(not p.done() for p in peers)
+    for q in leave[1::2]:
+        q.set()
+    await asyncio.sleep(0)  # the leaving peers start to close
+    stopping = time.monotonic()
+    server.terminate()
+    loop = asyncio.get_running_loop()
+    try:
+        out, err = await loop.run_in_executor(None, lambda: server.communicate(timeout=60))
+    except subprocess.TimeoutExpired:
+        stacks(server.pid)
+        server.kill()
+        out, err = server.communicate()
+    took = time.monotonic() - stopping
+    closed = await asyncio.wait_for(asyncio.gather(*peers, return_exceptions=True), 30)
+    told, staying = sum(c is True for c in closed[::2]), len(closed[::2])
+    print(f'{sessions} sessions, {mid_sentence} mid-sentence at SIGTERM, --stop-timeout='
+          f'{stop_timeout_s}: pfap-web exited {server.returncode} {took:.1f} s after it; {told} '
+          f'of the {staying} peers that stayed saw their WebSocket closed')
+    if 'CRITICAL' in err:
+        print(f'GLib CRITICALs:\n{err[-3000:]}', file=sys.stderr)
+        return None
+    if took > BOUND_S or told != staying:
+        print(err[-3000:], file=sys.stderr)
+        return None
+    return server.returncode, out, err
+
+
+async def main():
+    sessions = int(sys.argv[1]) if len(sys.argv) > 1 else 8
+    runs = int(sys.argv[2]) if len(sys.argv) > 2 else 1
+    ok = True
+    for _ in range(runs):
+        r = await run(sessions, STOP_TIMEOUT_S)
+        if r is None or r[0] != 0 or 'pfap-web: stopped' not in r[1]:
+            ok = False
+            print(f'not stopped cleanly: {r and r[0]}\n{r and r[2][-3000:]}', file=sys.stderr)
+    # A deadline too short for any stop: the server gives up on the sessions it has not
+    # stopped, names them, and exits 3.
+    r = await run(sessions, 0.001)
+    # At the signal the main thread may still be in the main loop (in a slow build), or already
+    # stopping a session.
+    gave_up = r is not None and re.search(
+        r'pfap-web: not stopped within 0.001 s \(--stop-timeout\), at (the main loop|session '
+        r"\d+'s pipeline going to NULL(; sessions? [\d, ]+ not stopped yet)?); exiting anyway",
+        r[2])
+    if r is None or r[0] != 3 or not gave_up:
+        ok = False
+        print(f'did not give up as it should: {r and r[0]}\n{r and r[2][-3000:]}', file=sys.stderr)
+    else:
+        print(gave_up.group(0))
+    if not ok:
+        sys.exit(1)
+
+
+if __name__ == '__main__':
+    enter_network_namespace()
+    skip_opus_decoding()
+    asyncio.run(main())
