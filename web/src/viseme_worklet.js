@@ -9,10 +9,11 @@
 //   {type: 'viseme', viseme, frame}: the viseme shown from 10 ms frame `frame` of the stream
 //     (frame 0 at the node's first audio) until the next such message;
 //   {type: 'runs', runs: [{start, frames, viseme}...]}: the runs that ended.
-// Post 'finish' to it for the last ones. docs/align.md, "A viseme detector".
+// Post 'finish' to it for the last ones. The processor's class is exported too, for the
+// benchmark that times it (web/bench/viseme_worklet_timed.js). docs/align.md, "A viseme detector".
 import { VisemeDetector, parseVisemeModel } from './viseme_detector.js';
 
-class VisemeDetectorProcessor extends AudioWorkletProcessor {
+export class VisemeDetectorProcessor extends AudioWorkletProcessor {
   constructor(options) {
     super();
     const { modelText, ...settings } = options.processorOptions;
