@@ -20,7 +20,8 @@ import path from 'node:path';
 import { test } from 'node:test';
 
 import { launchChromium, newPage } from '../test/janus.js';
-import { readWav, serveSourceRoot } from '../test/viseme_browser.js';
+import { serveSourceRoot } from '../test/viseme_browser.js';
+import { readWav } from '../test/wav.js';
 
 const LIBRIVOX = '/usr/share/pocketsphinx/test/data/librivox';
 const HARVARD = 'The birch canoe slid on the smooth planks. Glue the sheet to the dark blue background. ' +

@@ -18,7 +18,8 @@ import { after, before, test } from 'node:test';
 
 import { OCULUS_VISEMES, VisemeDetector, parseVisemeModel } from '../src/index.js';
 import { launchChromium, newPage } from './janus.js';
-import { readWav, serveSourceRoot, sourceRoot, writeWav } from './viseme_browser.js';
+import { serveSourceRoot, sourceRoot } from './viseme_browser.js';
+import { readWav, writeWav } from './wav.js';
 
 const tool = process.env.PFAP_VISEME_DATA;
 // Sharp onsets after silence: each "pa" sounds as its closed lips open.
@@ -37,7 +38,7 @@ before(() => {
   const samples = new Int16Array(spoken.rate + spoken.samples.length + spoken.rate / 2);
   samples.set(spoken.samples, spoken.rate);
   wav = path.join(dir, 'pa.wav');
-  writeWav(wav, { rate: spoken.rate, samples });
+  writeWav(wav, spoken.rate, samples);
 });
 
 after(() => {
