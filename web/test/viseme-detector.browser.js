@@ -6,7 +6,7 @@
 // played audio tapped (live/tap.js), each frame's time and whether it draws the pressed lips
 // (live/playout.js's DrawnPhonemes), paired by live/live.js's lipSyncErrors. Sanity bounds
 // only; the figures are printed (docs/align.md, "In Chromium"), and written to
-// PFAP_LIPSYNC_OUT if set.
+// PFAP_LIPSYNC_OUT if set. And the worklet's frames across a gap in its input.
 //
 // Run by tests/web/pfap-web-browser.sh inside a network namespace with only lo.
 import assert from 'node:assert/strict';
@@ -108,6 +108,40 @@ function detectorFrames({ rate, samples }) {
   return { envelope, frames };
 }
 
+// In the page: two bursts of noise, 0.3 s each, the second 1 s after the first, through the
+// worklet, with nothing connected to it for a while between them (its input then has no
+// channels); resolves to the worklet's viseme messages as [frame, viseme].
+async function burstsThroughWorklet() {
+  const context = new AudioContext();
+  await context.audioWorklet.addModule('/web/src/viseme_worklet.js');
+  const modelText = await (await fetch('/align/viseme_model.txt')).text();
+  const node = new AudioWorkletNode(context, 'pfap-viseme-detector', { processorOptions: { modelText } });
+  node.connect(context.destination);
+  const burst = context.createBuffer(1, Math.round(0.3 * context.sampleRate), context.sampleRate);
+  let seed = 30;
+  burst.getChannelData(0).forEach((_, i, samples) => {
+    seed = (seed * 1103515245 + 12345) % 2147483648;
+    samples[i] = 0.3 * (seed / 2147483648 - 0.5);
+  });
+  const visemes = [];
+  node.port.onmessage = ({ data }) => data.type === 'viseme' && visemes.push([data.frame, data.viseme]);
+  const until = async (t) => {
+    while (context.currentTime < t) await new Promise((r) => setTimeout(r, 20));
+  };
+  await context.resume();
+  const t0 = context.currentTime + 0.2;
+  for (const at of [t0, t0 + 1]) {
+    // The second is connected only 0.2 s after the first has ended.
+    await until(at - 0.5);
+    const source = new AudioBufferSourceNode(context, { buffer: burst });
+    source.connect(node);
+    source.start(at);
+  }
+  await until(t0 + 1.8);
+  await context.close();
+  return visemes;
+}
+
 const median = (values) => {
   const sorted = [...values].sort((a, b) => a - b);
   return sorted.length % 2 ? sorted[(sorted.length - 1) / 2] : (sorted[sorted.length / 2 - 1] + sorted[sorted.length / 2]) / 2;
@@ -145,8 +179,32 @@ test('the example page draws the pressed lips of "pa" in time with the sound it 
     assert.ok(figures.visemes > 10, `${figures.visemes} viseme messages: ${page.messages.join('\n')}`);
     assert.ok(figures.errors.length >= 5, text);
     // Frames come every 16.7 ms: in time, the first to draw the lips is 0 to 16.7 ms late.
-    // Drawn at the time rendered rather than heard, the page was 23 to 29 ms early.
-    assert.ok(own >= -18 && own <= 40, text);
+    // Drawn at the time rendered rather than heard, the page was 22 to 29 ms early. Where the
+    // output underran (a loaded machine), the sound was heard later than getOutputTimestamp()
+    // says, by an amount neither the page nor the tap can know: not judged then.
+    if (figures.underruns > 0) console.log(`the output underran ${figures.underruns} times: lip sync not judged`);
+    else assert.ok(own >= -18 && own <= 40, text);
+    await page.close();
+  } finally {
+    await browser.close();
+    await server.stop();
+  }
+});
+
+test('the worklet\'s frames keep the context\'s time when its input stops and comes back', { timeout: 60000 }, async () => {
+  const server = await serveSourceRoot();
+  const browser = await launchChromium();
+  try {
+    const page = await newPage(browser, `${server.url}/web/examples/viseme-detector.html`);
+    const visemes = await page.evaluate(burstsThroughWorklet);
+    const text = `noise at frames 0..30 and 100..130: visemes [frame, viseme] ${JSON.stringify(visemes)}`;
+    console.log(text);
+    // The same noise after silence gives the same visemes, 100 frames later (before, the
+    // input's gap left out, 20 frames early).
+    const first = visemes.find(([frame, viseme]) => frame < 50 && viseme !== 0);
+    const second = visemes.find(([frame, viseme]) => frame >= 60 && viseme !== 0);
+    assert.ok(first && second, text);
+    assert.ok(Math.abs(second[0] - first[0] - 100) <= 2, text);
     await page.close();
   } finally {
     await browser.close();
