@@ -1,8 +1,9 @@
 #!/bin/sh
 # SPDX-License-Identifier: LGPL-2.1-or-later
-# The browser test of tools/pfap-web (web/test/pfap-web.browser.js, docs/web.md): node,
-# chromium and the server run inside a network namespace of their own with only lo up, so
-# that WebRTC's ICE can only use 127.0.0.1 and no packet leaves the machine. unshare -n needs
+# The browser test of tools/pfap-web (web/test/pfap-web.browser.js, docs/web.md), and the
+# viseme detector's (web/test/viseme-detector.browser.js) and its benchmark: node, chromium
+# and the server run inside a network namespace of their own with only lo up, so that
+# WebRTC's ICE can only use 127.0.0.1 and no packet leaves the machine. unshare -n needs
 # root: elsewhere the test is skipped (exit 77) saying so; CI runs as root.
 # Arguments: node, the test file. PFAP_WEB names the server.
 set -eu

@@ -7,12 +7,14 @@
 // it posts, as the detector settles them:
 //   {type: 'start', time}: the context's time (currentTime, s) of the node's first audio;
 //   {type: 'viseme', viseme, frame}: the viseme shown from 10 ms frame `frame` of the stream
-//     (frame 0 at the node's first audio) until the next such message;
+//     (frame 0 at the node's first audio, frame k 10k ms of the context's time after it: a
+//     render quantum without input after the first is silence) until the next such message;
 //   {type: 'runs', runs: [{start, frames, viseme}...]}: the runs that ended.
-// Post 'finish' to it for the last ones. docs/align.md, "A viseme detector".
+// Post 'finish' to it for the last ones. The processor's class is exported too, for the
+// benchmark that times it (web/bench/viseme_worklet_timed.js). docs/align.md, "A viseme detector".
 import { VisemeDetector, parseVisemeModel } from './viseme_detector.js';
 
-class VisemeDetectorProcessor extends AudioWorkletProcessor {
+export class VisemeDetectorProcessor extends AudioWorkletProcessor {
   constructor(options) {
     super();
     const { modelText, ...settings } = options.processorOptions;
@@ -35,6 +37,12 @@ class VisemeDetectorProcessor extends AudioWorkletProcessor {
 
   process(inputs, outputs) {
     const input = inputs[0];
+    if ((input === undefined || input.length === 0) && this.shownFrom !== -1) {
+      // A source that stops, or is not yet playing, gives no input: without this, the frames
+      // after it would fall behind the context's time (once 40 ms at the example's start).
+      this.silence ??= new Float32Array(outputs[0]?.[0]?.length ?? 128);
+      this.report(this.detector.push(this.silence));
+    }
     if (input !== undefined && input.length > 0) {
       if (this.shownFrom === -1) {
         this.shownFrom = -2;

@@ -5,46 +5,20 @@
 // within float tolerance and the same runs. Needs PFAP_VISEME_DATA (tests/web/meson.build).
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
+import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { test } from 'node:test';
 import { fileURLToPath } from 'node:url';
 
 import { OCULUS_VISEMES, VISEME_LOOKAHEAD_MS, VisemeDetector, parseVisemeModel } from '../src/index.js';
+import { readWav, writeWav } from './wav.js';
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..', '..');
 const tool = process.env.PFAP_VISEME_DATA;
 const model = parseVisemeModel(readFileSync(path.join(root, 'align', 'viseme_model.txt'), 'utf8'));
 // Float32 weights, float in C++ and double here: the probabilities differ in the 6th digit.
 const TOLERANCE = 1e-4;
-
-function readWav(file) {
-  const b = readFileSync(file);
-  const rate = b.readUInt32LE(24);
-  let at = 12;
-  while (b.toString('latin1', at, at + 4) !== 'data') at += 8 + b.readUInt32LE(at + 4);
-  const n = b.readUInt32LE(at + 4) / 2;
-  return { rate, samples: Int16Array.from({ length: n }, (_, i) => b.readInt16LE(at + 8 + 2 * i)) };
-}
-
-function writeWav(file, rate, samples) {
-  const b = Buffer.alloc(44 + samples.length * 2);
-  b.write('RIFF', 0, 'latin1');
-  b.writeUInt32LE(36 + samples.length * 2, 4);
-  b.write('WAVEfmt ', 8, 'latin1');
-  b.writeUInt32LE(16, 16);
-  b.writeUInt16LE(1, 20);
-  b.writeUInt16LE(1, 22);
-  b.writeUInt32LE(rate, 24);
-  b.writeUInt32LE(rate * 2, 28);
-  b.writeUInt16LE(2, 32);
-  b.writeUInt16LE(16, 34);
-  b.write('data', 36, 'latin1');
-  b.writeUInt32LE(samples.length * 2, 40);
-  samples.forEach((s, i) => b.writeInt16LE(s, 44 + 2 * i));
-  writeFileSync(file, b);
-}
 
 function detect({ rate, samples }) {
   const trace = [];
