@@ -274,6 +274,42 @@ TEST(Boundaries, DigitalSilenceIsNoFloorForTheEdges) {
   EXPECT_DOUBLE_EQ(starts[1], static_cast<double>(speech_ends));
 }
 
+// Festival's lead-in hum: 160 ms of a 100 Hz hum at -40 dBFS (25 dB below the speech), 45 ms
+// of hiss at the recording's floor, then the first sound. The warp puts the first sound at the hum,
+// whose start is an edge of silence too; the first sound starts after the hum (before, at the hum:
+// 205 ms early). A sound 15 dB below the speech before the same silence (an /s/ before a stop's
+// closure) is the first sound.
+TEST(Boundaries, FirstSoundStartsAfterAHum) {
+  constexpr unsigned kRate = 16000;
+  for (const int below_db : {25, 15}) {
+    SCOPED_TRACE(below_db);
+    std::vector<int16_t> audio(kRate / 2, 0);
+    const size_t hum_begins = audio.size();
+    std::vector<int16_t> hum = tone(100, 0.16, kRate);  // the speech's level, -15 dBFS
+    for (int16_t& x : hum) x = static_cast<int16_t>(x * std::pow(10.0, -below_db / 20.0));
+    audio.insert(audio.end(), hum.begin(), hum.end());
+    auto hiss = [&](double seconds) {  // -68 dBFS, the recording's floor
+      for (size_t i = 0; i < static_cast<size_t>(seconds * kRate); ++i) {
+        audio.push_back(static_cast<int16_t>((static_cast<int>(i % 7) - 3) * 6));
+      }
+    };
+    hiss(0.045);
+    const size_t speech_begins = audio.size();
+    const std::vector<int16_t> speech = tone(200, 0.5, kRate);
+    audio.insert(audio.end(), speech.begin(), speech.end());
+    hiss(0.3);
+    audio.resize(audio.size() + kRate / 2, 0);
+    const std::vector<tts::SpokenPhoneme> phonemes = {phoneme_at(0, 0), phoneme_at(1, 1),
+                                                      phoneme_at(0, 2)};
+    std::vector<double> starts = {static_cast<double>(hum_begins) + 0.01 * kRate,
+                                  static_cast<double>(speech_begins + speech.size())};
+    const double speech_ends = starts[1];
+    snap_to_silence(phonemes, audio, kRate, starts);
+    EXPECT_DOUBLE_EQ(starts[0], static_cast<double>(below_db > 20 ? speech_begins : hum_begins));
+    EXPECT_DOUBLE_EQ(starts[1], speech_ends);
+  }
+}
+
 // A stop out of a pause starts at its closure, kStopClosureMs before its release, which is the
 // edge of silence; another sound at the edge.
 TEST(Boundaries, StopOutOfAPauseStartsAtItsClosure) {
