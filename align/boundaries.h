@@ -59,11 +59,12 @@ inline constexpr float kFloorRangeDb = 90;
 // kal corpus 40 to 80 ms gave the same first-sound p90, 50 was chosen (docs/align.md).
 inline constexpr unsigned kStopClosureMs = 50;
 
-// Festival's lead-in carries a hum (kal: 160 ms at 24..26 dB below the loudest, then 45 ms of
-// silence), as loud as a weak consonant. Sound before the first sound that stays more than
-// kHumBelowLoudestDb below the loudest and ends in silence within kMaxHumMs is no speech: the
-// first sound starts after it. Chosen on kal's two such sentences (34 and 40): a fricative
-// before a stop's closure (/s/ of "st") is louder, a weak onset (/f/, /h/) runs into its vowel.
+// Festival's lead-in carries a hum (kal: 160 ms whose loudest 5 ms block is 24..26 dB below
+// the loudest, then 45 ms of silence), as loud as a weak consonant. Sound before the first
+// sound that stays more than kHumBelowLoudestDb below the loudest and ends in silence within
+// kMaxHumMs is no speech: the first sound starts after it. Chosen on kal's two such sentences
+// (34 and 40): a fricative before a stop's closure (/s/ of "st") is louder, a weak onset (/f/,
+// /h/) runs into its vowel.
 inline constexpr float kHumBelowLoudestDb = 22;
 inline constexpr unsigned kMaxHumMs = 300;
 
