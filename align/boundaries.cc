@@ -128,6 +128,21 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
     }
     return count;
   };
+  // From the edge at block `b`: the edge after the hum that `b` starts, or `b` when what
+  // follows it is louder or goes on without silence.
+  auto past_hum = [&](long b) {
+    constexpr long kMaxHumBlocks = kMaxHumMs / 5;
+    for (long e = b; e < static_cast<long>(n) && e - b <= kMaxHumBlocks; ++e) {
+      if (db[e] >= loudest - kHumBelowLoudestDb) return b;
+      const auto quiet = static_cast<long>(quiet_blocks(e, 1));
+      if (quiet >= static_cast<long>(kMinQuietBlocks)) {
+        if (e + quiet >= static_cast<long>(n)) return b;
+        b = e + quiet;
+        e = b - 1;
+      }
+    }
+    return b;
+  };
   for (size_t k = 1; k < phonemes.size() && k <= starts.size(); ++k) {
     const bool speech_ends = is_pause(phonemes[k]) && !is_pause(phonemes[k - 1]);
     const bool speech_begins = !is_pause(phonemes[k]) && is_pause(phonemes[k - 1]);
@@ -148,7 +163,8 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
         return -1L;
       }();
       if (found >= 0) {
-        starts[k - 1] = static_cast<double>(found) * static_cast<double>(block);
+        const long edge = speech_begins && k == 1 ? past_hum(found) : found;
+        starts[k - 1] = static_cast<double>(edge) * static_cast<double>(block);
         // A stop's closure is as silent as the pause before it: the edge is its release.
         if (speech_begins && is_stop(phonemes[k])) {
           starts[k - 1] = std::max(starts[k - 1] - double{kStopClosureMs} * rate / 1000, 0.0);

@@ -59,6 +59,15 @@ inline constexpr float kFloorRangeDb = 90;
 // kal corpus 40 to 80 ms gave the same first-sound p90, 50 was chosen (docs/align.md).
 inline constexpr unsigned kStopClosureMs = 50;
 
+// Festival's lead-in carries a hum (kal: 160 ms whose loudest 5 ms block is 24..26 dB below
+// the loudest, then 45 ms of silence), as loud as a weak consonant. Sound before the first
+// sound that stays more than kHumBelowLoudestDb below the loudest and ends in silence within
+// kMaxHumMs is no speech: the first sound starts after it. Chosen on kal's two such sentences
+// (34 and 40): a fricative before a stop's closure (/s/ of "st") is louder, a weak onset (/f/,
+// /h/) runs into its vowel.
+inline constexpr float kHumBelowLoudestDb = 22;
+inline constexpr unsigned kMaxHumMs = 300;
+
 // Moves each boundary next to a pause in `phonemes` (a start into a pause: speech ends; a
 // start out of one: speech begins) onto the nearest edge of silence in `audio` within
 // kSnapRadiusMs: the warp matches a fading end of speech with the synthetic pause. `starts[k]`
@@ -68,7 +77,8 @@ inline constexpr unsigned kStopClosureMs = 50;
 // kFloorRangeDb of the loudest: digital silence (zeros before or after the speech, however
 // long) has no level to be a floor. A stop (p t k b d g ch jh) out of a pause starts
 // kStopClosureMs before the edge: its closure is silent, the edge its release, and phonetic
-// labels (and the lips) start it at its closure.
+// labels (and the lips) start it at its closure. The first sound starts after any hum
+// (kHumBelowLoudestDb).
 void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
                      std::span<const int16_t> audio, unsigned rate, std::vector<double>& starts);
 

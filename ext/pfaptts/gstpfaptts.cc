@@ -287,14 +287,21 @@ static GstFlowReturn speak_piece(GstPfapTts* self, const pfap::tts::Utterance& p
                    speech.phonemes.size(), speech.samples.size(), GST_TIME_ARGS(s.position()));
   for (const pfap::tts::SpokenPhoneme& p : speech.phonemes) {
     if (ret != GST_FLOW_OK) break;
-    GstBuffer* buffer = pfap_buffer_new(p.event);
+    const GstClockTime start = s.time_at(first + p.start);
+    const GstClockTime end = s.time_at(first + p.start + p.n_samples);
+    // The duration on the stream's ms grid, as the PTS: a piece starts between two ms, and on
+    // its own grid (speak()'s) a phoneme could end 1 ms from where the next one starts. A split
+    // phoneme's 4095 ms piece may round to 4096 here: it stays 4095.
+    pfap::MarkupEvent event = p.event;
+    const auto ms = [](GstClockTime t) { return (t + GST_MSECOND / 2) / GST_MSECOND; };
+    event.phoneme.duration_ms = static_cast<uint16_t>(
+        std::min<GstClockTime>(ms(end) - ms(start), pfap::kMaxPhonemeDurationMs));
+    GstBuffer* buffer = pfap_buffer_new(event);
     if (buffer == nullptr) {
       // speak() keeps every value in range: a bug.
       GST_ELEMENT_ERROR(self, STREAM, FAILED, (nullptr), ("a phoneme x-pfap cannot hold"));
       return GST_FLOW_ERROR;
     }
-    const GstClockTime start = s.time_at(first + p.start);
-    const GstClockTime end = s.time_at(first + p.start + p.n_samples);
     GST_BUFFER_PTS(buffer) = start;
     GST_BUFFER_DURATION(buffer) = end - start;
     if (s.pfap_discont) GST_BUFFER_FLAG_SET(buffer, GST_BUFFER_FLAG_DISCONT);

@@ -274,6 +274,42 @@ TEST(Boundaries, DigitalSilenceIsNoFloorForTheEdges) {
   EXPECT_DOUBLE_EQ(starts[1], static_cast<double>(speech_ends));
 }
 
+// Festival's lead-in hum: 160 ms of a 100 Hz hum at -40 dBFS (25 dB below the speech), 45 ms
+// of hiss at the recording's floor, then the first sound. The warp puts the first sound at the hum,
+// whose start is an edge of silence too; the first sound starts after the hum (before, at the hum:
+// 205 ms early). A sound 15 dB below the speech before the same silence (an /s/ before a stop's
+// closure) is the first sound.
+TEST(Boundaries, FirstSoundStartsAfterAHum) {
+  constexpr unsigned kRate = 16000;
+  for (const int below_db : {25, 15}) {
+    SCOPED_TRACE(below_db);
+    std::vector<int16_t> audio(kRate / 2, 0);
+    const size_t hum_begins = audio.size();
+    std::vector<int16_t> hum = tone(100, 0.16, kRate);  // the speech's level, -15 dBFS
+    for (int16_t& x : hum) x = static_cast<int16_t>(x * std::pow(10.0, -below_db / 20.0));
+    audio.insert(audio.end(), hum.begin(), hum.end());
+    auto hiss = [&](double seconds) {  // -68 dBFS, the recording's floor
+      for (size_t i = 0; i < static_cast<size_t>(seconds * kRate); ++i) {
+        audio.push_back(static_cast<int16_t>((static_cast<int>(i % 7) - 3) * 6));
+      }
+    };
+    hiss(0.045);
+    const size_t speech_begins = audio.size();
+    const std::vector<int16_t> speech = tone(200, 0.5, kRate);
+    audio.insert(audio.end(), speech.begin(), speech.end());
+    hiss(0.3);
+    audio.resize(audio.size() + kRate / 2, 0);
+    const std::vector<tts::SpokenPhoneme> phonemes = {phoneme_at(0, 0), phoneme_at(1, 1),
+                                                      phoneme_at(0, 2)};
+    std::vector<double> starts = {static_cast<double>(hum_begins) + 0.01 * kRate,
+                                  static_cast<double>(speech_begins + speech.size())};
+    const double speech_ends = starts[1];
+    snap_to_silence(phonemes, audio, kRate, starts);
+    EXPECT_DOUBLE_EQ(starts[0], static_cast<double>(below_db > 20 ? speech_begins : hum_begins));
+    EXPECT_DOUBLE_EQ(starts[1], speech_ends);
+  }
+}
+
 // A stop out of a pause starts at its closure, kStopClosureMs before its release, which is the
 // edge of silence; another sound at the edge.
 TEST(Boundaries, StopOutOfAPauseStartsAtItsClosure) {
@@ -466,6 +502,27 @@ TEST(Aligner, LeadingSilenceIsAPause) {
     EXPECT_LT(error_ms, 50);
     EXPECT_EQ(a.phonemes.back().event.phoneme.symbol, 0);  // the second after: a pause
     EXPECT_TRUE(a.phonemes.back().event.phoneme.end_of_text);
+  }
+}
+
+// Issue 31: an alignment does not depend on what the process spoke before it (espeak-ng keeps
+// state between syntheses, tts/espeak.cc): the same recording and text give the same phonemes,
+// to the sample, after another sentence in another voice and at another rate.
+TEST(Aligner, SameInputGivesTheSameAlignmentWhateverWasSpokenBefore) {
+  const std::string text = "Always remember the open ocean.";
+  const tts::Speech truth = phonetic_truth(text, {"en-us", 140, 60, 100});
+  const Alignment first = aligned(text, truth.samples, truth.sample_rate);
+  for (const tts::VoiceSettings& before :
+       {tts::VoiceSettings{}, tts::VoiceSettings{"en-us", 300, 20, 150}}) {
+    SCOPED_TRACE(before.voice + " at " + std::to_string(before.rate));
+    say("The quick brown fox jumps over the lazy dog.", before);
+    const Alignment again = aligned(text, truth.samples, truth.sample_rate);
+    ASSERT_EQ(again.phonemes.size(), first.phonemes.size());
+    for (size_t k = 0; k < first.phonemes.size(); ++k) {
+      EXPECT_EQ(again.phonemes[k].start, first.phonemes[k].start) << "phoneme " << k;
+      EXPECT_EQ(again.phonemes[k].event.phoneme.symbol, first.phonemes[k].event.phoneme.symbol);
+    }
+    EXPECT_EQ(again.relative_cost, first.relative_cost);
   }
 }
 
