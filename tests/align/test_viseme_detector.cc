@@ -307,12 +307,17 @@ TEST(VisemeDetector, ModelNumbersAreChecked) {
   EXPECT_GT(VisemeModel::builtin().weights(), 10000u);
   EXPECT_LT(VisemeModel::builtin().weights(), 40000u);
   EXPECT_EQ(VisemeModel::from_numbers(std::vector<float>{}), nullptr);
-  EXPECT_EQ(VisemeModel::from_numbers(std::vector<float>{1, 13, 8, 4, 2, 2, 15}), nullptr);
-  std::vector<float> wrong_shape{1, 13, 8, 5, 2, 2, 15};
-  wrong_shape.resize(7 + 26 + 2 * 170 + 2 * 3 + 15 * 3);
+  EXPECT_EQ(VisemeModel::from_numbers(std::vector<float>{2, 13, 8, 4, 2, 2, 15}), nullptr);
+  // Kind 2: the means and scales of 13 coefficients, the cepstral prior of 12, the layers.
+  const size_t size = 7 + 26 + 12 + 2 * 170 + 2 * 3 + 15 * 3;
+  std::vector<float> wrong_shape{2, 13, 8, 5, 2, 2, 15};
+  wrong_shape.resize(size);
   EXPECT_EQ(VisemeModel::from_numbers(wrong_shape), nullptr);
-  std::vector<float> right{1, 13, 8, 4, 2, 2, 15};
-  right.resize(7 + 26 + 2 * 170 + 2 * 3 + 15 * 3);
+  std::vector<float> kind_1{1, 13, 8, 4, 2, 2, 15};  // before the cepstral mean
+  kind_1.resize(size);
+  EXPECT_EQ(VisemeModel::from_numbers(kind_1), nullptr);
+  std::vector<float> right{2, 13, 8, 4, 2, 2, 15};
+  right.resize(size);
   EXPECT_NE(VisemeModel::from_numbers(right), nullptr);
 }
 
