@@ -204,6 +204,57 @@ TEST(VisemeDetector, ClippedAndResampledSpeechStillAgrees) {
   std::printf("\n");
 }
 
+// A thin microphone's tilt (a first difference, 0.95: high frequencies 20 dB over the low)
+// moves c1..c12 alike in every frame; the running cepstral mean takes it out as the stream
+// goes (here the three sentences in one stream, 7 s). Measured: plain 70 %, tilted 70 %;
+// without the mean (the model before it), 63 % and 36 %.
+TEST(VisemeDetector, AMicrophonesTiltCostsLittle) {
+  std::vector<int16_t> stream;
+  std::vector<Viseme> truth;
+  unsigned rate = 0;
+  for (const char* text : kSentences) {
+    // Each sentence padded with silence to whole 20 ms, so that its frames stay its own.
+    Spoken s = spoken(text);
+    const size_t block = s.rate / 50;
+    s.samples.resize((s.samples.size() + block - 1) / block * block, 0);
+    s.truth.resize(s.samples.size() / block * 2, Viseme::kNone);
+    stream.insert(stream.end(), s.samples.begin(), s.samples.end());
+    truth.insert(truth.end(), s.truth.begin(), s.truth.end());
+    rate = s.rate;
+  }
+  std::vector<int16_t> tilted(stream.size());
+  for (size_t i = 0; i < stream.size(); ++i) {
+    const double previous = i > 0 ? stream[i - 1] : 0;
+    tilted[i] = static_cast<int16_t>(std::clamp(stream[i] - 0.95 * previous, -32768.0, 32767.0));
+  }
+  const double plain = viseme_agreement(frames_of(detect(stream, rate, rate / 50)), truth);
+  const double tilt = viseme_agreement(frames_of(detect(tilted, rate, rate / 50)), truth);
+  std::printf("agreement: plain %.2f, tilted %.2f\n", plain, tilt);
+  EXPECT_GT(tilt, plain - 0.1);
+}
+
+TEST(VisemeDetector, CepstralMeanFollowsTheFramesOfSound) {
+  std::vector<float> prior(kVisemeMfccs - 1, 1.0f);
+  CepstralMean mean(prior);
+  // A frame of sound whose c1..c12 are 3 over the prior: its first copy moves the mean 1 /
+  // kCepstralPriorFrames of the way, and after half a minute of it the frame reads as the prior.
+  std::vector<float> sound(kVisemeMfccs, 4.0f);
+  sound[0] = 0;
+  std::vector<float> frame = sound;
+  mean.apply(frame);
+  EXPECT_EQ(frame[0], 0.0f);
+  EXPECT_NEAR(frame[1], 4.0 - 3.0 / kCepstralPriorFrames, 1e-5);
+  for (int k = 0; k < 3000; ++k) frame = sound, mean.apply(frame);
+  for (size_t i = 1; i < kVisemeMfccs; ++i) EXPECT_NEAR(frame[i], 1.0, 0.01) << i;
+  // Quiet frames leave the mean where it is: a pause does not pull it.
+  std::vector<float> quiet(kVisemeMfccs, -20.0f);
+  quiet[0] = static_cast<float>(kCepstralSoundC0) - 1;
+  for (int k = 0; k < 1000; ++k) frame = quiet, mean.apply(frame);
+  frame = sound;
+  mean.apply(frame);
+  EXPECT_NEAR(frame[1], 1.0, 0.01);
+}
+
 // The phonemes of `samples` by VisemePhonemes, pushed in blocks of `block` samples; with
 // `pushed_at`, for each phoneme the samples pushed when it came out.
 std::vector<tts::SpokenPhoneme> viseme_phonemes(std::span<const int16_t> samples, unsigned rate,
