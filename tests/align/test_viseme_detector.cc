@@ -97,7 +97,7 @@ TEST(VisemeDetector, HeldOutVoiceAgreesWithItsPhonemesWellAboveTheBaseline) {
   std::printf("agreement %.1f %% of %zu frames (pauses %.1f %%), %.1f runs a second\n",
               100 * agreement, frames, 100.0 * static_cast<double>(pauses) / frames,
               static_cast<double>(runs_total) / seconds);
-  // Measured 70 to 80 % on these (docs/align.md); the baseline of one viseme is under 20 %.
+  // Measured 70 % on these (docs/align.md); the baseline of one viseme is under 20 %.
   EXPECT_GT(agreement, 0.50);
   // Smoothed: about 10 runs a second, not a flicker every frame or two.
   EXPECT_LT(static_cast<double>(runs_total) / seconds, 20);
@@ -195,11 +195,9 @@ TEST(VisemeDetector, ClippedAndResampledSpeechStillAgrees) {
     expect_tiles(runs, static_cast<double>(audio.size()) / rate);
     const double a = agreement(runs);
     std::printf(", %u Hz %.2f", rate, a);
-    // 8 kHz audio has nothing above 4 kHz, where the mel bands up to 7.6 kHz look and the
-    // training never saw such speech: a clear result, not a good one (docs/align.md).
-    if (rate != 8000) {
-      EXPECT_GT(a, plain - 0.15) << rate;
-    }
+    // 8 kHz audio has nothing above 4 kHz, where the mel bands up to 7.6 kHz look; the
+    // training has telephone copies at 8 kHz (measured 0.62 against 0.71; 0.05 before them).
+    EXPECT_GT(a, plain - (rate == 8000 ? 0.25 : 0.15)) << rate;
   }
   std::printf("\n");
 }
