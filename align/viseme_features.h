@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // The frame-level viseme detector's features, as the audio comes: any rate resampled to
-// 16 kHz, then 13 MFCCs (c0..c12) of a 25 ms window every 10 ms. Hand-written (no aubio) so
-// that web/src/viseme_detector.js computes the same numbers in a browser; the training
-// (tools/viseme-train) reads them from this code through tools/pfap-viseme-data.
+// 16 kHz, then 13 MFCCs (c0..c12) of a 25 ms window every 10 ms, and the running mean that
+// takes a channel out of c1..c12. Hand-written (no aubio) so that web/src/viseme_detector.js
+// computes the same numbers in a browser; the training (tools/viseme-train) reads the MFCCs
+// from this code through tools/pfap-viseme-data and computes the mean as CepstralMean does.
 // docs/align.md, "A viseme detector".
 #pragma once
 
