@@ -72,7 +72,7 @@ class MfccFrames {
 // A running mean of c1..c12 over the frames of sound, causal, taken from each frame: a
 // channel's spectral tilt (a microphone, a room, a codec) shifts them alike in every frame,
 // and goes with the mean. The mean starts at `prior` (the training set's, so that a stream's
-// first frames are as they come), weighted as kCepstralPriorFrames frames, and then follows
+// first frames are as they come), weighted as kCepstralPriorFrames - 1 frames, and then follows
 // about the last kCepstralMeanFrames frames of sound: alpha = 1 / min(kCepstralPriorFrames +
 // n, kCepstralMeanFrames) after n. A frame counts as sound when its c0 is above
 // kCepstralSoundC0: digital silence (-117) and a quiet room's hiss (LibriVox's pauses, -45
