@@ -13,7 +13,9 @@ namespace {
 constexpr size_t kContextFrames = kVisemePastFrames + 1 + kVisemeAheadFrames;
 constexpr size_t kInputs = kContextFrames * kVisemeMfccs;
 constexpr size_t kHeader = 7;  // kind, mfccs, past, ahead, hidden1, hidden2, visemes
-constexpr float kKind = 1;
+constexpr float kKind = 2;     // 2: with the cepstral mean's prior
+// The numbers before the layers: the inputs' means and scales, and the cepstral mean's prior.
+constexpr size_t kNormalization = 2 * kVisemeMfccs + (kVisemeMfccs - 1);
 
 // The model tools/viseme-train wrote: its numbers, C++ and JavaScript read the same file.
 constexpr float kBuiltinNumbers[] = {
@@ -50,8 +52,7 @@ std::unique_ptr<VisemeModel> VisemeModel::from_numbers(std::span<const float> n)
   model->hidden1_ = static_cast<size_t>(n[4]);
   model->hidden2_ = static_cast<size_t>(n[5]);
   const size_t h1 = model->hidden1_, h2 = model->hidden2_;
-  const size_t want = 2 * kVisemeMfccs + h1 * (kInputs + 1) + h2 * (h1 + 1) +
-                      kVisemeCount * (h2 + 1);
+  const size_t want = kNormalization + h1 * (kInputs + 1) + h2 * (h1 + 1) + kVisemeCount * (h2 + 1);
   if (n.size() != kHeader + want) return nullptr;
   model->params_.assign(n.begin() + kHeader, n.end());
   return model;
@@ -61,7 +62,7 @@ void VisemeModel::probabilities(std::span<const float> context, std::span<float>
   const float* p = params_.data();
   const float* mean = p;
   const float* scale = p + kVisemeMfccs;
-  p += 2 * kVisemeMfccs;
+  p += kNormalization;
   std::array<float, kInputs> x;
   for (size_t i = 0; i < kInputs; ++i) {
     x[i] = (context[i] - mean[i % kVisemeMfccs]) * scale[i % kVisemeMfccs];
@@ -89,7 +90,11 @@ void VisemeModel::probabilities(std::span<const float> context, std::span<float>
 
 VisemeDetector::VisemeDetector(unsigned rate, size_t max_run_frames, VisemeSmoothing smoothing,
                                const VisemeModel& model)
-    : model_(model), max_run_frames_(max_run_frames), smoothing_(smoothing), resampler_(rate) {
+    : model_(model),
+      max_run_frames_(max_run_frames),
+      smoothing_(smoothing),
+      resampler_(rate),
+      cepstral_mean_(model.cepstral_prior()) {
   for (size_t k = 0; k < kVisemePastFrames; ++k) {
     context_.insert(context_.end(), silence_frame().begin(), silence_frame().end());
   }
@@ -106,6 +111,7 @@ void VisemeDetector::push(std::span<const float> samples, std::vector<VisemeRun>
   resampler_.push(samples, resampled_);
   coefficients_.clear();
   mfcc_.push(resampled_, coefficients_);
+  cepstral_mean_.apply(coefficients_);
   take_frames(out);
 }
 
@@ -115,6 +121,7 @@ void VisemeDetector::finish(std::vector<VisemeRun>& out) {
   coefficients_.clear();
   mfcc_.push(resampled_, coefficients_);
   mfcc_.finish(coefficients_);
+  cepstral_mean_.apply(coefficients_);
   take_frames(out);
   // The frames ahead of the last ones are silence.
   while (classified_ < mfcc_.frames()) {

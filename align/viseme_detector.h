@@ -78,10 +78,14 @@ class VisemeModel {
   // kVisemeAheadFrames frames of kVisemeMfccs, oldest first), into `out` (kVisemeCount).
   void probabilities(std::span<const float> context, std::span<float> out) const;
   size_t weights() const { return params_.size(); }
+  // The training set's mean of c1..c12 over frames of sound: where CepstralMean starts.
+  std::span<const float> cepstral_prior() const {
+    return std::span(params_).subspan(2 * kVisemeMfccs, kVisemeMfccs - 1);
+  }
 
  private:
   size_t hidden1_ = 0, hidden2_ = 0;
-  std::vector<float> params_;  // mean, scale, then W1 b1 W2 b2 W3 b3, row-major
+  std::vector<float> params_;  // mean, scale, cepstral prior, then W1 b1 W2 b2 W3 b3, row-major
 };
 
 class VisemeDetector {
@@ -114,6 +118,7 @@ class VisemeDetector {
   VisemeSmoothing smoothing_;
   Resampler resampler_;
   MfccFrames mfcc_;
+  CepstralMean cepstral_mean_;
   std::vector<float> resampled_, coefficients_;
   std::vector<float> context_;  // the last frames' coefficients, oldest first
   uint64_t classified_ = 0;     // frames whose probabilities are known

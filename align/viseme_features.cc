@@ -190,6 +190,24 @@ void MfccFrames::finish(std::vector<float>& out) {
   }
 }
 
+CepstralMean::CepstralMean(std::span<const float> prior)
+    : prior_(prior.begin(), prior.end()), mean_(prior_) {}
+
+void CepstralMean::apply(std::span<float> coefficients) {
+  for (size_t at = 0; at + kVisemeMfccs <= coefficients.size(); at += kVisemeMfccs) {
+    float* c = coefficients.data() + at;
+    if (c[0] > kCepstralSoundC0) {
+      const double alpha = 1.0 / static_cast<double>(std::min(kCepstralPriorFrames + sound_frames_,
+                                                              kCepstralMeanFrames));
+      for (size_t i = 1; i < kVisemeMfccs; ++i) mean_[i - 1] += alpha * (c[i] - mean_[i - 1]);
+      ++sound_frames_;
+    }
+    for (size_t i = 1; i < kVisemeMfccs; ++i) {
+      c[i] = static_cast<float>(static_cast<double>(c[i]) - mean_[i - 1] + prior_[i - 1]);
+    }
+  }
+}
+
 std::vector<float> viseme_features(std::span<const int16_t> samples, unsigned rate) {
   std::vector<float> in(samples.size()), resampled, out;
   for (size_t i = 0; i < samples.size(); ++i) in[i] = static_cast<float>(samples[i]) / 32768;

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // The frame-level viseme detector's features, as the audio comes: any rate resampled to
-// 16 kHz, then 13 MFCCs (c0..c12) of a 25 ms window every 10 ms. Hand-written (no aubio) so
-// that web/src/viseme_detector.js computes the same numbers in a browser; the training
-// (tools/viseme-train) reads them from this code through tools/pfap-viseme-data.
+// 16 kHz, then 13 MFCCs (c0..c12) of a 25 ms window every 10 ms, and the running mean that
+// takes a channel out of c1..c12. Hand-written (no aubio) so that web/src/viseme_detector.js
+// computes the same numbers in a browser; the training (tools/viseme-train) reads the MFCCs
+// from this code through tools/pfap-viseme-data and computes the mean as CepstralMean does.
 // docs/align.md, "A viseme detector".
 #pragma once
 
@@ -66,6 +67,29 @@ class MfccFrames {
   size_t samples_ = 0;  // pushed in all
   std::vector<float> window_, mel_, dct_;  // tables
   std::vector<size_t> mel_first_;          // each band's first FFT bin
+};
+
+// A running mean of c1..c12 over the frames of sound, causal, taken from each frame: a
+// channel's spectral tilt (a microphone, a room, a codec) shifts them alike in every frame,
+// and goes with the mean. The mean starts at `prior` (the training set's, so that a stream's
+// first frames are as they come), weighted as kCepstralPriorFrames - 1 frames, and then follows
+// about the last kCepstralMeanFrames frames of sound: alpha = 1 / min(kCepstralPriorFrames +
+// n, kCepstralMeanFrames) after n. A frame counts as sound when its c0 is above
+// kCepstralSoundC0: digital silence (-117) and a quiet room's hiss (LibriVox's pauses, -45
+// to -37) do not move it; speech is mostly above -30.
+// Each frame becomes c1..c12 less the mean plus `prior`; c0 (the level) stays.
+inline constexpr size_t kCepstralPriorFrames = 100;
+inline constexpr size_t kCepstralMeanFrames = 300;
+inline constexpr double kCepstralSoundC0 = -35;
+class CepstralMean {
+ public:
+  explicit CepstralMean(std::span<const float> prior);  // kVisemeMfccs - 1 values
+  // Takes the mean from each frame of `coefficients` (kVisemeMfccs each), in place.
+  void apply(std::span<float> coefficients);
+
+ private:
+  std::vector<double> prior_, mean_;
+  size_t sound_frames_ = 0;
 };
 
 // The frames of a whole recording at `rate`, as the two classes give them (frames x

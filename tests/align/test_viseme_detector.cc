@@ -97,7 +97,7 @@ TEST(VisemeDetector, HeldOutVoiceAgreesWithItsPhonemesWellAboveTheBaseline) {
   std::printf("agreement %.1f %% of %zu frames (pauses %.1f %%), %.1f runs a second\n",
               100 * agreement, frames, 100.0 * static_cast<double>(pauses) / frames,
               static_cast<double>(runs_total) / seconds);
-  // Measured 70 to 80 % on these (docs/align.md); the baseline of one viseme is under 20 %.
+  // Measured 73.5 % on these (docs/align.md); the baseline of one viseme is under 20 %.
   EXPECT_GT(agreement, 0.50);
   // Smoothed: about 10 runs a second, not a flicker every frame or two.
   EXPECT_LT(static_cast<double>(runs_total) / seconds, 20);
@@ -195,13 +195,62 @@ TEST(VisemeDetector, ClippedAndResampledSpeechStillAgrees) {
     expect_tiles(runs, static_cast<double>(audio.size()) / rate);
     const double a = agreement(runs);
     std::printf(", %u Hz %.2f", rate, a);
-    // 8 kHz audio has nothing above 4 kHz, where the mel bands up to 7.6 kHz look and the
-    // training never saw such speech: a clear result, not a good one (docs/align.md).
-    if (rate != 8000) {
-      EXPECT_GT(a, plain - 0.15) << rate;
-    }
+    // 8 kHz audio has nothing above 4 kHz, where the mel bands up to 7.6 kHz look; the
+    // training has telephone copies at 8 kHz (measured 0.63 against 0.72; 0.05 before them).
+    EXPECT_GT(a, plain - (rate == 8000 ? 0.25 : 0.15)) << rate;
   }
   std::printf("\n");
+}
+
+// A thin microphone's tilt (a first difference, 0.95: high frequencies 20 dB over the low)
+// moves c1..c12 alike in every frame; the running cepstral mean takes it out as the stream
+// goes (here the three sentences in one stream, 7 s). Measured: plain 74 %, tilted 73 %;
+// without the mean (the model before it), 63 % and 36 %.
+TEST(VisemeDetector, AMicrophonesTiltCostsLittle) {
+  std::vector<int16_t> stream;
+  std::vector<Viseme> truth;
+  unsigned rate = 0;
+  for (const char* text : kSentences) {
+    // Each sentence padded with silence to whole 20 ms, so that its frames stay its own.
+    Spoken s = spoken(text);
+    const size_t block = s.rate / 50;
+    s.samples.resize((s.samples.size() + block - 1) / block * block, 0);
+    s.truth.resize(s.samples.size() / block * 2, Viseme::kNone);
+    stream.insert(stream.end(), s.samples.begin(), s.samples.end());
+    truth.insert(truth.end(), s.truth.begin(), s.truth.end());
+    rate = s.rate;
+  }
+  std::vector<int16_t> tilted(stream.size());
+  for (size_t i = 0; i < stream.size(); ++i) {
+    const double previous = i > 0 ? stream[i - 1] : 0;
+    tilted[i] = static_cast<int16_t>(std::clamp(stream[i] - 0.95 * previous, -32768.0, 32767.0));
+  }
+  const double plain = viseme_agreement(frames_of(detect(stream, rate, rate / 50)), truth);
+  const double tilt = viseme_agreement(frames_of(detect(tilted, rate, rate / 50)), truth);
+  std::printf("agreement: plain %.2f, tilted %.2f\n", plain, tilt);
+  EXPECT_GT(tilt, plain - 0.1);
+}
+
+TEST(VisemeDetector, CepstralMeanFollowsTheFramesOfSound) {
+  std::vector<float> prior(kVisemeMfccs - 1, 1.0f);
+  CepstralMean mean(prior);
+  // A frame of sound whose c1..c12 are 3 over the prior: its first copy moves the mean 1 /
+  // kCepstralPriorFrames of the way, and after half a minute of it the frame reads as the prior.
+  std::vector<float> sound(kVisemeMfccs, 4.0f);
+  sound[0] = 0;
+  std::vector<float> frame = sound;
+  mean.apply(frame);
+  EXPECT_EQ(frame[0], 0.0f);
+  EXPECT_NEAR(frame[1], 4.0 - 3.0 / kCepstralPriorFrames, 1e-5);
+  for (int k = 0; k < 3000; ++k) frame = sound, mean.apply(frame);
+  for (size_t i = 1; i < kVisemeMfccs; ++i) EXPECT_NEAR(frame[i], 1.0, 0.01) << i;
+  // Quiet frames leave the mean where it is: a pause does not pull it.
+  std::vector<float> quiet(kVisemeMfccs, -20.0f);
+  quiet[0] = static_cast<float>(kCepstralSoundC0) - 1;
+  for (int k = 0; k < 1000; ++k) frame = quiet, mean.apply(frame);
+  frame = sound;
+  mean.apply(frame);
+  EXPECT_NEAR(frame[1], 1.0, 0.01);
 }
 
 // The phonemes of `samples` by VisemePhonemes, pushed in blocks of `block` samples; with
@@ -307,12 +356,17 @@ TEST(VisemeDetector, ModelNumbersAreChecked) {
   EXPECT_GT(VisemeModel::builtin().weights(), 10000u);
   EXPECT_LT(VisemeModel::builtin().weights(), 40000u);
   EXPECT_EQ(VisemeModel::from_numbers(std::vector<float>{}), nullptr);
-  EXPECT_EQ(VisemeModel::from_numbers(std::vector<float>{1, 13, 8, 4, 2, 2, 15}), nullptr);
-  std::vector<float> wrong_shape{1, 13, 8, 5, 2, 2, 15};
-  wrong_shape.resize(7 + 26 + 2 * 170 + 2 * 3 + 15 * 3);
+  EXPECT_EQ(VisemeModel::from_numbers(std::vector<float>{2, 13, 8, 4, 2, 2, 15}), nullptr);
+  // Kind 2: the means and scales of 13 coefficients, the cepstral prior of 12, the layers.
+  const size_t size = 7 + 26 + 12 + 2 * 170 + 2 * 3 + 15 * 3;
+  std::vector<float> wrong_shape{2, 13, 8, 5, 2, 2, 15};
+  wrong_shape.resize(size);
   EXPECT_EQ(VisemeModel::from_numbers(wrong_shape), nullptr);
-  std::vector<float> right{1, 13, 8, 4, 2, 2, 15};
-  right.resize(7 + 26 + 2 * 170 + 2 * 3 + 15 * 3);
+  std::vector<float> kind_1{1, 13, 8, 4, 2, 2, 15};  // before the cepstral mean
+  kind_1.resize(size);
+  EXPECT_EQ(VisemeModel::from_numbers(kind_1), nullptr);
+  std::vector<float> right{2, 13, 8, 4, 2, 2, 15};
+  right.resize(size);
   EXPECT_NE(VisemeModel::from_numbers(right), nullptr);
 }
 

@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // The frame-level viseme detector of align/viseme_detector.{h,cc} in JavaScript, step by
 // step the same (tests/web checks that both give the same visemes on the same audio): any
-// rate resampled to 16 kHz, 13 MFCCs of a 25 ms window every 10 ms, a small network over 8
-// frames before and 4 after (align/viseme_model.txt), smoothed into runs of the 15 Oculus
-// visemes. At most 60 ms of audio ahead. docs/align.md, "A viseme detector".
+// rate resampled to 16 kHz, 13 MFCCs of a 25 ms window every 10 ms, c1..c12 less their
+// running mean over the stream, a small network over 8 frames before and 4 after
+// (align/viseme_model.txt), smoothed into runs of the 15 Oculus visemes. At most 60 ms of audio ahead. docs/align.md, "A viseme detector".
 
 /** The alphabet of the detector's phonemes: symbol k is Oculus viseme k (= MPEG-4 viseme k). */
 export const OCULUS_VISEME_ALPHABET = 'x-pfap-oculus-viseme';
@@ -39,6 +39,11 @@ const INPUTS = CONTEXT * MFCCS;
 const VISEMES = 15;
 const SMOOTH = 1;
 const HEADER = 7;
+const KIND = 2;  // 2: with the cepstral mean's prior
+const NORMALIZATION = 2 * MFCCS + (MFCCS - 1);  // means, scales, cepstral prior
+const CEPSTRAL_PRIOR_FRAMES = 100;
+const CEPSTRAL_MEAN_FRAMES = 300;
+const CEPSTRAL_SOUND_C0 = -35;
 
 /** Audio after a frame's end that settles it, in ms (kVisemeLookaheadMs). */
 export const VISEME_LOOKAHEAD_MS =
@@ -221,6 +226,28 @@ class MfccFrames {
   }
 }
 
+// A running mean of c1..c12 over the frames of sound, taken from each frame (CepstralMean).
+class CepstralMean {
+  constructor(prior) {
+    this.prior = Float64Array.from(prior);
+    this.mean = Float64Array.from(prior);
+    this.soundFrames = 0;
+  }
+
+  apply(coefficients) {
+    for (let at = 0; at + MFCCS <= coefficients.length; at += MFCCS) {
+      if (coefficients[at] > CEPSTRAL_SOUND_C0) {
+        const alpha = 1 / Math.min(CEPSTRAL_PRIOR_FRAMES + this.soundFrames, CEPSTRAL_MEAN_FRAMES);
+        for (let i = 1; i < MFCCS; i++) this.mean[i - 1] += alpha * (coefficients[at + i] - this.mean[i - 1]);
+        this.soundFrames++;
+      }
+      for (let i = 1; i < MFCCS; i++) {
+        coefficients[at + i] = f32(coefficients[at + i] - this.mean[i - 1] + this.prior[i - 1]);
+      }
+    }
+  }
+}
+
 const SILENCE_FRAME = (() => {
   const out = [];
   new MfccFrames().push(new Float32Array(WINDOW), out);
@@ -239,8 +266,8 @@ export function parseVisemeModel(text) {
     .filter((s) => s !== '')
     .map(Number);
   const [kind, mfccs, past, ahead, hidden1, hidden2, visemes] = numbers;
-  const want = HEADER + 2 * MFCCS + hidden1 * (INPUTS + 1) + hidden2 * (hidden1 + 1) + VISEMES * (hidden2 + 1);
-  if (kind !== 1 || mfccs !== MFCCS || past !== PAST || ahead !== AHEAD || visemes !== VISEMES ||
+  const want = HEADER + NORMALIZATION + hidden1 * (INPUTS + 1) + hidden2 * (hidden1 + 1) + VISEMES * (hidden2 + 1);
+  if (kind !== KIND || mfccs !== MFCCS || past !== PAST || ahead !== AHEAD || visemes !== VISEMES ||
       !(hidden1 >= 1 && hidden1 <= 1024 && hidden2 >= 1 && hidden2 <= 1024) ||
       numbers.length !== want || numbers.some((n) => !Number.isFinite(n))) {
     throw new Error('not a viseme model of this version (align/viseme_model.txt)');
@@ -250,7 +277,7 @@ export function parseVisemeModel(text) {
 
 function probabilities(model, context, out) {
   const { params, hidden1, hidden2 } = model;
-  let p = 2 * MFCCS;
+  let p = NORMALIZATION;
   const x = new Float32Array(INPUTS);
   for (let i = 0; i < INPUTS; i++) {
     x[i] = f32(context[i] - params[i % MFCCS]) * params[MFCCS + (i % MFCCS)];
@@ -299,6 +326,7 @@ export class VisemeDetector {
     this.traceTo = trace;
     this.resampler = new Resampler(rate);
     this.mfcc = new MfccFrames();
+    this.cepstralMean = new CepstralMean(model.params.subarray(2 * MFCCS, NORMALIZATION));
     this.context = [];
     for (let k = 0; k < PAST; k++) this.context.push(...SILENCE_FRAME);
     this.classified = 0;
@@ -322,6 +350,7 @@ export class VisemeDetector {
     this.resampler.push(samples, resampled);
     const coefficients = [];
     this.mfcc.push(resampled, coefficients);
+    this.cepstralMean.apply(coefficients);
     this.takeFrames(coefficients, out);
     return out;
   }
@@ -334,6 +363,7 @@ export class VisemeDetector {
     const coefficients = [];
     this.mfcc.push(resampled, coefficients);
     this.mfcc.finish(coefficients);
+    this.cepstralMean.apply(coefficients);
     this.takeFrames(coefficients, out);
     while (this.classified < this.mfcc.frames) this.takeFrames(SILENCE_FRAME, out);
     while (this.decided < this.classified) this.decide(out);

@@ -68,7 +68,11 @@ test('the JavaScript detector gives the C++ one\'s visemes on the same audio', {
 test('the model file is checked, and the detector declares at most 60 ms ahead', () => {
   assert.ok(VISEME_LOOKAHEAD_MS <= 60);
   assert.equal(OCULUS_VISEMES.length, 15);
-  assert.throws(() => parseVisemeModel('1, 13, 8, 4, 2, 2, 15'), /not a viseme model/);
+  assert.throws(() => parseVisemeModel('2, 13, 8, 4, 2, 2, 15'), /not a viseme model/);
+  // A kind-1 model (before the cepstral mean) is refused.
+  const kind1 = `1, 13, 8, 4, 2, 2, 15, ${new Array(26 + 12 + 2 * 170 + 2 * 3 + 15 * 3).fill(0).join(', ')}`;
+  assert.throws(() => parseVisemeModel(kind1), /not a viseme model/);
+  assert.doesNotThrow(() => parseVisemeModel(kind1.replace(/^1/, '2')));
   assert.throws(() => parseVisemeModel('// nothing'), /not a viseme model/);
   assert.throws(() => new VisemeDetector(16000), /needs a model/);
   // Silence: one pause run covering every frame, at any rate.
