@@ -108,7 +108,7 @@ function detectorFrames({ rate, samples }) {
   return { envelope, frames };
 }
 
-// In the page: two bursts of noise, 0.3 s each, the second 1 s after the first, through the
+// In the page: two bursts of a sawtooth, 0.3 s each, the second 1 s after the first, through the
 // worklet, with nothing connected to it for a while between them (its input then has no
 // channels); resolves to the worklet's viseme messages as [frame, viseme].
 async function burstsThroughWorklet() {
@@ -118,10 +118,10 @@ async function burstsThroughWorklet() {
   const node = new AudioWorkletNode(context, 'pfap-viseme-detector', { processorOptions: { modelText } });
   node.connect(context.destination);
   const burst = context.createBuffer(1, Math.round(0.3 * context.sampleRate), context.sampleRate);
-  let seed = 30;
+  // A 150 Hz sawtooth, voiced as a vowel is: the detector hears it as sound (white noise, to
+  // the model with the cepstral mean, is silence).
   burst.getChannelData(0).forEach((_, i, samples) => {
-    seed = (seed * 1103515245 + 12345) % 2147483648;
-    samples[i] = 0.3 * (seed / 2147483648 - 0.5);
+    samples[i] = 0.3 * (((i * 150) / context.sampleRate) % 1 - 0.5);
   });
   const visemes = [];
   node.port.onmessage = ({ data }) => data.type === 'viseme' && visemes.push([data.frame, data.viseme]);
@@ -197,14 +197,14 @@ test('the worklet\'s frames keep the context\'s time when its input stops and co
   try {
     const page = await newPage(browser, `${server.url}/web/examples/viseme-detector.html`);
     const visemes = await page.evaluate(burstsThroughWorklet);
-    const text = `noise at frames 0..30 and 100..130: visemes [frame, viseme] ${JSON.stringify(visemes)}`;
+    const text = `a sawtooth at frames 0..30 and 100..130: visemes [frame, viseme] ${JSON.stringify(visemes)}`;
     console.log(text);
-    // The same noise after silence gives the same visemes, 100 frames later (before, the
-    // input's gap left out, 20 frames early).
+    // The same sound after silence is heard 100 frames later (before, the input's gap left
+    // out, 20 frames early); within 5 frames, as the smoothing may settle a frame or two apart.
     const first = visemes.find(([frame, viseme]) => frame < 50 && viseme !== 0);
     const second = visemes.find(([frame, viseme]) => frame >= 60 && viseme !== 0);
     assert.ok(first && second, text);
-    assert.ok(Math.abs(second[0] - first[0] - 100) <= 2, text);
+    assert.ok(Math.abs(second[0] - first[0] - 100) <= 5, text);
     await page.close();
   } finally {
     await browser.close();
