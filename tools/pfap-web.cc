@@ -252,6 +252,9 @@ void finish(Session& s, JsonBuilder* b) {
   send_json(s, b);
 }
 
+// The thread of main(), where the sessions live.
+const std::thread::id kMainThread = std::this_thread::get_id();
+
 // Runs `f` on the main thread if the session is still open then.
 void post(const std::shared_ptr<Session>& session, std::function<void(Session&)> f) {
   struct Call {
@@ -262,6 +265,10 @@ void post(const std::shared_ptr<Session>& session, std::function<void(Session&)>
       nullptr, G_PRIORITY_DEFAULT,
       [](gpointer data) -> gboolean {
         auto* call = static_cast<Call*>(data);
+        if (std::this_thread::get_id() != kMainThread) {
+          g_critical("pfap-web: session %d: a call for the main thread ran on another",
+                     call->session->id);
+        }
         if (!call->session->closed) call->f(*call->session);
         return G_SOURCE_REMOVE;
       },
