@@ -6,7 +6,9 @@ each until its first PFAP packet; then every second peer leaves (closes its peer
 WebSocket) as the server gets SIGTERM, so that sessions closing as their peers leave and
 sessions stopped by the server meet. RUNS times with --stop-timeout=10: the server must exit 0
 with "pfap-web: stopped" within BOUND_S, and every peer that stayed must see its WebSocket
-closed. Then once with --stop-timeout=0.001, shorter than any stop: it must exit 3 within
+closed. Then once the same with 2N sessions whose peers ask for a short text each time one
+starts, a second after the first packets, so that texts end and start as the stop closes the
+sessions. Then once with --stop-timeout=0.001, shorter than any stop: it must exit 3 within
 BOUND_S with the line naming the session it was stopping and those not stopped yet (or the
 main loop, if the signal came before the stop began). The server
 must print no GLib CRITICAL. A server that
@@ -107,10 +109,12 @@ async def main():
         if r is None or r[0] != 0 or 'pfap-web: stopped' not in r[1]:
             ok = False
             print(f'not stopped cleanly: {r and r[0]}\n{r and r[2][-3000:]}', file=sys.stderr)
-    # Texts ending and starting while the stop closes the sessions: the calls their streaming
-    # threads post must still run on the main thread, after their session is closed, not on
-    # those threads beside close_session (GLib CRITICALs, a speaker disposed in PAUSED).
-    r = await run(sessions, STOP_TIMEOUT_S, short=True)
+    # Texts ending and starting while the stop closes twice as many sessions: the calls their
+    # streaming threads post must still run on the main thread, after their session is closed,
+    # not on those threads beside close_session (GLib CRITICALs, a speaker disposed in PAUSED,
+    # a stop that hung: 2 of 3 such stops of 20 sessions in the sanitizer build before the fix,
+    # 0 of 4 of 10).
+    r = await run(2 * sessions, STOP_TIMEOUT_S, short=True)
     if r is None or r[0] != 0 or 'pfap-web: stopped' not in r[1]:
         ok = False
         print(f'not stopped cleanly with short texts: {r and r[0]}\n{r and r[2][-3000:]}',
