@@ -112,8 +112,8 @@ async def main():
     # Texts ending and starting while the stop closes twice as many sessions: the calls their
     # streaming threads post must still run on the main thread, after their session is closed,
     # not on those threads beside close_session (GLib CRITICALs, a speaker disposed in PAUSED,
-    # a stop that hung: 2 of 3 such stops of 20 sessions in the sanitizer build before the fix,
-    # 0 of 4 of 10).
+    # stops that hung: 5 of 7 such stops of 20 sessions in the sanitizer build before the fix,
+    # 0 of 4 of 10; docs/web.md, "Stopping").
     r = await run(2 * sessions, STOP_TIMEOUT_S, short=True)
     if r is None or r[0] != 0 or 'pfap-web: stopped' not in r[1]:
         ok = False
