@@ -252,20 +252,35 @@ void finish(Session& s, JsonBuilder* b) {
   send_json(s, b);
 }
 
-// Runs `f` on the main thread if the session is still open then.
+// The thread of main(), where the sessions live.
+const std::thread::id kMainThread = std::this_thread::get_id();
+
+// Runs `f` on the main thread, from its main loop, if the session is still open then. Never
+// at once, as g_main_context_invoke would: called from the main thread, `f` would run inside a
+// GStreamer call; called from a streaming thread while the main loop is not running (as the
+// stop closes the sessions one by one), it would run on that thread, beside close_session
+// (a speaker bin started that way on a pipeline going to NULL was disposed in PAUSED).
 void post(const std::shared_ptr<Session>& session, std::function<void(Session&)> f) {
   struct Call {
     std::shared_ptr<Session> session;
     std::function<void(Session&)> f;
   };
-  g_main_context_invoke_full(
-      nullptr, G_PRIORITY_DEFAULT,
+  GSource* source = g_idle_source_new();
+  g_source_set_priority(source, G_PRIORITY_DEFAULT);
+  g_source_set_callback(
+      source,
       [](gpointer data) -> gboolean {
         auto* call = static_cast<Call*>(data);
+        if (std::this_thread::get_id() != kMainThread) {
+          g_critical("pfap-web: session %d: a call for the main thread ran on another",
+                     call->session->id);
+        }
         if (!call->session->closed) call->f(*call->session);
         return G_SOURCE_REMOVE;
       },
       new Call{session, std::move(f)}, [](gpointer data) { delete static_cast<Call*>(data); });
+  g_source_attach(source, nullptr);
+  g_source_unref(source);
 }
 
 std::shared_ptr<Session> session_of(gpointer data) {

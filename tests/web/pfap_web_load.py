@@ -170,11 +170,13 @@ async def add_candidate(pc, m):
     await pc.addIceCandidate(c)
 
 
-async def playing_peer(port, first_packet, leave, until=()):
+async def playing_peer(port, first_packet, leave, until=(), again=None):
     """A peer that connects, answers the offer, says it plays once its data channel opens, and
     sets `first_packet` at its first PFAP packet. It leaves (closes its peer connection and
     WebSocket) when `leave` is set, returning 'left', or at the first message whose type is in
-    `until`, returning that type. Raises what the WebSocket raises when the server closes it."""
+    `until`, returning that type. With `again`, it asks for that text each time the server
+    starts one, so that the next always waits. Raises what the WebSocket raises when the server
+    closes it."""
     from aiortc import RTCPeerConnection
 
     pc = RTCPeerConnection()
@@ -199,6 +201,8 @@ async def playing_peer(port, first_packet, leave, until=()):
                 await answer_offer(pc, ws, m)
             elif m['type'] == 'ice' and m['candidate']:
                 await add_candidate(pc, m)
+            elif m['type'] == 'saying' and again is not None:
+                ws.send({'type': 'say', 'text': again})
             elif m['type'] in until:
                 return m['type']
     finally:

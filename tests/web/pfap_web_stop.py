@@ -6,7 +6,9 @@ each until its first PFAP packet; then every second peer leaves (closes its peer
 WebSocket) as the server gets SIGTERM, so that sessions closing as their peers leave and
 sessions stopped by the server meet. RUNS times with --stop-timeout=10: the server must exit 0
 with "pfap-web: stopped" within BOUND_S, and every peer that stayed must see its WebSocket
-closed. Then once with --stop-timeout=0.001, shorter than any stop: it must exit 3 within
+closed. Then once the same with 2N sessions whose peers ask for a short text each time one
+starts, a second after the first packets, so that texts end and start as the stop closes the
+sessions. Then once with --stop-timeout=0.001, shorter than any stop: it must exit 3 within
 BOUND_S with the line naming the session it was stopping and those not stopped yet (or the
 main loop, if the signal came before the stop began). The server
 must print no GLib CRITICAL. A server that
@@ -26,17 +28,20 @@ import time
 from pfap_web_load import enter_network_namespace, playing_peer, skip_opus_decoding, start_server
 
 TEXT = ' '.join(['One, <FAP 3 100 400 1> two, three, four, five, six, seven, eight.'] * 6)
+# Short texts, each asked for as the one before starts: texts end and start as the stop closes
+# the sessions one by one.
+SHORT_TEXT = 'One, <FAP 3 100 400 1> two.'
 # The server's default deadline: the sanitizer build's stops of 10 sessions took 1.3 to 3.2 s.
 STOP_TIMEOUT_S = 10
 # The deadline, and what the process's end may take after it.
 BOUND_S = STOP_TIMEOUT_S + 5
 
 
-async def open_session(port, first_packet, leave):
+async def open_session(port, first_packet, leave, again):
     """A playing peer (pfap_web_load.playing_peer) that waits until the server closes its
     WebSocket (True) or `leave` is set (False)."""
     try:
-        await playing_peer(port, first_packet, leave)
+        await playing_peer(port, first_packet, leave, again=again)
         return False
     except (ConnectionError, asyncio.IncompleteReadError):
         return True
@@ -51,14 +56,21 @@ def stacks(pid):
                        stdout=sys.stderr, stderr=subprocess.DEVNULL, timeout=120)
 
 
-async def run(sessions, stop_timeout_s):
+async def run(sessions, stop_timeout_s, short=False):
     """One server with `sessions` open, stopped; its exit status and what it printed, or None
-    if it took longer than BOUND_S or not every peer that stayed saw its WebSocket closed."""
-    server, port = start_server([f'--text={TEXT}', f'--stop-timeout={stop_timeout_s}'])
+    if it took longer than BOUND_S or not every peer that stayed saw its WebSocket closed.
+    `short`: the peers ask for SHORT_TEXT again and again, and the signal comes a second after
+    the first packets."""
+    server, port = start_server([f'--text={SHORT_TEXT if short else TEXT}',
+                                 f'--stop-timeout={stop_timeout_s}'])
     packets = [asyncio.Event() for _ in range(sessions)]
     leave = [asyncio.Event() for _ in range(sessions)]
-    peers = [asyncio.ensure_future(open_session(port, p, q)) for p, q in zip(packets, leave)]
+    again = SHORT_TEXT if short else None
+    peers = [asyncio.ensure_future(open_session(port, p, q, again))
+             for p, q in zip(packets, leave)]
     await asyncio.wait_for(asyncio.gather(*(p.wait() for p in packets)), 60)
+    if short:
+        await asyncio.sleep(1)
     mid_sentence = sum(not p.done() for p in peers)
     for q in leave[1::2]:
         q.set()
@@ -75,7 +87,8 @@ async def run(sessions, stop_timeout_s):
     took = time.monotonic() - stopping
     closed = await asyncio.wait_for(asyncio.gather(*peers, return_exceptions=True), 30)
     told, staying = sum(c is True for c in closed[::2]), len(closed[::2])
-    print(f'{sessions} sessions, {mid_sentence} mid-sentence at SIGTERM, --stop-timeout='
+    print(f'{sessions} sessions, {mid_sentence} mid-sentence at SIGTERM'
+          f'{" (short texts, one after another)" if short else ""}, --stop-timeout='
           f'{stop_timeout_s}: pfap-web exited {server.returncode} {took:.1f} s after it; {told} '
           f'of the {staying} peers that stayed saw their WebSocket closed')
     if 'CRITICAL' in err:
@@ -96,6 +109,16 @@ async def main():
         if r is None or r[0] != 0 or 'pfap-web: stopped' not in r[1]:
             ok = False
             print(f'not stopped cleanly: {r and r[0]}\n{r and r[2][-3000:]}', file=sys.stderr)
+    # Texts ending and starting while the stop closes twice as many sessions: the calls their
+    # streaming threads post must still run on the main thread, after their session is closed,
+    # not on those threads beside close_session (GLib CRITICALs, a speaker disposed in PAUSED,
+    # stops that hung: 5 of 7 such stops of 20 sessions in the sanitizer build before the fix,
+    # 0 of 4 of 10; docs/web.md, "Stopping").
+    r = await run(2 * sessions, STOP_TIMEOUT_S, short=True)
+    if r is None or r[0] != 0 or 'pfap-web: stopped' not in r[1]:
+        ok = False
+        print(f'not stopped cleanly with short texts: {r and r[0]}\n{r and r[2][-3000:]}',
+              file=sys.stderr)
     # A deadline too short for any stop: the server gives up on the sessions it has not
     # stopped, names them, and exits 3.
     r = await run(sessions, 0.001)
