@@ -2,7 +2,6 @@
 #include "espeak.h"
 
 #include <espeak-ng/speak_lib.h>
-#include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -190,8 +189,7 @@ bool in_child(const std::function<void(Writer&, std::string&)>& work,
   {
     std::lock_guard lock(espeak_mutex);
     if (!start(error)) return false;
-    // Close-on-exec: a child another thread forks and execs must not hold the pipe open.
-    if (pipe2(fds, O_CLOEXEC) != 0) {
+    if (pipe(fds) != 0) {
       error = std::string("no pipe for espeak-ng: ") + std::strerror(errno);
       return false;
     }
