@@ -1,9 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // espeak-ng 1.51 as a function: text in, audio and its events out. espeak-ng is one
-// process-wide synthesizer that is not reentrant and keeps state from one synthesis to the
-// next that no call resets, so each call runs in a child process forked from one whose
-// espeak-ng has started and never spoken: the same text and settings give the same audio and
-// events, whatever was spoken before (espeak.cc says why).
+// process-wide synthesizer that is not reentrant (its voice, parameters and callback are
+// global), so every call runs under one mutex, synchronously, and sets all of them.
 #pragma once
 
 #include <atomic>
@@ -48,9 +46,9 @@ struct Synthesis {
 // (a synthesis reports its own, which is the one to use).
 bool check_voice(const VoiceSettings& settings, unsigned& sample_rate, std::string& error);
 
-// Speaks plain UTF-8 `text` (no SSML). False with `error` set when espeak-ng cannot start, has
-// no such voice or dies. When `*cancel` becomes true, espeak-ng is stopped within 10 ms and
-// `out` is empty.
+// Speaks plain UTF-8 `text` (no SSML). False with `error` set when espeak-ng cannot start or
+// has no such voice. When `*cancel` becomes true, espeak-ng stops at its next block of audio
+// (a few ms of work) and `out` holds what was spoken so far.
 bool synthesize(std::string_view text, const VoiceSettings& settings, Synthesis& out,
                 std::string& error, const std::atomic<bool>* cancel = nullptr);
 
