@@ -319,8 +319,8 @@ async def main():
                     thread_cpu[tid] = (name, int(fields[11]) + int(fields[12]))
             await asyncio.sleep(0.05)
 
-    # The server's own time and its children's, once it has waited for them: pfaptts speaks
-    # each sentence in a child process (docs/tts.md).
+    # The server's own time and that of the children it has waited for: a synthesis in a child
+    # process (docs/tts.md, "Tried and withdrawn") would otherwise look free.
     def cpu_s():
         fields = open(f'/proc/{server.pid}/stat').read().rsplit(')', 1)[1].split()
         return sum(int(f) for f in fields[11:15]) / os.sysconf('SC_CLK_TCK')
