@@ -746,12 +746,18 @@ bool make_pipeline(Session& s) {
 
 // ICE on 127.0.0.1 only, as the HTTP server: the page is on this machine (a browser offers
 // its loopback candidate with --allow-loopback-in-peer-connection, docs/web.md), and no
-// packet goes to another address. Send only: the page has nothing to send but its answer.
+// packet goes to another address: so no UPnP either, which would ask the LAN's router for a
+// port mapping by multicast from every address, in every session. Send only: the page has
+// nothing to send but its answer.
 void configure_webrtc(Session& s) {
   GObject* ice = nullptr;
   g_object_get(s.webrtc, "ice-agent", &ice, nullptr);
   gboolean added = FALSE;
   g_signal_emit_by_name(ice, "add-local-ip-address", "127.0.0.1", &added);
+  GObject* agent = nullptr;
+  g_object_get(ice, "agent", &agent, nullptr);
+  g_object_set(agent, "upnp", FALSE, nullptr);
+  g_object_unref(agent);
   g_object_unref(ice);
   if (!added) g_printerr("pfap-web: session %d: ICE cannot use 127.0.0.1\n", s.id);
 

@@ -24,6 +24,7 @@ addresses that exist only there (10.99.0.1 and .2); aiortc offers those and reac
 server's 127.0.0.1 from them. No packet leaves the namespace."""
 import asyncio
 import base64
+import ipaddress
 import json
 import os
 import re
@@ -304,9 +305,12 @@ async def main():
     rss_base = rss_kib(server.pid, 'VmRSS')
     thread_cpu = {}  # thread id: (name, CPU ticks), its last reading
 
+    off_loopback = set()  # the server's sockets bound to another address than loopback's
+
     async def sample():
         for tick in range(1 << 62):
             peak[0] = max(peak[0], len(os.listdir(f'/proc/{server.pid}/fd')))
+            off_loopback.update(sockets_off_loopback(server.pid))
             peak[1] = max(peak[1], len(os.listdir(f'/proc/{server.pid}/task')))
             if by_thread and tick % 10 == 0:
                 for tid in os.listdir(f'/proc/{server.pid}/task'):
@@ -381,9 +385,35 @@ async def main():
               f'{pfap_late * 100:.1f} % over {LATE_S * 1000:.0f} ms')
         print(f'{good} of {sessions} sessions whole in {took:.1f} s; pfap-web exited '
               f'{server.returncode}, {stopped_in:.1f} s after SIGTERM')
-    if good != sessions or server.returncode != 0:
+    if off_loopback:
+        print(f"pfap-web's sockets bound off loopback: {', '.join(sorted(off_loopback))}")
+    if good != sessions or server.returncode != 0 or off_loopback:
         print(err[-2000:], file=sys.stderr)
         sys.exit(1)
+
+
+def sockets_off_loopback(pid):
+    """The local addresses (address:port) of pid's inet sockets bound to an address other than
+    127.0.0.1 or ::1: pfap-web sends nothing off this machine (docs/web.md)."""
+    inodes = set()
+    for fd in os.listdir(f'/proc/{pid}/fd'):
+        try:
+            link = os.readlink(f'/proc/{pid}/fd/{fd}')
+        except OSError:
+            continue  # closed meanwhile
+        if link.startswith('socket:['):
+            inodes.add(link[8:-1])
+    found = set()
+    for table in ('udp', 'tcp', 'udp6', 'tcp6'):
+        for line in open(f'/proc/{pid}/net/{table}').readlines()[1:]:
+            fields = line.split()
+            address, port = fields[1].split(':')
+            if fields[9] in inodes and address not in ('0100007F', '0' * 24 + '01000000'):
+                raw = bytes.fromhex(address)
+                # /proc prints each 32-bit word of the address in host (little-endian) order.
+                raw = b''.join(raw[i:i + 4][::-1] for i in range(0, len(raw), 4))
+                found.add(f'{ipaddress.ip_address(raw)}:{int(port, 16)}')
+    return found
 
 
 def start_server(options, env=None):
