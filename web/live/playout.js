@@ -62,6 +62,7 @@ export class PlayoutClock {
     this.scannedTo = this.envelope.at(-1)?.t ?? -Infinity;  // heard since the reset: after this
     this.corrections = [];  // {t: heard time, lag: ms}
     this.misses = 0;  // tap messages since the last match whose window held sound
+    this.polls = [];  // getStats' inbound-rtp counters at each poll, for the figures
     // The stream's start, for the figures (docs/web.md, the first syllable): the running time
     // each of the first frames was drawn at and whether it rested on a match.
     this.startTrace = [];
@@ -116,11 +117,22 @@ export class PlayoutClock {
       const polled = performance.now();
       (await receiver.getStats()).forEach((v) => {
         if (v.type !== 'inbound-rtp') return;
-        const net = (v.removedSamplesForAcceleration ?? 0) - (v.insertedSamplesForDeceleration ?? 0);
-        remember(this.stretches, polled - 12.5 + this.latencyMs(), net);
+        this.statsPolled(v, polled, this.latencyMs());
         onStats(v, polled);
       });
     }, 25);
+  }
+
+  /** One poll's inbound-rtp report `v`, taken at performance time `polled` (followStretching). */
+  statsPolled(v, polled, latencyMs) {
+    const net = (v.removedSamplesForAcceleration ?? 0) - (v.insertedSamplesForDeceleration ?? 0);
+    remember(this.stretches, polled - 12.5 + latencyMs, net);
+    this.polls.push({
+      t: polled, concealed: v.concealedSamples, silentConcealed: v.silentConcealedSamples, events: v.concealmentEvents,
+      received: v.totalSamplesReceived, duration: v.totalSamplesDuration, jbDelay: v.jitterBufferDelay,
+      jbEmitted: v.jitterBufferEmittedCount, net, packets: v.packetsReceived, lost: v.packetsLost,
+    });
+    if (this.polls.length > 4000) this.polls.splice(0, 2000);
   }
 
   /**
