@@ -23,6 +23,8 @@ const remember = (history, from, value) => {
 // (-50 dBFS), which a "pa"'s p passes within 2 ms of its onset, after 100 ms under it.
 const FIRST_SOUND_RMS = 100;
 const FIRST_SOUND_QUIET_MS = 100;
+// The audio's packet duration (the senders' Opus frames): what NetEq conceals for a lost packet.
+const PACKET_S = 0.02;
 
 export class PlayoutClock {
   /**
@@ -53,7 +55,9 @@ export class PlayoutClock {
   reset() {
     this.sent = new SentLevel();
     this.readings = [];  // [heard from, running time less heard time]
-    this.stretches = [];  // [heard from, samples removed less inserted]
+    this.stretches = [];  // [heard from, samples removed less inserted less concealed late]
+    this.concealedLate = 0;  // samples of concealment that delayed the audio, from the first match on
+    this.counted = null;  // the last poll's concealment counts, once the level has been matched
     this.matched = null;  // {m: running time less heard time, stretch: the stretch then}
     // The stream's first sound heard put at the first sound sent: the mapping from the sound
     // until the level's first match ({m, stretch} as `matched`, and `t`, when it is heard).
@@ -123,9 +127,30 @@ export class PlayoutClock {
     }, 25);
   }
 
-  /** One poll's inbound-rtp report `v`, taken at performance time `polled` (followStretching). */
+  /**
+   * One poll's inbound-rtp report `v`, taken at performance time `polled` (followStretching).
+   * Besides the stretching, the concealment that delays the audio (docs/web.md, Lost clocks):
+   * when NetEq runs dry it conceals until packets come and then plays them, as late as it
+   * concealed. Counted from the first poll after the level's first match (concealedSamples
+   * also holds the silence played before any audio came); not the silent concealment NetEq
+   * fades to (silentConcealedSamples), which at a stream's end would stop the clock; and not
+   * a lost packet's (packetsLost), after which the next is played on time.
+   */
   statsPolled(v, polled, latencyMs) {
-    const net = (v.removedSamplesForAcceleration ?? 0) - (v.insertedSamplesForDeceleration ?? 0);
+    const counts = {
+      voiced: (v.concealedSamples ?? 0) - (v.silentConcealedSamples ?? 0),
+      lost: v.packetsLost ?? 0,
+    };
+    if (this.matched === null) {
+      this.counted = null;
+    } else {
+      const voiced = counts.voiced - (this.counted?.voiced ?? counts.voiced);
+      const lost = counts.lost - (this.counted?.lost ?? counts.lost);
+      // Fewer than before: a new receiver, whose counts start again.
+      if (voiced > 0 && lost >= 0) this.concealedLate += Math.max(0, voiced - lost * this.audioClockRate * PACKET_S);
+      this.counted = counts;
+    }
+    const net = (v.removedSamplesForAcceleration ?? 0) - (v.insertedSamplesForDeceleration ?? 0) - this.concealedLate;
     remember(this.stretches, polled - 12.5 + latencyMs, net);
     this.polls.push({
       t: polled, concealed: v.concealedSamples, silentConcealed: v.silentConcealedSamples, events: v.concealmentEvents,
