@@ -113,10 +113,12 @@ export class PlayoutClock {
   /**
    * Follows the jitter buffer's stretching (getStats of `receiver`, an RTCRtpReceiver), from
    * when it is heard: a poll sees a change some time in the 25 ms before it, which is heard
-   * the output's latency later. `onStats` sees each inbound-rtp report.
+   * the output's latency later. `onStats` sees each inbound-rtp report. A new receiver (the
+   * page watches again) replaces the last: two series of counts would mix.
    */
   followStretching(receiver, onStats = () => {}) {
-    setInterval(async () => {
+    clearInterval(this.polling);
+    this.polling = setInterval(async () => {
       if (!this.context) return;
       const polled = performance.now();
       (await receiver.getStats()).forEach((v) => {
