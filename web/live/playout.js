@@ -25,6 +25,8 @@ const FIRST_SOUND_RMS = 100;
 const FIRST_SOUND_QUIET_MS = 100;
 // The audio's packet duration (the senders' Opus frames): what NetEq conceals for a lost packet.
 const PACKET_S = 0.02;
+// Silent concealment for longer than this, with no audio decoded, is the audio's end, not a stall.
+const SILENT_END_MS = 500;
 
 export class PlayoutClock {
   /**
@@ -58,6 +60,7 @@ export class PlayoutClock {
     this.stretches = [];  // [heard from, samples removed less inserted less concealed late]
     this.concealedLate = 0;  // samples of concealment that delayed the audio, from the first match on
     this.counted = null;  // the last poll's concealment counts, once the level has been matched
+    this.silentRun = 0;  // samples of silent concealment since audio was last decoded
     this.matched = null;  // {m: running time less heard time, stretch: the stretch then}
     // The stream's first sound heard put at the first sound sent: the mapping from the sound
     // until the level's first match ({m, stretch} as `matched`, and `t`, when it is heard).
@@ -134,22 +137,31 @@ export class PlayoutClock {
    * Besides the stretching, the concealment that delays the audio (docs/web.md, Lost clocks):
    * when NetEq runs dry it conceals until packets come and then plays them, as late as it
    * concealed. Counted from the first poll after the level's first match (concealedSamples
-   * also holds the silence played before any audio came); not the silent concealment NetEq
-   * fades to (silentConcealedSamples), which at a stream's end would stop the clock; and not
-   * a lost packet's (packetsLost), after which the next is played on time.
+   * also holds the silence played before any audio came); not a lost packet's (packetsLost),
+   * after which the next is played on time. NetEq fades a long concealment to silence
+   * (silentConcealedSamples): past SILENT_END_MS of it with no audio decoded, the audio has
+   * ended (the stream's end, Janus gone) and the silence is taken back, so that the clock runs
+   * on past the end.
    */
   statsPolled(v, polled, latencyMs) {
     const counts = {
-      voiced: (v.concealedSamples ?? 0) - (v.silentConcealedSamples ?? 0),
-      lost: v.packetsLost ?? 0,
+      concealed: v.concealedSamples ?? 0, silent: v.silentConcealedSamples ?? 0, lost: v.packetsLost ?? 0,
+      decoded: v.jitterBufferEmittedCount ?? 0,
     };
     if (this.matched === null) {
       this.counted = null;
+      this.silentRun = 0;
     } else {
-      const voiced = counts.voiced - (this.counted?.voiced ?? counts.voiced);
-      const lost = counts.lost - (this.counted?.lost ?? counts.lost);
+      const d = Object.fromEntries(Object.entries(counts).map(([k, n]) => [k, n - (this.counted?.[k] ?? n)]));
       // Fewer than before: a new receiver, whose counts start again.
-      if (voiced > 0 && lost >= 0) this.concealedLate += Math.max(0, voiced - lost * this.audioClockRate * PACKET_S);
+      if (Object.values(d).every((n) => n >= 0)) {
+        const end = SILENT_END_MS * (this.audioClockRate / 1000);
+        const before = this.silentRun;
+        this.silentRun = d.decoded > 0 ? 0 : before + d.silent;
+        let late = Math.max(0, d.concealed - d.lost * this.audioClockRate * PACKET_S);
+        if (this.silentRun > end) late -= before > end ? d.silent : before + d.silent;
+        this.concealedLate += late;
+      }
       this.counted = counts;
     }
     const net = (v.removedSamplesForAcceleration ?? 0) - (v.insertedSamplesForDeceleration ?? 0) - this.concealedLate;

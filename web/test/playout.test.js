@@ -155,9 +155,10 @@ test('a late joiner, whose level begins 1 s after what it hears first, draws fro
 // -- A stall mid-speech (docs/web.md, "Lost clocks") ----------------------------------------
 // Under load NetEq runs dry and conceals until packets come, then plays them late: the audio is
 // heard later by as long as it concealed. getStats' inbound-rtp says so as it happens
-// (concealedSamples; in Chromium, silentConcealedSamples stays 0 in such a stall and takes
-// over once NetEq has faded to silence, as at a stream's end). What a run logged: 131.6 ms of
-// concealment over four polls, the next match's correction -131.6 ms.
+// (concealedSamples; silentConcealedSamples takes over once NetEq has faded to silence). What
+// runs logged: 131.6 ms of concealment over four polls, none silent, and the next match's
+// correction -131.6 ms; 43.4 ms concealed and 86.8 ms silent, correction -86.9 ms (the silent
+// part, when silence was not followed).
 const LATENCY_MS = 40;  // the output's latency: NetEq's output at t is heard at t + LATENCY_MS
 const SAMPLES_PER_MS = 48;
 
@@ -182,6 +183,7 @@ function stall({ fromMs, ms, before = 5000, silentAfterMs = Infinity, lostPacket
     const concealed = Math.max(0, Math.min(heard, fromMs + ms) - fromMs);
     const silent = Math.max(0, concealed - silentAfterMs);
     return {
+      jitterBufferEmittedCount: Math.max(0, heard - concealed) * SAMPLES_PER_MS,
       concealedSamples: (before + concealed) * SAMPLES_PER_MS, silentConcealedSamples: (before + silent) * SAMPLES_PER_MS,
       packetsLost: heard >= fromMs + ms ? lostPackets : 0, removedSamplesForAcceleration: 0, insertedSamplesForDeceleration: 0,
     };
@@ -190,10 +192,14 @@ function stall({ fromMs, ms, before = 5000, silentAfterMs = Infinity, lostPacket
 }
 
 test('a stall mid-speech delays the clock as getStats counts it, before the next match', () => {
+  for (const silentAfterMs of [Infinity, 40]) stalled(silentAfterMs);
+});
+
+function stalled(silentAfterMs) {
   const clock = new PlayoutClock({ envelope: [] });
   sending(clock, 8000);
   clock.reading(0, 30);
-  const { delay, counters } = stall({ fromMs: 2030, ms: 130 });  // in the vowel of the 7th "pa"
+  const { delay, counters } = stall({ fromMs: 2030, ms: 130, silentAfterMs });  // in the vowel of the 7th "pa"
   hearPolled(clock, 0, 2030, delay, counters);
   assert.ok(Math.abs(clock.runningMs(2000) - 2000) < 2, `before the stall: ${clock.runningMs(2000)}`);
   const matches = clock.corrections.length;
@@ -202,15 +208,15 @@ test('a stall mid-speech delays the clock as getStats counts it, before the next
   for (let t = 2030; t < 2700; ++t) {
     hearPolled(clock, t, t + 1, delay, counters);
     if (t >= 2160 + 30 && t < 2500) {
-      assert.ok(Math.abs(clock.runningMs(t) - (t - 130)) < 3, `at ${t}: the clock says ${clock.runningMs(t).toFixed(1)}, the sound ${t - 130}`);
+      assert.ok(Math.abs(clock.runningMs(t) - (t - 130)) < 3, `silent after ${silentAfterMs} ms, at ${t}: the clock says ${clock.runningMs(t).toFixed(1)}, the sound ${t - 130}`);
     }
   }
   // The matches after it agree.
   const after = clock.corrections.slice(matches).filter((c) => c.t > 2160);
   assert.ok(after.length > 0 && after.every((c) => Math.abs(c.lag) < 3), JSON.stringify(after.slice(0, 5)));
-});
+}
 
-test('concealment that delays nothing moves no clock: a lost packet; the silence after a stream\'s end', () => {
+test('a lost packet moves no clock; at a stream\'s end the clock stops, then runs on past it', () => {
   // A lost packet (20 ms concealed, packetsLost 1): the next is played on time.
   let clock = new PlayoutClock({ envelope: [] });
   sending(clock, 8000);
@@ -219,12 +225,14 @@ test('concealment that delays nothing moves no clock: a lost packet; the silence
   hearPolled(clock, 0, 2400, lost.delay, lost.counters);
   for (const t of [2100, 2200, 2300]) assert.ok(Math.abs(clock.runningMs(t) - t) < 2, `at ${t}: ${clock.runningMs(t)}`);
   // The stream ends: NetEq conceals, fading to silence (silentConcealedSamples) within 140 ms
-  // in Chromium. The clock stops for that long, then runs on, so that the face gets past the end.
+  // in Chromium. The clock stops, and once the silence has gone on for 500 ms with no audio
+  // decoded it runs on, 140 ms behind, so that the face gets past the end.
   clock = new PlayoutClock({ envelope: [] });
   sending(clock, 3000);
   clock.reading(0, 0);
   const end = stall({ fromMs: 3000, ms: 1e9, silentAfterMs: 140 });
   hearPolled(clock, 0, 4500, end.delay, end.counters);
+  assert.ok(Math.abs(clock.runningMs(3400) - (3000 - 30)) < 30, `the clock stops: ${clock.runningMs(3400)}`);
   assert.ok(Math.abs(clock.runningMs(4000) - (4000 - 140)) < 30, `${clock.runningMs(4000)}`);
   assert.ok(Math.abs(clock.runningMs(4400) - clock.runningMs(3900) - 500) < 1, `${clock.runningMs(3900)}, ${clock.runningMs(4400)}`);
 });
