@@ -6,7 +6,7 @@
 // The page plays the speech through Web Audio and taps it (tap.js); its readings of the audio
 // receiver's synchronization source say roughly which running time is heard, the played
 // level found in the level the sender sent (clock.js) says exactly, and between matches the
-// jitter buffer's stretching (getStats) is followed.
+// jitter buffer's stretching and the concealment that delays the audio (getStats) are followed.
 import { SentLevel, matchLevels } from './clock.js';
 
 // The value of `history` ([from, value], in order) at heard time t.
@@ -35,8 +35,7 @@ export class PlayoutClock {
    *   `envelope` receives the tap's level of what is heard (1 ms blocks, performance time);
    *   the first match searches ±firstSearchMs around the readings, later ones ±searchMs around
    *   the last match, and ±lostSearchMs after 300 ms of sound heard without a match (the clock
-   *   is lost: NetEq's concealment when packets come late moves the audio by more than the
-   *   search, and getStats' stretch counts leave it out). Until the first match the clock
+   *   is lost: the audio moved by more than the search, by what getStats does not count). Until the first match the clock
    *   draws from the stream's first sound, if it lies within ±firstSoundSearchMs of where the
    *   readings put it (findFirstSound), and not at all without it.
    */
