@@ -58,7 +58,7 @@ export class PlayoutClock {
     this.readings = [];  // [heard from, running time less heard time]
     this.stretches = [];  // [heard from, samples removed less inserted less concealed late]
     this.concealedLate = 0;  // samples of concealment that delayed the audio, from the first match on
-    this.counted = null;  // the last poll's concealment counts, once the level has been matched
+    this.counted = null;  // the last poll's concealment counts
     this.silentRun = 0;  // samples of silent concealment since audio was last decoded
     this.matched = null;  // {m: running time less heard time, stretch: the stretch then}
     // The stream's first sound heard put at the first sound sent: the mapping from the sound
@@ -135,8 +135,9 @@ export class PlayoutClock {
    * One poll's inbound-rtp report `v`, taken at performance time `polled` (followStretching).
    * Besides the stretching, the concealment that delays the audio (docs/web.md, Lost clocks):
    * when NetEq runs dry it conceals until packets come and then plays them, as late as it
-   * concealed. Counted from the first poll after the level's first match (concealedSamples
-   * also holds the silence played before any audio came); not a lost packet's (packetsLost),
+   * concealed. Counted from the last poll before the level's first match on (concealedSamples
+   * also holds the silence played before any audio came; a poll can come 130 ms after the one
+   * before it under load, and a stall in between would be lost); not a lost packet's (packetsLost),
    * after which the next is played on time. NetEq fades a long concealment to silence
    * (silentConcealedSamples): past SILENT_END_MS of it with no audio decoded, the audio has
    * ended (the stream's end, Janus gone) and the silence is taken back, so that the clock runs
@@ -147,10 +148,7 @@ export class PlayoutClock {
       concealed: v.concealedSamples ?? 0, silent: v.silentConcealedSamples ?? 0, lost: v.packetsLost ?? 0,
       decoded: v.jitterBufferEmittedCount ?? 0,
     };
-    if (this.matched === null) {
-      this.counted = null;
-      this.silentRun = 0;
-    } else {
+    if (this.matched !== null) {
       const d = Object.fromEntries(Object.entries(counts).map(([k, n]) => [k, n - (this.counted?.[k] ?? n)]));
       // Fewer than before: a new receiver, whose counts start again.
       if (Object.values(d).every((n) => n >= 0)) {
@@ -161,8 +159,8 @@ export class PlayoutClock {
         if (this.silentRun > end) late -= before > end ? d.silent : before + d.silent;
         this.concealedLate += late;
       }
-      this.counted = counts;
     }
+    this.counted = counts;
     const net = (v.removedSamplesForAcceleration ?? 0) - (v.insertedSamplesForDeceleration ?? 0) - this.concealedLate;
     remember(this.stretches, polled - 12.5 + latencyMs, net);
     this.polls.push({

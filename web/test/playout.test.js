@@ -216,6 +216,28 @@ function stalled(silentAfterMs) {
   assert.ok(after.length > 0 && after.every((c) => Math.abs(c.lag) < 3), JSON.stringify(after.slice(0, 5)));
 }
 
+test('a stall before the first poll after the first match delays the clock', () => {
+  // Under load a page's polls come up to 130 ms apart (a run here: the first match at 2199, the
+  // polls at 2146 and 2279, 59 ms of concealment between them, the next match -68.9 ms). Here:
+  // the first "pa" matched, then no poll for 250 ms, and a 60 ms stall in the silence after it.
+  const clock = new PlayoutClock({ envelope: [] });
+  sending(clock, 8000);
+  clock.reading(0, 0);
+  const { delay, counters } = stall({ fromMs: 200, ms: 60 });
+  let matchedAt = null;
+  for (let t = 0; t < 1000; ++t) {
+    clock.envelope.push({ t, rms: delay(t) === null ? 0 : level(t - delay(t)) / 32768 });
+    if (t % 10 === 9) clock.matchHeard();
+    if (matchedAt === null && clock.matched !== null) matchedAt = t;
+    if (t % 25 === 0 && (matchedAt === null || t > 250)) clock.statsPolled(counters(t - LATENCY_MS), t - LATENCY_MS, LATENCY_MS);
+    // Up to the next syllable's match: the clock 60 ms behind where it was.
+    if (t >= 300 && t < 397) {
+      assert.ok(Math.abs(clock.runningMs(t) - (t - 60)) < 3, `first match at ${matchedAt}; at ${t} the clock says ${clock.runningMs(t).toFixed(1)}, the sound ${t - 60}`);
+    }
+  }
+  assert.ok(matchedAt !== null && matchedAt < 100, `first match at ${matchedAt}`);
+});
+
 test('a lost packet moves no clock; at a stream\'s end the clock stops, then runs on past it', () => {
   // A lost packet (20 ms concealed, packetsLost 1): the next is played on time.
   let clock = new PlayoutClock({ envelope: [] });
