@@ -135,13 +135,13 @@ export class PlayoutClock {
    * One poll's inbound-rtp report `v`, taken at performance time `polled` (followStretching).
    * Besides the stretching, the concealment that delays the audio (docs/web.md, Lost clocks):
    * when NetEq runs dry it conceals until packets come and then plays them, as late as it
-   * concealed. Counted from the last poll before the level's first match on (concealedSamples
-   * also holds the silence played before any audio came; a poll can come 130 ms after the one
-   * before it under load, and a stall in between would be lost); not a lost packet's (packetsLost),
-   * after which the next is played on time. NetEq fades a long concealment to silence
-   * (silentConcealedSamples): past SILENT_END_MS of it with no audio decoded, the audio has
-   * ended (the stream's end, Janus gone) and the silence is taken back, so that the clock runs
-   * on past the end.
+   * concealed. Counted from the last poll before the level's first match on: concealedSamples
+   * also holds the silence played before any audio came, and under load a poll can come 130 ms
+   * after the one before it, a stall between them lost to a count started after the match. Not
+   * a lost packet's (packetsLost), after which the next is played on time. NetEq fades a long
+   * concealment to silence (silentConcealedSamples): past SILENT_END_MS of it with no audio
+   * decoded, the audio has ended (the stream's end, Janus gone) and the silence is taken back,
+   * so that the clock runs on past the end.
    */
   statsPolled(v, polled, latencyMs) {
     const counts = {
