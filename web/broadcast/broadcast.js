@@ -182,6 +182,7 @@ export function start({ canvas, audio, status, janusServer }) {
   drawInTime({ receiver, canvas, stats, streamNs, drawn: drawnPhonemes });
   stats.measureLipSync = () => {
     stats.corrections = clock.corrections;
+    stats.polls = clock.polls;
     // The stream's start (docs/web.md, "The first syllable").
     stats.start = {
       trace: clock.startTrace, firstSound: clock.firstSound, estimates: stream?.estimates,

@@ -6,7 +6,7 @@
 // The page plays the speech through Web Audio and taps it (tap.js); its readings of the audio
 // receiver's synchronization source say roughly which running time is heard, the played
 // level found in the level the sender sent (clock.js) says exactly, and between matches the
-// jitter buffer's stretching (getStats) is followed.
+// jitter buffer's stretching and the concealment that delays the audio (getStats) are followed.
 import { SentLevel, matchLevels } from './clock.js';
 
 // The value of `history` ([from, value], in order) at heard time t.
@@ -23,6 +23,10 @@ const remember = (history, from, value) => {
 // (-50 dBFS), which a "pa"'s p passes within 2 ms of its onset, after 100 ms under it.
 const FIRST_SOUND_RMS = 100;
 const FIRST_SOUND_QUIET_MS = 100;
+// The audio's packet duration (the senders' Opus frames): what NetEq conceals for a lost packet.
+const PACKET_S = 0.02;
+// Silent concealment for longer than this, with no audio decoded, is the audio's end, not a stall.
+const SILENT_END_MS = 500;
 
 export class PlayoutClock {
   /**
@@ -31,8 +35,7 @@ export class PlayoutClock {
    *   `envelope` receives the tap's level of what is heard (1 ms blocks, performance time);
    *   the first match searches ±firstSearchMs around the readings, later ones ±searchMs around
    *   the last match, and ±lostSearchMs after 300 ms of sound heard without a match (the clock
-   *   is lost: NetEq's concealment when packets come late moves the audio by more than the
-   *   search, and getStats' stretch counts leave it out). Until the first match the clock
+   *   is lost: the audio moved by more than the search, by what getStats does not count). Until the first match the clock
    *   draws from the stream's first sound, if it lies within ±firstSoundSearchMs of where the
    *   readings put it (findFirstSound), and not at all without it.
    */
@@ -53,7 +56,10 @@ export class PlayoutClock {
   reset() {
     this.sent = new SentLevel();
     this.readings = [];  // [heard from, running time less heard time]
-    this.stretches = [];  // [heard from, samples removed less inserted]
+    this.stretches = [];  // [heard from, samples removed less inserted less concealed late]
+    this.concealedLate = 0;  // samples of concealment that delayed the audio, from the first match on
+    this.counted = null;  // the last poll's concealment counts
+    this.silentRun = 0;  // samples of silent concealment since audio was last decoded
     this.matched = null;  // {m: running time less heard time, stretch: the stretch then}
     // The stream's first sound heard put at the first sound sent: the mapping from the sound
     // until the level's first match ({m, stretch} as `matched`, and `t`, when it is heard).
@@ -62,6 +68,7 @@ export class PlayoutClock {
     this.scannedTo = this.envelope.at(-1)?.t ?? -Infinity;  // heard since the reset: after this
     this.corrections = [];  // {t: heard time, lag: ms}
     this.misses = 0;  // tap messages since the last match whose window held sound
+    this.polls = [];  // getStats' inbound-rtp counters at each poll, for the figures
     // The stream's start, for the figures (docs/web.md, the first syllable): the running time
     // each of the first frames was drawn at and whether it rested on a match.
     this.startTrace = [];
@@ -108,19 +115,60 @@ export class PlayoutClock {
   /**
    * Follows the jitter buffer's stretching (getStats of `receiver`, an RTCRtpReceiver), from
    * when it is heard: a poll sees a change some time in the 25 ms before it, which is heard
-   * the output's latency later. `onStats` sees each inbound-rtp report.
+   * the output's latency later. `onStats` sees each inbound-rtp report. A new receiver (the
+   * page watches again) replaces the last: two series of counts would mix.
    */
   followStretching(receiver, onStats = () => {}) {
-    setInterval(async () => {
+    clearInterval(this.polling);
+    this.polling = setInterval(async () => {
       if (!this.context) return;
       const polled = performance.now();
       (await receiver.getStats()).forEach((v) => {
         if (v.type !== 'inbound-rtp') return;
-        const net = (v.removedSamplesForAcceleration ?? 0) - (v.insertedSamplesForDeceleration ?? 0);
-        remember(this.stretches, polled - 12.5 + this.latencyMs(), net);
+        this.statsPolled(v, polled, this.latencyMs());
         onStats(v, polled);
       });
     }, 25);
+  }
+
+  /**
+   * One poll's inbound-rtp report `v`, taken at performance time `polled` (followStretching).
+   * Besides the stretching, the concealment that delays the audio (docs/web.md, Lost clocks):
+   * when NetEq runs dry it conceals until packets come and then plays them, as late as it
+   * concealed. Counted from the last poll before the level's first match on: concealedSamples
+   * also holds the silence played before any audio came, and under load a poll can come 130 ms
+   * after the one before it, a stall between them lost to a count started after the match. Not
+   * a lost packet's (packetsLost), after which the next is played on time. NetEq fades a long
+   * concealment to silence (silentConcealedSamples): past SILENT_END_MS of it with no audio
+   * decoded, the audio has ended (the stream's end, Janus gone) and the silence is taken back,
+   * so that the clock runs on past the end.
+   */
+  statsPolled(v, polled, latencyMs) {
+    const counts = {
+      concealed: v.concealedSamples ?? 0, silent: v.silentConcealedSamples ?? 0, lost: v.packetsLost ?? 0,
+      decoded: v.jitterBufferEmittedCount ?? 0,
+    };
+    if (this.matched !== null) {
+      const d = Object.fromEntries(Object.entries(counts).map(([k, n]) => [k, n - (this.counted?.[k] ?? n)]));
+      // Fewer than before: a new receiver, whose counts start again.
+      if (Object.values(d).every((n) => n >= 0)) {
+        const end = SILENT_END_MS * (this.audioClockRate / 1000);
+        const before = this.silentRun;
+        this.silentRun = d.decoded > 0 ? 0 : before + d.silent;
+        let late = Math.max(0, d.concealed - d.lost * this.audioClockRate * PACKET_S);
+        if (this.silentRun > end) late -= before > end ? d.silent : before + d.silent;
+        this.concealedLate += late;
+      }
+    }
+    this.counted = counts;
+    const net = (v.removedSamplesForAcceleration ?? 0) - (v.insertedSamplesForDeceleration ?? 0) - this.concealedLate;
+    remember(this.stretches, polled - 12.5 + latencyMs, net);
+    this.polls.push({
+      t: polled, concealed: v.concealedSamples, silentConcealed: v.silentConcealedSamples, events: v.concealmentEvents,
+      received: v.totalSamplesReceived, duration: v.totalSamplesDuration, jbDelay: v.jitterBufferDelay,
+      jbEmitted: v.jitterBufferEmittedCount, net, packets: v.packetsReceived, lost: v.packetsLost,
+    });
+    if (this.polls.length > 4000) this.polls.splice(0, 2000);
   }
 
   /**

@@ -151,3 +151,110 @@ test('a late joiner, whose level begins 1 s after what it hears first, draws fro
     assert.ok(closure && closure.t - (heardAt + onset) >= 0 && closure.t - (heardAt + onset) <= FRAME_MS + 1, `onset ${k}: ${closure?.t}`);
   }
 });
+
+// -- A stall mid-speech (docs/web.md, "Lost clocks") ----------------------------------------
+// Under load NetEq runs dry and conceals until packets come, then plays them late: the audio is
+// heard later by as long as it concealed. getStats' inbound-rtp says so as it happens
+// (concealedSamples; silentConcealedSamples takes over once NetEq has faded to silence). What
+// runs logged: 131.6 ms of concealment over four polls, none silent, and the next match's
+// correction -131.6 ms; 43.4 ms concealed and 86.8 ms silent, correction -86.9 ms (the silent
+// part, when silence was not followed).
+const LATENCY_MS = 40;  // the output's latency: NetEq's output at t is heard at t + LATENCY_MS
+const SAMPLES_PER_MS = 48;
+
+// Hears running time t - delay(t) at each ms t of [fromMs, toMs) as hear() does, and polls
+// getStats every 25 ms: `counters(outputMs)` gives the inbound-rtp report of NetEq's output up to
+// performance time outputMs (what is heard LATENCY_MS later).
+function hearPolled(clock, fromMs, toMs, delay, counters) {
+  for (let t = fromMs; t < toMs; ++t) {
+    clock.envelope.push({ t, rms: delay(t) === null ? 0 : level(t - delay(t)) / 32768 });
+    if (t % 10 === 9) clock.matchHeard();
+    if (t % 25 === 0) clock.statsPolled(counters(t - LATENCY_MS), t - LATENCY_MS, LATENCY_MS);
+  }
+}
+
+// A stall heard over [fromMs, fromMs + ms): concealment (heard as nothing here), then the audio
+// ms later. Concealment before the stream's audio (`before` ms, the silence played before any
+// audio came) counts as concealment too.
+function stall({ fromMs, ms, before = 5000, silentAfterMs = Infinity, lostPackets = 0 }) {
+  const delay = (t) => (t < fromMs ? 0 : t < fromMs + ms ? null : lostPackets > 0 ? 0 : ms);
+  const counters = (outputMs) => {
+    const heard = outputMs + LATENCY_MS;
+    const concealed = Math.max(0, Math.min(heard, fromMs + ms) - fromMs);
+    const silent = Math.max(0, concealed - silentAfterMs);
+    return {
+      jitterBufferEmittedCount: Math.max(0, heard - concealed) * SAMPLES_PER_MS,
+      concealedSamples: (before + concealed) * SAMPLES_PER_MS, silentConcealedSamples: (before + silent) * SAMPLES_PER_MS,
+      packetsLost: heard >= fromMs + ms ? lostPackets : 0, removedSamplesForAcceleration: 0, insertedSamplesForDeceleration: 0,
+    };
+  };
+  return { delay, counters };
+}
+
+test('a stall mid-speech delays the clock as getStats counts it, before the next match', () => {
+  for (const silentAfterMs of [Infinity, 40]) stalled(silentAfterMs);
+});
+
+function stalled(silentAfterMs) {
+  const clock = new PlayoutClock({ envelope: [] });
+  sending(clock, 8000);
+  clock.reading(0, 30);
+  const { delay, counters } = stall({ fromMs: 2030, ms: 130, silentAfterMs });  // in the vowel of the 7th "pa"
+  hearPolled(clock, 0, 2030, delay, counters);
+  assert.ok(Math.abs(clock.runningMs(2000) - 2000) < 2, `before the stall: ${clock.runningMs(2000)}`);
+  const matches = clock.corrections.length;
+  // From when the stall is heard to the next syllable: the audio is 130 ms late. (No match
+  // comes before it: the windows hold the stall.)
+  for (let t = 2030; t < 2700; ++t) {
+    hearPolled(clock, t, t + 1, delay, counters);
+    if (t >= 2160 + 30 && t < 2500) {
+      assert.ok(Math.abs(clock.runningMs(t) - (t - 130)) < 3, `silent after ${silentAfterMs} ms, at ${t}: the clock says ${clock.runningMs(t).toFixed(1)}, the sound ${t - 130}`);
+    }
+  }
+  // The matches after it agree.
+  const after = clock.corrections.slice(matches).filter((c) => c.t > 2160);
+  assert.ok(after.length > 0 && after.every((c) => Math.abs(c.lag) < 3), JSON.stringify(after.slice(0, 5)));
+}
+
+test('a stall before the first poll after the first match delays the clock', () => {
+  // Under load a page's polls come up to 130 ms apart (a run here: the first match at 2199, the
+  // polls at 2146 and 2279, 59 ms of concealment between them, the next match -68.9 ms). Here:
+  // the first "pa" matched, then no poll for 250 ms, and a 60 ms stall in the silence after it.
+  const clock = new PlayoutClock({ envelope: [] });
+  sending(clock, 8000);
+  clock.reading(0, 0);
+  const { delay, counters } = stall({ fromMs: 200, ms: 60 });
+  let matchedAt = null;
+  for (let t = 0; t < 1000; ++t) {
+    clock.envelope.push({ t, rms: delay(t) === null ? 0 : level(t - delay(t)) / 32768 });
+    if (t % 10 === 9) clock.matchHeard();
+    if (matchedAt === null && clock.matched !== null) matchedAt = t;
+    if (t % 25 === 0 && (matchedAt === null || t > 250)) clock.statsPolled(counters(t - LATENCY_MS), t - LATENCY_MS, LATENCY_MS);
+    // Up to the next syllable's match: the clock 60 ms behind where it was.
+    if (t >= 300 && t < 397) {
+      assert.ok(Math.abs(clock.runningMs(t) - (t - 60)) < 3, `first match at ${matchedAt}; at ${t} the clock says ${clock.runningMs(t).toFixed(1)}, the sound ${t - 60}`);
+    }
+  }
+  assert.ok(matchedAt !== null && matchedAt < 100, `first match at ${matchedAt}`);
+});
+
+test('a lost packet moves no clock; at a stream\'s end the clock stops, then runs on past it', () => {
+  // A lost packet (20 ms concealed, packetsLost 1): the next is played on time.
+  let clock = new PlayoutClock({ envelope: [] });
+  sending(clock, 8000);
+  clock.reading(0, 0);
+  const lost = stall({ fromMs: 2030, ms: 20, lostPackets: 1 });
+  hearPolled(clock, 0, 2400, lost.delay, lost.counters);
+  for (const t of [2100, 2200, 2300]) assert.ok(Math.abs(clock.runningMs(t) - t) < 2, `at ${t}: ${clock.runningMs(t)}`);
+  // The stream ends: NetEq conceals, fading to silence (silentConcealedSamples) within 140 ms
+  // in Chromium. The clock stops, and once the silence has gone on for 500 ms with no audio
+  // decoded it runs on, 140 ms behind, so that the face gets past the end.
+  clock = new PlayoutClock({ envelope: [] });
+  sending(clock, 3000);
+  clock.reading(0, 0);
+  const end = stall({ fromMs: 3000, ms: 1e9, silentAfterMs: 140 });
+  hearPolled(clock, 0, 4500, end.delay, end.counters);
+  assert.ok(Math.abs(clock.runningMs(3400) - (3000 - 30)) < 30, `the clock stops: ${clock.runningMs(3400)}`);
+  assert.ok(Math.abs(clock.runningMs(4000) - (4000 - 140)) < 30, `${clock.runningMs(4000)}`);
+  assert.ok(Math.abs(clock.runningMs(4400) - clock.runningMs(3900) - 500) < 1, `${clock.runningMs(3900)}, ${clock.runningMs(4400)}`);
+});
