@@ -43,12 +43,9 @@ bool espeak_failed = false;  // espeak-ng did not start in pfap-espeak: not trie
 // loader found this library, in the build tree and installed alike.
 std::string helper_path() {
   Dl_info info{};
-  if (dladdr(reinterpret_cast<void*>(&helper_path), &info) == 0 || info.dli_fname == nullptr)
-    return "pfap-espeak";  // not reached: a shared object's function is always found
-  const std::string library = info.dli_fname;
-  const size_t slash = library.rfind('/');
-  return (slash == std::string::npos ? std::string() : library.substr(0, slash + 1)) +
-         "pfap-espeak";
+  dladdr(reinterpret_cast<void*>(&helper_path), &info);  // finds this library's file
+  const std::string library = info.dli_fname != nullptr ? info.dli_fname : "";
+  return library.substr(0, library.rfind('/') + 1) + "pfap-espeak";
 }
 
 // Under helper_mutex: pfap-espeak runs, or `error` says why not.
