@@ -38,6 +38,7 @@ std::mutex helper_mutex;  // held while pfap-espeak starts and while a request i
 int helper_socket = -1;   // the caller's end; -1 when there is no pfap-espeak
 pid_t helper_pid = -1;
 bool espeak_failed = false;  // espeak-ng did not start in pfap-espeak: not tried again
+constexpr char espeak_failure[] = "espeak-ng could not start (its data not installed?)";
 
 // pfap-espeak is installed beside this library, and built beside it: found from where the
 // loader found this library, in the build tree and installed alike.
@@ -52,7 +53,7 @@ std::string helper_path() {
 bool start(std::string& error) {
   if (helper_socket >= 0) return true;
   if (espeak_failed) {
-    error = "espeak-ng could not start (its data not installed?)";
+    error = espeak_failure;
     return false;
   }
   int sv[2];
@@ -101,7 +102,7 @@ bool start(std::string& error) {
     while (waitpid(pid, nullptr, 0) < 0 && errno == EINTR) {
     }
     espeak_failed = n == sizeof rate;  // it answered: espeak-ng itself did not start
-    error = espeak_failed ? "espeak-ng could not start (its data not installed?)"
+    error = espeak_failed ? std::string(espeak_failure)
                           : "espeak-ng's helper " + path + " ended as it started";
     return false;
   }
