@@ -6,7 +6,8 @@
 // synthesis to the next that no call of its API resets (wavegen.c's function-level statics
 // Flutter_ix and cycle_count), so a fresh child is the only way the same text gives the same
 // audio whatever was spoken before (issue 31). It exits when the caller's end of the socket
-// closes. It runs only espeak-ng's code and this file's, so a fork of it is cheap and safe.
+// closes. It runs only espeak-ng's code and this file's, in its main thread and one that
+// espeak_Initialize starts and that then waits for good, so a fork of it is cheap and safe.
 #include <espeak-ng/speak_lib.h>
 #include <signal.h>
 #include <sys/prctl.h>
