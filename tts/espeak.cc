@@ -1,89 +1,208 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 #include "espeak.h"
 
-#include <espeak-ng/speak_lib.h>
+#include <dlfcn.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
-#include <algorithm>
+#include <cerrno>
 #include <cstring>
+#include <functional>
 #include <mutex>
+
+#include "espeakwire.h"
+
+extern char** environ;
 
 namespace pfap::tts {
 namespace {
 
-std::mutex espeak_mutex;
-bool initialized = false;
-int espeak_rate = 0;  // espeak_Initialize's answer; <= 0 when it failed
+using wire::Ask;
+using wire::Reader;
+using wire::Writer;
 
-// The call in progress, under espeak_mutex.
-struct Call {
-  Synthesis* out = nullptr;
-  size_t sentences = 0;  // sentence events so far
-  const std::atomic<bool>* cancel = nullptr;
-};
-Call current;
+// espeak-ng 1.51 carries state from one synthesis to the next that no call of its API resets
+// (wavegen.c's function-level statics Flutter_ix and cycle_count): the same text spoken twice
+// in one process gave other audio and alignments that differed by up to 300 ms (issue 31). So
+// espeak-ng runs in a helper program, pfap-espeak, that the first call starts (posix_spawn: the
+// caller, which may be large and many-threaded, never runs its own code in a child). It starts
+// espeak-ng, never speaks, and forks a child per synthesis whose espeak-ng never has
+// (pfap-espeak.cc). Each call sends it a request with the write end of a fresh pipe, on which
+// the answer comes (espeakwire.h).
+std::mutex helper_mutex;  // held while pfap-espeak starts and while a request is sent
+int helper_socket = -1;   // the caller's end; -1 when there is no pfap-espeak
+pid_t helper_pid = -1;
+bool espeak_failed = false;  // espeak-ng did not start in pfap-espeak: not tried again
+constexpr char espeak_failure[] = "espeak-ng could not start (its data not installed?)";
 
-size_t sentence_now() { return current.sentences > 0 ? current.sentences - 1 : 0; }
-
-// espeak-ng hands over audio and the events up to it, in order.
-int on_synth(short* wav, int n_samples, espeak_EVENT* events) {
-  Synthesis& s = *current.out;
-  for (espeak_EVENT* e = events; e != nullptr && e->type != espeakEVENT_LIST_TERMINATED; ++e) {
-    switch (e->type) {
-      case espeakEVENT_SAMPLERATE:
-        s.sample_rate = static_cast<unsigned>(e->id.number);
-        break;
-      case espeakEVENT_SENTENCE:
-        ++current.sentences;
-        break;
-      case espeakEVENT_WORD:
-        // text_position counts code points from 1.
-        s.words.push_back({static_cast<size_t>(std::max(e->text_position - 1, 0)), sentence_now(),
-                           s.phonemes.size(), s.phonemes.size()});
-        break;
-      case espeakEVENT_PHONEME:
-        s.phonemes.push_back({std::string(e->id.string, strnlen(e->id.string, sizeof e->id.string)),
-                              static_cast<size_t>(std::max(e->sample, 0)), sentence_now()});
-        break;
-      default:
-        break;
-    }
-  }
-  if (wav != nullptr && n_samples > 0) s.samples.insert(s.samples.end(), wav, wav + n_samples);
-  // Non-zero stops the synthesis.
-  return current.cancel != nullptr && current.cancel->load() ? 1 : 0;
+// pfap-espeak is installed beside this library, and built beside it: found from where the
+// loader found this library, in the build tree and installed alike.
+std::string helper_path() {
+  Dl_info info{};
+  dladdr(reinterpret_cast<void*>(&helper_path), &info);  // finds this library's file
+  const std::string library = info.dli_fname != nullptr ? info.dli_fname : "";
+  return library.substr(0, library.rfind('/') + 1) + "pfap-espeak";
 }
 
-// A word's phonemes run to the next word's, without the pauses that end a clause.
-void close_words(Synthesis& s) {
-  for (size_t i = 0; i < s.words.size(); ++i) {
-    Synthesis::Word& w = s.words[i];
-    size_t end = i + 1 < s.words.size() ? s.words[i + 1].first_phoneme : s.phonemes.size();
-    while (end > w.first_phoneme && s.phonemes[end - 1].mnemonic.starts_with('_')) --end;
-    w.end_phoneme = end;
-  }
-}
-
-bool set_voice(const VoiceSettings& settings, std::string& error) {
-  if (espeak_SetVoiceByName(settings.voice.c_str()) != EE_OK) {
-    error = "espeak-ng has no voice \"" + settings.voice + "\"";
+// Under helper_mutex: pfap-espeak runs, or `error` says why not.
+bool start(std::string& error) {
+  if (helper_socket >= 0) return true;
+  if (espeak_failed) {
+    error = espeak_failure;
     return false;
   }
-  espeak_SetParameter(espeakRATE, settings.rate, 0);
-  espeak_SetParameter(espeakPITCH, settings.pitch, 0);
-  espeak_SetParameter(espeakVOLUME, settings.volume, 0);
+  int sv[2];
+  if (socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sv) != 0) {
+    error = std::string("no socket for espeak-ng: ") + std::strerror(errno);
+    return false;
+  }
+  // Its end becomes kSocketFd, which a dup2 onto itself would leave close-on-exec.
+  if (sv[1] == wire::kSocketFd) {
+    const int moved = fcntl(sv[1], F_DUPFD_CLOEXEC, wire::kSocketFd + 1);
+    close(sv[1]);
+    sv[1] = moved;
+  }
+  // pfap-espeak holds only its socket and the standard streams, with no signal blocked or
+  // ignored, whatever the caller holds and does with signals.
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  posix_spawn_file_actions_adddup2(&files, sv[1], wire::kSocketFd);
+  posix_spawn_file_actions_addclosefrom_np(&files, wire::kSocketFd + 1);
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  sigset_t signals;
+  sigemptyset(&signals);
+  posix_spawnattr_setsigmask(&attributes, &signals);
+  sigfillset(&signals);
+  posix_spawnattr_setsigdefault(&attributes, &signals);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
+  static const std::string path = helper_path();
+  char* argv[] = {const_cast<char*>(path.c_str()), nullptr};
+  pid_t pid = -1;
+  const int spawned = posix_spawn(&pid, path.c_str(), &files, &attributes, argv, environ);
+  posix_spawnattr_destroy(&attributes);
+  posix_spawn_file_actions_destroy(&files);
+  close(sv[1]);
+  if (spawned != 0) {
+    close(sv[0]);
+    error = "espeak-ng's helper " + path + " could not start: " + std::strerror(spawned);
+    return false;
+  }
+  int rate = 0;
+  ssize_t n;
+  while ((n = recv(sv[0], &rate, sizeof rate, 0)) < 0 && errno == EINTR) {
+  }
+  if (n != sizeof rate || rate <= 0) {
+    close(sv[0]);
+    while (waitpid(pid, nullptr, 0) < 0 && errno == EINTR) {
+    }
+    espeak_failed = n == sizeof rate;  // it answered: espeak-ng itself did not start
+    error = espeak_failed ? std::string(espeak_failure)
+                          : "espeak-ng's helper " + path + " ended as it started";
+    return false;
+  }
+  helper_socket = sv[0];
+  helper_pid = pid;
   return true;
 }
 
-// Under espeak_mutex.
-bool start(std::string& error) {
-  if (!initialized) {
-    initialized = true;
-    espeak_rate = espeak_Initialize(AUDIO_OUTPUT_SYNCHRONOUS, 0, nullptr,
-                                    espeakINITIALIZE_PHONEME_EVENTS | espeakINITIALIZE_DONT_EXIT);
-    if (espeak_rate > 0) espeak_SetSynthCallback(on_synth);
+// Sends `request` and `fd` to pfap-espeak; starts it if it does not run, and again once if it
+// has died.
+bool send_request(const std::string& request, int fd, std::string& error) {
+  std::lock_guard lock(helper_mutex);
+  for (bool restarted = false;;) {
+    if (!start(error)) return false;
+    iovec iov{const_cast<char*>(request.data()), request.size()};
+    alignas(cmsghdr) char control[CMSG_SPACE(sizeof fd)] = {};
+    msghdr m{};
+    m.msg_iov = &iov;
+    m.msg_iovlen = 1;
+    m.msg_control = control;
+    m.msg_controllen = sizeof control;
+    cmsghdr* c = CMSG_FIRSTHDR(&m);
+    c->cmsg_level = SOL_SOCKET;
+    c->cmsg_type = SCM_RIGHTS;
+    c->cmsg_len = CMSG_LEN(sizeof fd);
+    std::memcpy(CMSG_DATA(c), &fd, sizeof fd);
+    if (sendmsg(helper_socket, &m, MSG_NOSIGNAL) >= 0) return true;
+    if (errno == EINTR) continue;
+    if (errno == EMSGSIZE || request.size() > wire::kMaxRequest) {
+      error = "the text is too long for espeak-ng (" + std::to_string(request.size()) + " bytes)";
+      return false;
+    }
+    // pfap-espeak has died (its end of the socket closed).
+    const int cause = errno;
+    close(helper_socket);
+    helper_socket = -1;
+    while (waitpid(helper_pid, nullptr, 0) < 0 && errno == EINTR) {
+    }
+    if (restarted || (cause != EPIPE && cause != ECONNRESET)) {
+      error = std::string("espeak-ng's helper has gone: ") + std::strerror(cause);
+      return false;
+    }
+    restarted = true;
   }
-  if (espeak_rate <= 0) {
-    error = "espeak-ng could not start (its data not installed?)";
+}
+
+// Asks pfap-espeak for `ask` and hands the answer to `take`. False with `error` when espeak-ng
+// cannot start, has no such voice, could not speak or died before it answered. When `*cancel`
+// becomes true, the child speaking is killed within 10 ms and `take` is not called.
+bool call(Ask ask, std::string_view text, const VoiceSettings& settings,
+          const std::function<void(Reader&)>& take, std::string& error,
+          const std::atomic<bool>* cancel = nullptr) {
+  Writer request;
+  request.put(ask);
+  put(request, settings);
+  request.put(text);
+  int fds[2];
+  // Close-on-exec: a child another thread forks and execs must not hold the pipe open.
+  if (pipe2(fds, O_CLOEXEC) != 0) {
+    error = std::string("no pipe for espeak-ng: ") + std::strerror(errno);
+    return false;
+  }
+  const bool sent = send_request(request.bytes, fds[1], error);
+  close(fds[1]);
+  if (!sent) {
+    close(fds[0]);
+    return false;
+  }
+  std::string bytes;
+  pid_t pid = -1;  // the speaking child's, 0 when pfap-espeak answered; -1 until it came
+  bool cancelled = false;
+  for (;;) {
+    if (pid < 0 && bytes.size() >= sizeof pid) std::memcpy(&pid, bytes.data(), sizeof pid);
+    if (cancel != nullptr && cancel->load() && pid >= 0) {
+      cancelled = true;
+      // It has not closed the pipe, so it has not exited and the pid is still its own.
+      if (pid > 0) kill(pid, SIGKILL);
+      break;
+    }
+    pollfd p{fds[0], POLLIN, 0};
+    if (poll(&p, 1, cancel != nullptr ? 10 : -1) == 0) continue;
+    char buffer[65536];
+    const ssize_t n = read(fds[0], buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    bytes.append(buffer, static_cast<size_t>(n));
+  }
+  close(fds[0]);
+  if (cancelled) return true;
+  Reader r{bytes};
+  std::string failure;
+  r.get(pid);
+  r.get(failure);
+  if (r.whole && !failure.empty()) {
+    error = failure;
+    return false;
+  }
+  if (r.whole) take(r);
+  if (!r.whole || !r.rest.empty()) {
+    error = "espeak-ng stopped before it answered";
     return false;
   }
   return true;
@@ -92,39 +211,15 @@ bool start(std::string& error) {
 }  // namespace
 
 bool check_voice(const VoiceSettings& settings, unsigned& sample_rate, std::string& error) {
-  std::lock_guard lock(espeak_mutex);
-  if (!start(error) || !set_voice(settings, error)) return false;
-  sample_rate = static_cast<unsigned>(espeak_rate);
-  return true;
+  return call(
+      Ask::check_voice, {}, settings, [&](Reader& r) { r.get(sample_rate); }, error);
 }
 
 bool synthesize(std::string_view text, const VoiceSettings& settings, Synthesis& out,
                 std::string& error, const std::atomic<bool>* cancel) {
-  std::lock_guard lock(espeak_mutex);
-  if (!start(error) || !set_voice(settings, error)) return false;
   out = Synthesis{};
-  out.sample_rate = static_cast<unsigned>(espeak_rate);  // until its event says otherwise
-  const std::string input(text);
-
-  // The stressed transcription, clause by clause, as espeak-ng -x prints it.
-  const void* clause = input.c_str();
-  while (clause != nullptr) {
-    const char* phonemes = espeak_TextToPhonemes(&clause, espeakCHARS_UTF8, 0);
-    if (phonemes == nullptr) break;
-    if (!out.transcription.empty()) out.transcription += ' ';
-    out.transcription += phonemes;
-  }
-
-  current = {&out, 0, cancel};
-  const espeak_ERROR result = espeak_Synth(input.c_str(), input.size() + 1, 0, POS_CHARACTER, 0,
-                                           espeakCHARS_UTF8, nullptr, nullptr);
-  current = {};
-  if (result != EE_OK) {
-    error = "espeak-ng could not speak the text (error " + std::to_string(result) + ")";
-    return false;
-  }
-  close_words(out);
-  return true;
+  return call(
+      Ask::synthesize, text, settings, [&](Reader& r) { get(r, out); }, error, cancel);
 }
 
 }  // namespace pfap::tts

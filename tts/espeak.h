@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // espeak-ng 1.51 as a function: text in, audio and its events out. espeak-ng is one
-// process-wide synthesizer that is not reentrant (its voice, parameters and callback are
-// global), so every call runs under one mutex, synchronously, and sets all of them.
+// process-wide synthesizer that is not reentrant and keeps state from one synthesis to the
+// next that no call resets, so it runs in a helper program, pfap-espeak, installed beside
+// libpfaptts and started by the first call of a process: each call is spoken by a child of it
+// whose espeak-ng has started and never spoken, so the same text and settings give the same
+// audio and events whatever was spoken before (espeak.cc and pfap-espeak.cc say why).
 #pragma once
 
 #include <atomic>
@@ -46,9 +49,9 @@ struct Synthesis {
 // (a synthesis reports its own, which is the one to use).
 bool check_voice(const VoiceSettings& settings, unsigned& sample_rate, std::string& error);
 
-// Speaks plain UTF-8 `text` (no SSML). False with `error` set when espeak-ng cannot start or
-// has no such voice. When `*cancel` becomes true, espeak-ng stops at its next block of audio
-// (a few ms of work) and `out` holds what was spoken so far.
+// Speaks plain UTF-8 `text` (no SSML). False with `error` set when pfap-espeak or espeak-ng
+// cannot start, has no such voice or dies. When `*cancel` becomes true, espeak-ng is stopped within 10 ms and
+// `out` is empty.
 bool synthesize(std::string_view text, const VoiceSettings& settings, Synthesis& out,
                 std::string& error, const std::atomic<bool>* cancel = nullptr);
 

@@ -505,5 +505,26 @@ TEST(Aligner, LeadingSilenceIsAPause) {
   }
 }
 
+// Issue 31: an alignment does not depend on what the process spoke before it (espeak-ng keeps
+// state between syntheses, tts/espeak.cc): the same recording and text give the same phonemes,
+// to the sample, after another sentence in another voice and at another rate.
+TEST(Aligner, SameInputGivesTheSameAlignmentWhateverWasSpokenBefore) {
+  const std::string text = "Always remember the open ocean.";
+  const tts::Speech truth = phonetic_truth(text, {"en-us", 140, 60, 100});
+  const Alignment first = aligned(text, truth.samples, truth.sample_rate);
+  for (const tts::VoiceSettings& before :
+       {tts::VoiceSettings{}, tts::VoiceSettings{"en-us", 300, 20, 150}}) {
+    SCOPED_TRACE(before.voice + " at " + std::to_string(before.rate));
+    say("The quick brown fox jumps over the lazy dog.", before);
+    const Alignment again = aligned(text, truth.samples, truth.sample_rate);
+    ASSERT_EQ(again.phonemes.size(), first.phonemes.size());
+    for (size_t k = 0; k < first.phonemes.size(); ++k) {
+      EXPECT_EQ(again.phonemes[k].start, first.phonemes[k].start) << "phoneme " << k;
+      EXPECT_EQ(again.phonemes[k].event.phoneme.symbol, first.phonemes[k].event.phoneme.symbol);
+    }
+    EXPECT_EQ(again.relative_cost, first.relative_cost);
+  }
+}
+
 }  // namespace
 }  // namespace pfap::align

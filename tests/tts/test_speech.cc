@@ -216,6 +216,27 @@ TEST(Speech, DurationsOnTheUtterancesMsGrid) {
   EXPECT_EQ(out[0].n_samples, 1768u);
 }
 
+// espeak-ng keeps its wave generator's pitch flutter and roughness from one synthesis to the
+// next (issue 31): each synthesis must give the same audio and phonemes whatever was spoken
+// before it, in another voice or at another rate.
+TEST(Speech, SameTextGivesTheSameSpeechWhateverWasSpokenBefore) {
+  const std::string text = "Always remember the open ocean.";
+  const Speech first = say(text);
+  for (const VoiceSettings& before :
+       {VoiceSettings{}, VoiceSettings{"en-us", 140, 60, 100}, VoiceSettings{"de", 300, 20, 150}}) {
+    SCOPED_TRACE(before.voice + " at " + std::to_string(before.rate));
+    say("The quick brown fox jumps over the lazy dog near the river bank.", before);
+    const Speech again = say(text);
+    EXPECT_EQ(again.samples, first.samples);
+    ASSERT_EQ(again.phonemes.size(), first.phonemes.size());
+    for (size_t i = 0; i < first.phonemes.size(); ++i) {
+      EXPECT_EQ(again.phonemes[i].start, first.phonemes[i].start) << "phoneme " << i;
+      EXPECT_EQ(again.phonemes[i].n_samples, first.phonemes[i].n_samples) << "phoneme " << i;
+      EXPECT_EQ(again.phonemes[i].event.phoneme.f0, first.phonemes[i].event.phoneme.f0);
+    }
+  }
+}
+
 TEST(Speech, UnknownVoiceIsAnError) {
   Speech s;
   std::string error;

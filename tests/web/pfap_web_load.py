@@ -323,11 +323,24 @@ async def main():
                     thread_cpu[tid] = (name, int(fields[11]) + int(fields[12]))
             await asyncio.sleep(0.05)
 
-    # The server's own time and that of the children it has waited for: a synthesis in a child
-    # process (docs/tts.md, "Tried and withdrawn") would otherwise look free.
+    # The server's own time and that of its children, live or waited for: pfaptts speaks each
+    # sentence in a child of the server's pfap-espeak, which waits for them (docs/tts.md).
     def cpu_s():
-        fields = open(f'/proc/{server.pid}/stat').read().rsplit(')', 1)[1].split()
-        return sum(int(f) for f in fields[11:15]) / os.sysconf('SC_CLK_TCK')
+        pids = [server.pid]
+        for task in os.listdir(f'/proc/{server.pid}/task'):
+            try:
+                with open(f'/proc/{server.pid}/task/{task}/children') as children:
+                    pids += [int(pid) for pid in children.read().split()]
+            except FileNotFoundError:  # a thread that has ended
+                pass
+        ticks = 0
+        for pid in pids:
+            try:
+                fields = open(f'/proc/{pid}/stat').read().rsplit(')', 1)[1].split()
+            except FileNotFoundError:
+                continue
+            ticks += sum(int(f) for f in fields[11:15])
+        return ticks / os.sysconf('SC_CLK_TCK')
 
     sampler = asyncio.ensure_future(sample())
     start = time.monotonic()
