@@ -666,19 +666,18 @@ void close_session(const std::shared_ptr<Session>& s) {
   if (s->connect_timer != 0) g_source_remove(s->connect_timer);
   s->connect_timer = 0;
   StopWatch* watch = s->server->stop_watch;
-  // webrtcbin 1.22 sets the answer on its own thread, which stops only once webrtcbin's
-  // children are in NULL. Set there, the answer blocks the receive bin's input again (ICE not
-  // yet connected) with a probe that holds the bin, and the bin, its nicesrc, dtlsdec and
-  // srtpdec, and their 20 fds outlive the session (docs/performance.md, "Sessions that come
-  // and go"). So the answer is set first.
+  if (watch != nullptr)
+    watch->now("session " + std::to_string(s->id) + "'s pipeline going to NULL");
+  // webrtcbin 1.22 sets the answer on its own thread, which it stops only after its children
+  // have gone to NULL. Set in between, the answer blocks the receive bin's input again (ICE
+  // not yet connected) with a probe that holds the bin: the bin, its nicesrc, dtlsdec and
+  // srtpdec and their 5 fds would outlive the session (docs/performance.md, "Sessions that
+  // come and go"). So the answer is set first.
   if (s->answer_set != nullptr) {
-    if (watch != nullptr) watch->now("session " + std::to_string(s->id) + "'s answer being set");
     gst_promise_wait(s->answer_set);
     gst_promise_unref(s->answer_set);
     s->answer_set = nullptr;
   }
-  if (watch != nullptr)
-    watch->now("session " + std::to_string(s->id) + "'s pipeline going to NULL");
   gst_element_set_state(s->pipeline, GST_STATE_NULL);
   if (watch != nullptr) watch->now("the main loop");
   gst_bus_remove_watch(GST_ELEMENT_BUS(s->pipeline));
