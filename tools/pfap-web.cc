@@ -196,8 +196,9 @@ struct Session : std::enable_shared_from_this<Session> {
   bool audio_flowing = false;
   bool closed = false;
   bool answered = false;
-  guint connect_timer = 0;   // until the data channel opens
-  std::string pending_text;  // said when the audio starts or the current text ends
+  GstPromise* answer_set = nullptr;  // the last answer's, until the session closes
+  guint connect_timer = 0;           // until the data channel opens
+  std::string pending_text;          // said when the audio starts or the current text ends
   uint32_t audio_ts_offset = 0;
   uint32_t pfap_ts_offset = 0;
 
@@ -295,11 +296,13 @@ void free_weak(gpointer data, GClosure*) { free_weak_data(data); }
 
 // -- Signalling ---------------------------------------------------------------------------
 
-// With a promise: given none, webrtcbin 1.22 leaks the reply it would have given it.
-void set_description(GstElement* webrtc, const char* signal, GstWebRTCSessionDescription* sdp) {
+// With a promise: given none, webrtcbin 1.22 leaks the reply it would have given it. The
+// promise is returned, replied once webrtcbin's thread has set the description.
+GstPromise* set_description(GstElement* webrtc, const char* signal,
+                            GstWebRTCSessionDescription* sdp) {
   GstPromise* promise = gst_promise_new();
   g_signal_emit_by_name(webrtc, signal, sdp, promise);
-  gst_promise_unref(promise);
+  return promise;
 }
 
 void on_offer_created(GstPromise* promise, gpointer data) {
@@ -315,7 +318,7 @@ void on_offer_created(GstPromise* promise, gpointer data) {
     if (offer != nullptr) gst_webrtc_session_description_free(offer);
     return;
   }
-  set_description(session->webrtc, "set-local-description", offer);
+  gst_promise_unref(set_description(session->webrtc, "set-local-description", offer));
   gchar* sdp = gst_sdp_message_as_text(offer->sdp);
   std::string text = sdp;
   g_free(sdp);
@@ -357,7 +360,8 @@ bool set_answer(Session& s, const std::string& sdp_text) {
   }
   GstWebRTCSessionDescription* answer =
       gst_webrtc_session_description_new(GST_WEBRTC_SDP_TYPE_ANSWER, sdp);
-  set_description(s.webrtc, "set-remote-description", answer);
+  if (s.answer_set != nullptr) gst_promise_unref(s.answer_set);
+  s.answer_set = set_description(s.webrtc, "set-remote-description", answer);
   gst_webrtc_session_description_free(answer);
   return true;
 }
@@ -664,6 +668,16 @@ void close_session(const std::shared_ptr<Session>& s) {
   StopWatch* watch = s->server->stop_watch;
   if (watch != nullptr)
     watch->now("session " + std::to_string(s->id) + "'s pipeline going to NULL");
+  // webrtcbin 1.22 sets the answer on its own thread, which it stops only after its children
+  // have gone to NULL. Set in between, the answer blocks the receive bin's input again (ICE
+  // not yet connected) with a probe that holds the bin: the bin, its nicesrc, dtlsdec and
+  // srtpdec and their 5 fds would outlive the session (docs/performance.md, "Sessions that
+  // come and go"). So the answer is set first.
+  if (s->answer_set != nullptr) {
+    gst_promise_wait(s->answer_set);
+    gst_promise_unref(s->answer_set);
+    s->answer_set = nullptr;
+  }
   gst_element_set_state(s->pipeline, GST_STATE_NULL);
   if (watch != nullptr) watch->now("the main loop");
   gst_bus_remove_watch(GST_ELEMENT_BUS(s->pipeline));

@@ -2,17 +2,18 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """Sessions that come and go against tools/pfap-web (issue 28): CYCLES sessions, CONCURRENT at
 a time, each of one of KINDS in turn: n, one that never answers the offer (the server's
---connect-timeout closes it); m, one that connects, says it plays and leaves mid-sentence (at
-its first PFAP packet); e, one that hears its text to the end and leaves. After a warm-up (the
-first sessions load plugins and fill caches that stay), it takes the server's file
-descriptors, threads and RSS; after the cycles, once the server has closed every session, it
-takes them again. The server runs with GStreamer's leaks tracer, which lists at exit every
-GstObject still alive. Exits 1 if a session was left open (pfap-web prints "session N opened"
-and "closed"), if any file descriptor or thread was left behind, or if any object but
-dtlsdec's one shared DTLS agent (GStreamer's, made once per process for the default
-certificate) outlived the sessions. RSS is printed, not checked: glibc's arenas grow with the
-sessions open at once and keep what they took, so only a long run tells a leak from that
-(scripts/bench churn, docs/performance.md).
+--connect-timeout closes it); a, one that answers the offer and leaves at once, while ICE has
+yet to connect and webrtcbin may not yet have set the answer; m, one that connects, says it
+plays and leaves mid-sentence (at its first PFAP packet); e, one that hears its text to the end
+and leaves. After a warm-up (the first sessions load plugins and fill caches that stay), it
+takes the server's file descriptors, threads and RSS; after the cycles, once the server has
+closed every session, it takes them again. The server runs with GStreamer's leaks tracer,
+which lists at exit every GstObject still alive. Exits 1 if a session was left open (pfap-web
+prints "session N opened" and "closed"), if any file descriptor or thread was left behind, or
+if any object but dtlsdec's one shared DTLS agent (GStreamer's, made once per process for the
+default certificate) outlived the sessions. RSS is printed, not checked: glibc's arenas grow
+with the sessions open at once and keep what they took, so only a long run tells a leak from
+that (scripts/bench churn, docs/performance.md).
 
     pfap_web_churn.py [CYCLES] [CONCURRENT] [KINDS]   (default 50 6 nme; PFAP_WEB names the
                                                       server; as root)
@@ -25,8 +26,8 @@ import sys
 import threading
 import time
 
-from pfap_web_load import (WebSocket, enter_network_namespace, playing_peer, rss_kib,
-                           skip_opus_decoding, start_server)
+from pfap_web_load import (WebSocket, answer_offer, enter_network_namespace, playing_peer,
+                           rss_kib, skip_opus_decoding, start_server)
 
 WARM_UP = 9
 # Alive at exit whatever the sessions did: dtlsdec keeps one agent for its generated
@@ -46,6 +47,22 @@ async def never_answers(port):
         ws.writer.close()
 
 
+async def answers_and_leaves(port):
+    """Leaves as soon as its answer is sent: the server has it, and the closed connection,
+    at once (docs/performance.md, "The receive bin")."""
+    from aiortc import RTCPeerConnection
+    pc = RTCPeerConnection()
+    ws = await WebSocket.connect(port)
+    try:
+        while (m := await ws.receive())['type'] != 'offer':
+            pass
+        await answer_offer(pc, ws, m)
+        await ws.writer.drain()
+    finally:
+        await pc.close()
+        ws.writer.close()
+
+
 async def connects(port, to_the_end):
     """A playing peer (pfap_web_load.playing_peer) that leaves at its first PFAP packet
     (mid-sentence) or, `to_the_end`, at the text's end."""
@@ -55,7 +72,8 @@ async def connects(port, to_the_end):
 
 
 async def cycle(port, kind):
-    await asyncio.wait_for(never_answers(port) if kind == 'n' else connects(port, kind == 'e'), 60)
+    await asyncio.wait_for(never_answers(port) if kind == 'n' else answers_and_leaves(port)
+                           if kind == 'a' else connects(port, kind == 'e'), 60)
 
 
 def figures(pid):
@@ -67,8 +85,8 @@ async def main():
     cycles = int(sys.argv[1]) if len(sys.argv) > 1 else 50
     concurrent = int(sys.argv[2]) if len(sys.argv) > 2 else 6
     kinds = sys.argv[3] if len(sys.argv) > 3 else 'nme'
-    if not kinds or set(kinds) - set('nme'):
-        raise SystemExit(f'KINDS is some of n, m and e: {kinds}')
+    if not kinds or set(kinds) - set('nmea'):
+        raise SystemExit(f'KINDS is some of n, m, e and a: {kinds}')
     server, port = start_server([f'--text={TEXT}', '--connect-timeout=1'],
                                 env=dict(os.environ, GST_TRACERS='leaks', GST_DEBUG_NO_COLOR='1',
                                          GST_DEBUG='*:1,GST_TRACER:7'))
