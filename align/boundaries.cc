@@ -143,6 +143,22 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
     }
     return b;
   };
+  // From the onset edge at block `b`: where the sound starts to rise out of the silence just
+  // before it (the median of its blocks, digital silence left out), at most kMaxRiseMs back.
+  auto rise_start = [&](long b) {
+    std::vector<float> before;
+    for (long e = std::max(0L, b - kRadiusBlocks); e < b; ++e) {
+      if (db[e] < threshold && db[e] > loudest - kFloorRangeDb) before.push_back(db[e]);
+    }
+    if (before.empty()) return b;
+    std::nth_element(before.begin(), before.begin() + static_cast<long>(before.size() / 2),
+                     before.end());
+    const float rising = before[before.size() / 2] + kOnsetRiseDb;
+    constexpr long kMaxRiseBlocks = kMaxRiseMs / 5;
+    long e = b;
+    while (e > 0 && b - e < kMaxRiseBlocks && db[e - 1] >= rising) --e;
+    return e > 0 && db[e - 1] < rising ? e : b;  // else no silence before the rise
+  };
   for (size_t k = 1; k < phonemes.size() && k <= starts.size(); ++k) {
     const bool speech_ends = is_pause(phonemes[k]) && !is_pause(phonemes[k - 1]);
     const bool speech_begins = !is_pause(phonemes[k]) && is_pause(phonemes[k - 1]);
@@ -163,7 +179,7 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
         return -1L;
       }();
       if (found >= 0) {
-        const long edge = speech_begins && k == 1 ? past_hum(found) : found;
+        const long edge = speech_begins ? rise_start(k == 1 ? past_hum(found) : found) : found;
         starts[k - 1] = static_cast<double>(edge) * static_cast<double>(block);
         // A stop's closure is as silent as the pause before it: the edge is its release.
         if (speech_begins && is_stop(phonemes[k])) {

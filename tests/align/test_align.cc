@@ -274,6 +274,40 @@ TEST(Boundaries, DigitalSilenceIsNoFloorForTheEdges) {
   EXPECT_DOUBLE_EQ(starts[1], static_cast<double>(speech_ends));
 }
 
+// A weak onset (/f/, /h/, /dh/) rises out of the silence for tens of ms below the silence
+// threshold (floor + 20 dB): a 3 kHz sound rising from -64 to -40 dBFS over 60 ms out of a
+// -68 dBFS hiss, then the vowel. It starts where it rises kOnsetRiseDb above that hiss, within a
+// block of the rise; before, where it crossed the threshold, 40 ms late.
+TEST(Boundaries, WeakOnsetStartsWhereItRises) {
+  constexpr unsigned kRate = 16000;
+  std::vector<int16_t> audio(kRate / 2, 0);
+  auto hiss = [&](double seconds) {  // -68 dBFS, the recording's floor
+    for (size_t i = 0; i < static_cast<size_t>(seconds * kRate); ++i) {
+      audio.push_back(static_cast<int16_t>((static_cast<int>(i % 7) - 3) * 6));
+    }
+  };
+  hiss(0.3);
+  const size_t rise_begins = audio.size();
+  std::vector<int16_t> rise = tone(3000, 0.06, kRate);  // tone() is at -15 dBFS
+  for (size_t i = 0; i < rise.size(); ++i) {
+    const double db = -64 + 24.0 * static_cast<double>(i) / static_cast<double>(rise.size());
+    rise[i] = static_cast<int16_t>(rise[i] * std::pow(10.0, (db + 15) / 20));
+  }
+  audio.insert(audio.end(), rise.begin(), rise.end());
+  const std::vector<int16_t> vowel = tone(200, 0.5, kRate);
+  audio.insert(audio.end(), vowel.begin(), vowel.end());
+  const size_t speech_ends = audio.size();
+  hiss(0.3);
+  audio.resize(audio.size() + kRate / 2, 0);
+  const std::vector<tts::SpokenPhoneme> phonemes = {phoneme_at(0, 0), phoneme_at(1, 1),
+                                                    phoneme_at(0, 2)};
+  std::vector<double> starts = {static_cast<double>(rise_begins + rise.size()),  // the warp's
+                                static_cast<double>(speech_ends)};
+  snap_to_silence(phonemes, audio, kRate, starts);
+  EXPECT_NEAR(starts[0], static_cast<double>(rise_begins), 0.005 * kRate);
+  EXPECT_DOUBLE_EQ(starts[1], static_cast<double>(speech_ends));
+}
+
 // Festival's lead-in hum: 160 ms of a 100 Hz hum at -40 dBFS (25 dB below the speech), 45 ms
 // of hiss at the recording's floor, then the first sound. The warp puts the first sound at the hum,
 // whose start is an edge of silence too; the first sound starts after the hum (before, at the hum:
