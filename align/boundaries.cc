@@ -159,6 +159,14 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
     while (e > 0 && b - e < kMaxRiseBlocks && db[e - 1] >= rising) --e;
     return e > 0 && db[e - 1] < rising ? e : b;  // else no silence before the rise
   };
+  // The first edge into sound within kMaxHumMs after block `b`, when `b` starts a silence.
+  auto next_onset = [&](long b) {
+    if (b < 1 || quiet_blocks(b, 1) < kMinQuietBlocks) return -1L;
+    for (long e = b + 1; e < static_cast<long>(n) && e - b <= kMaxHumMs / 5; ++e) {
+      if (db[e] >= threshold && quiet_blocks(e - 1, -1) >= kMinQuietBlocks) return e;
+    }
+    return -1L;
+  };
   for (size_t k = 1; k < phonemes.size() && k <= starts.size(); ++k) {
     const bool speech_ends = is_pause(phonemes[k]) && !is_pause(phonemes[k - 1]);
     const bool speech_begins = !is_pause(phonemes[k]) && is_pause(phonemes[k - 1]);
@@ -166,7 +174,7 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
     // The edge between blocks b - 1 and b nearest the warp's boundary.
     const long at = std::lround(starts[k - 1] / static_cast<double>(block));
     for (long d = 0; d <= kRadiusBlocks; ++d) {
-      const long found = [&] {
+      long found = [&] {
         for (long b : {at - d, at + d}) {
           if (b < 1 || b >= static_cast<long>(n)) continue;
           if (speech_ends && db[b - 1] >= threshold && quiet_blocks(b, 1) >= kMinQuietBlocks) {
@@ -178,6 +186,9 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
         }
         return -1L;
       }();
+      // The warp can put the first sound in the silence before it, at a hum quieter than the
+      // threshold, farther than the radius: it starts at the next edge.
+      if (found < 0 && d == kRadiusBlocks && speech_begins && k == 1) found = next_onset(at);
       if (found >= 0) {
         const long edge = speech_begins ? rise_start(k == 1 ? past_hum(found) : found) : found;
         starts[k - 1] = static_cast<double>(edge) * static_cast<double>(block);

@@ -87,7 +87,9 @@ inline constexpr unsigned kMaxHumMs = 300;
 // long) has no level to be a floor. A stop (p t k b d g ch jh) out of a pause starts
 // kStopClosureMs before the edge: its closure is silent, the edge its release, and phonetic
 // labels (and the lips) start it at its closure. The first sound starts after any hum
-// (kHumBelowLoudestDb). An onset starts where it rises out of the silence (kOnsetRiseDb).
+// (kHumBelowLoudestDb); when the warp puts it in silence with no edge within the radius (live,
+// at a hum that the speech heard since makes silence), at the next edge within kMaxHumMs. An
+// onset starts where it rises out of the silence (kOnsetRiseDb).
 void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
                      std::span<const int16_t> audio, unsigned rate, std::vector<double>& starts);
 

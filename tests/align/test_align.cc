@@ -344,6 +344,35 @@ TEST(Boundaries, FirstSoundStartsAfterAHum) {
   }
 }
 
+// Live, a hum that is the loudest sound heard so far is quieter than the threshold once the
+// speech comes: the warp's first sound at it, 195 ms before the speech, had no edge within the
+// radius and stayed there. The warp's first sound in silence starts at the next edge, within
+// kMaxHumMs: a hum at -52 dBFS (the threshold is the -68 dBFS hiss + 20 dB), 45 ms of hiss.
+TEST(Boundaries, FirstSoundInSilenceStartsAtTheNextEdge) {
+  constexpr unsigned kRate = 16000;
+  std::vector<int16_t> audio(kRate / 2, 0);
+  auto hiss = [&](double seconds) {  // -68 dBFS, the recording's floor
+    for (size_t i = 0; i < static_cast<size_t>(seconds * kRate); ++i) {
+      audio.push_back(static_cast<int16_t>((static_cast<int>(i % 7) - 3) * 6));
+    }
+  };
+  hiss(0.3);
+  const size_t hum_begins = audio.size();
+  std::vector<int16_t> hum = tone(100, 0.16, kRate);  // tone() is at -15 dBFS
+  for (int16_t& x : hum) x = static_cast<int16_t>(x * std::pow(10.0, -37 / 20.0));
+  audio.insert(audio.end(), hum.begin(), hum.end());
+  hiss(0.045);
+  const size_t speech_begins = audio.size();
+  const std::vector<int16_t> speech = tone(200, 0.5, kRate);
+  audio.insert(audio.end(), speech.begin(), speech.end());
+  hiss(0.3);
+  audio.resize(audio.size() + kRate / 2, 0);
+  const std::vector<tts::SpokenPhoneme> phonemes = {phoneme_at(0, 0), phoneme_at(1, 1)};
+  std::vector<double> starts = {static_cast<double>(hum_begins) + 0.01 * kRate};
+  snap_to_silence(phonemes, audio, kRate, starts);
+  EXPECT_DOUBLE_EQ(starts[0], static_cast<double>(speech_begins));
+}
+
 // A stop out of a pause starts at its closure, kStopClosureMs before its release, which is the
 // edge of silence; another sound at the edge.
 TEST(Boundaries, StopOutOfAPauseStartsAtItsClosure) {
