@@ -190,11 +190,14 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
       // threshold, farther than the radius: it starts at the next edge.
       if (found < 0 && d == kRadiusBlocks && speech_begins && k == 1) found = next_onset(at);
       if (found >= 0) {
-        const long edge = speech_begins ? rise_start(k == 1 ? past_hum(found) : found) : found;
+        const long edge = speech_begins && k == 1 ? past_hum(found) : found;
         starts[k - 1] = static_cast<double>(edge) * static_cast<double>(block);
-        // A stop's closure is as silent as the pause before it: the edge is its release.
+        // A stop's closure is as silent as the pause before it: the edge is its release. What
+        // rises before a release is in its closure (ked's /t/): the closure rule alone.
         if (speech_begins && is_stop(phonemes[k])) {
           starts[k - 1] = std::max(starts[k - 1] - double{kStopClosureMs} * rate / 1000, 0.0);
+        } else if (speech_begins) {
+          starts[k - 1] = static_cast<double>(rise_start(edge)) * static_cast<double>(block);
         }
         break;
       }

@@ -306,6 +306,13 @@ TEST(Boundaries, WeakOnsetStartsWhereItRises) {
   snap_to_silence(phonemes, audio, kRate, starts);
   EXPECT_NEAR(starts[0], static_cast<double>(rise_begins), 0.005 * kRate);
   EXPECT_DOUBLE_EQ(starts[1], static_cast<double>(speech_ends));
+  // What rises before a stop's release is in its closure: the closure rule alone (ked's /t/),
+  // kStopClosureMs before the edge, not before the rise (10 ms before the rise, not 45).
+  const PhonemeAlphabet& arpabet = *find_alphabet(kArpabetAlphabet);
+  std::vector<double> stop_start = {static_cast<double>(rise_begins + rise.size())};
+  snap_to_silence({phoneme_at(0, 0), phoneme_at(*find_symbol(arpabet, "P"), 1)}, audio, kRate,
+                  stop_start);
+  EXPECT_GT(stop_start[0], static_cast<double>(rise_begins) - 0.02 * kRate);
 }
 
 // Festival's lead-in hum: 160 ms of a 100 Hz hum at -40 dBFS (25 dB below the speech), 45 ms
