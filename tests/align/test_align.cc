@@ -38,6 +38,13 @@ std::vector<int16_t> tone(double hz, double seconds, unsigned rate) {
   return s;
 }
 
+// Appends `seconds` of a -68 dBFS hiss (the recordings' floor in the tests below).
+void add_hiss(std::vector<int16_t>& audio, double seconds, unsigned rate) {
+  for (size_t i = 0; i < static_cast<size_t>(seconds * rate); ++i) {
+    audio.push_back(static_cast<int16_t>((static_cast<int>(i % 7) - 3) * 6));
+  }
+}
+
 Alignment aligned(const std::string& text, const std::vector<int16_t>& audio, unsigned rate) {
   Alignment a;
   std::string error;
@@ -281,12 +288,7 @@ TEST(Boundaries, DigitalSilenceIsNoFloorForTheEdges) {
 TEST(Boundaries, WeakOnsetStartsWhereItRises) {
   constexpr unsigned kRate = 16000;
   std::vector<int16_t> audio(kRate / 2, 0);
-  auto hiss = [&](double seconds) {  // -68 dBFS, the recording's floor
-    for (size_t i = 0; i < static_cast<size_t>(seconds * kRate); ++i) {
-      audio.push_back(static_cast<int16_t>((static_cast<int>(i % 7) - 3) * 6));
-    }
-  };
-  hiss(0.3);
+  add_hiss(audio, 0.3, kRate);
   const size_t rise_begins = audio.size();
   std::vector<int16_t> rise = tone(3000, 0.06, kRate);  // tone() is at -15 dBFS
   for (size_t i = 0; i < rise.size(); ++i) {
@@ -297,7 +299,7 @@ TEST(Boundaries, WeakOnsetStartsWhereItRises) {
   const std::vector<int16_t> vowel = tone(200, 0.5, kRate);
   audio.insert(audio.end(), vowel.begin(), vowel.end());
   const size_t speech_ends = audio.size();
-  hiss(0.3);
+  add_hiss(audio, 0.3, kRate);
   audio.resize(audio.size() + kRate / 2, 0);
   const std::vector<tts::SpokenPhoneme> phonemes = {phoneme_at(0, 0), phoneme_at(1, 1),
                                                     phoneme_at(0, 2)};
@@ -358,21 +360,16 @@ TEST(Boundaries, FirstSoundStartsAfterAHum) {
 TEST(Boundaries, FirstSoundInSilenceStartsAtTheNextEdge) {
   constexpr unsigned kRate = 16000;
   std::vector<int16_t> audio(kRate / 2, 0);
-  auto hiss = [&](double seconds) {  // -68 dBFS, the recording's floor
-    for (size_t i = 0; i < static_cast<size_t>(seconds * kRate); ++i) {
-      audio.push_back(static_cast<int16_t>((static_cast<int>(i % 7) - 3) * 6));
-    }
-  };
-  hiss(0.3);
+  add_hiss(audio, 0.3, kRate);
   const size_t hum_begins = audio.size();
   std::vector<int16_t> hum = tone(100, 0.16, kRate);  // tone() is at -15 dBFS
   for (int16_t& x : hum) x = static_cast<int16_t>(x * std::pow(10.0, -37 / 20.0));
   audio.insert(audio.end(), hum.begin(), hum.end());
-  hiss(0.045);
+  add_hiss(audio, 0.045, kRate);
   const size_t speech_begins = audio.size();
   const std::vector<int16_t> speech = tone(200, 0.5, kRate);
   audio.insert(audio.end(), speech.begin(), speech.end());
-  hiss(0.3);
+  add_hiss(audio, 0.3, kRate);
   audio.resize(audio.size() + kRate / 2, 0);
   const std::vector<tts::SpokenPhoneme> phonemes = {phoneme_at(0, 0), phoneme_at(1, 1)};
   std::vector<double> starts = {static_cast<double>(hum_begins) + 0.01 * kRate};
