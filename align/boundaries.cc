@@ -143,6 +143,30 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
     }
     return b;
   };
+  // From the onset edge at block `b`: where the sound starts to rise out of the silence just
+  // before it (the median of its blocks, digital silence left out), at most kMaxRiseMs back.
+  auto rise_start = [&](long b) {
+    std::vector<float> before;
+    for (long e = std::max(0L, b - kRadiusBlocks); e < b; ++e) {
+      if (db[e] < threshold && db[e] > loudest - kFloorRangeDb) before.push_back(db[e]);
+    }
+    if (before.empty()) return b;
+    std::nth_element(before.begin(), before.begin() + static_cast<long>(before.size() / 2),
+                     before.end());
+    const float rising = before[before.size() / 2] + kOnsetRiseDb;
+    constexpr long kMaxRiseBlocks = kMaxRiseMs / 5;
+    long e = b;
+    while (e > 0 && b - e < kMaxRiseBlocks && db[e - 1] >= rising) --e;
+    return e > 0 && db[e - 1] < rising ? e : b;  // else no silence before the rise
+  };
+  // The first edge into sound within kMaxHumMs after block `b`, when `b` starts a silence.
+  auto next_onset = [&](long b) {
+    if (b < 1 || quiet_blocks(b, 1) < kMinQuietBlocks) return -1L;
+    for (long e = b + 1; e < static_cast<long>(n) && e - b <= kMaxHumMs / 5; ++e) {
+      if (db[e] >= threshold && quiet_blocks(e - 1, -1) >= kMinQuietBlocks) return e;
+    }
+    return -1L;
+  };
   for (size_t k = 1; k < phonemes.size() && k <= starts.size(); ++k) {
     const bool speech_ends = is_pause(phonemes[k]) && !is_pause(phonemes[k - 1]);
     const bool speech_begins = !is_pause(phonemes[k]) && is_pause(phonemes[k - 1]);
@@ -150,7 +174,7 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
     // The edge between blocks b - 1 and b nearest the warp's boundary.
     const long at = std::lround(starts[k - 1] / static_cast<double>(block));
     for (long d = 0; d <= kRadiusBlocks; ++d) {
-      const long found = [&] {
+      long found = [&] {
         for (long b : {at - d, at + d}) {
           if (b < 1 || b >= static_cast<long>(n)) continue;
           if (speech_ends && db[b - 1] >= threshold && quiet_blocks(b, 1) >= kMinQuietBlocks) {
@@ -162,12 +186,18 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
         }
         return -1L;
       }();
+      // The warp can put the first sound in the silence before it, at a hum quieter than the
+      // threshold, farther than the radius: it starts at the next edge.
+      if (found < 0 && d == kRadiusBlocks && speech_begins && k == 1) found = next_onset(at);
       if (found >= 0) {
         const long edge = speech_begins && k == 1 ? past_hum(found) : found;
         starts[k - 1] = static_cast<double>(edge) * static_cast<double>(block);
-        // A stop's closure is as silent as the pause before it: the edge is its release.
+        // A stop's closure is as silent as the pause before it: the edge is its release. What
+        // rises before a release is in its closure (ked's /t/): the closure rule alone.
         if (speech_begins && is_stop(phonemes[k])) {
           starts[k - 1] = std::max(starts[k - 1] - double{kStopClosureMs} * rate / 1000, 0.0);
+        } else if (speech_begins) {
+          starts[k - 1] = static_cast<double>(rise_start(edge)) * static_cast<double>(block);
         }
         break;
       }

@@ -59,6 +59,15 @@ inline constexpr float kFloorRangeDb = 90;
 // kal corpus 40 to 80 ms gave the same first-sound p90, 50 was chosen (docs/align.md).
 inline constexpr unsigned kStopClosureMs = 50;
 
+// A weak onset (/f/, /h/, /dh/) rises out of silence more slowly than a vowel, for tens of ms
+// below the silence threshold: an onset starts where it first rises kOnsetRiseDb above the
+// silence just before it, at most kMaxRiseMs before the threshold's edge. That silence's own
+// level, not the recording's floor: live the floor is taken over the audio kept, and a margin
+// under the floor's threshold put some first sounds early there. Chosen on kal: 4 and 6 dB put
+// its first sound within p90 15 ms, 10 dB within 25; 30 ms back within 20 (docs/align.md).
+inline constexpr float kOnsetRiseDb = 6;
+inline constexpr unsigned kMaxRiseMs = 50;
+
 // Festival's lead-in carries a hum (kal: 160 ms whose loudest 5 ms block is 24..26 dB below
 // the loudest, then 45 ms of silence), as loud as a weak consonant. Sound before the first
 // sound that stays more than kHumBelowLoudestDb below the loudest and ends in silence within
@@ -78,7 +87,9 @@ inline constexpr unsigned kMaxHumMs = 300;
 // long) has no level to be a floor. A stop (p t k b d g ch jh) out of a pause starts
 // kStopClosureMs before the edge: its closure is silent, the edge its release, and phonetic
 // labels (and the lips) start it at its closure. The first sound starts after any hum
-// (kHumBelowLoudestDb).
+// (kHumBelowLoudestDb); when the warp puts it in silence with no edge within the radius (live,
+// at a hum that the speech heard since makes silence), at the next edge within kMaxHumMs. An
+// onset starts where it rises out of the silence (kOnsetRiseDb).
 void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
                      std::span<const int16_t> audio, unsigned rate, std::vector<double>& starts);
 

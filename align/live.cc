@@ -180,26 +180,35 @@ void LiveAligner::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
       const double to = static_cast<double>(rec_centre(w.first[i]));
       return static_cast<size_t>(std::lround(from + t * (to - from)));
     };
+    const size_t hold = samples_of(kHoldMs, rate_);
+    size_t piece_end = horizon;
     while (next_ + 1 < syn_.phonemes.size()) {
       const size_t b = syn_.phonemes[next_ + 1].start;
       size_t at = map(b);
       if (at == kNone || at > horizon) break;
       at = snap(next_ + 1, at);  // the lookahead holds the audio it looks at (live.h)
+      // The first sound's start waits for kHoldMs more audio: whether what starts there is a
+      // hum (snap_to_silence) shows in what follows it, louder speech. The pause before it is
+      // not given out past it meanwhile.
+      if (!at_end && next_ == 0 && at + hold > horizon) {
+        piece_end = std::max(at, rec_settled_);
+        break;
+      }
       syn_settled_ = b;
       emit(std::clamp(at, rec_settled_, n), true, out);
     }
-    if (!at_end && horizon > rec_settled_ + samples_of(kHoldMs, rate_)) {
+    if (!at_end && horizon > rec_settled_ + hold && piece_end > rec_settled_) {
       // The phoneme goes on past the hold: a piece up to the horizon, and the warp restarts
       // from the synthetic frame matched there (within the phoneme).
-      const size_t fr =
-          std::min(rec.frame_at(horizon - w0) - std::min(rec.frame_at(horizon - w0), r0), rows - 1);
+      const size_t fr = std::min(
+          rec.frame_at(piece_end - w0) - std::min(rec.frame_at(piece_end - w0), r0), rows - 1);
       size_t j = 0;
       while (j < w.end && w.last[j] < fr) ++j;
       const size_t lo = syn_.phonemes[next_].start;
       const size_t hi = next_ + 1 < syn_.phonemes.size() ? syn_.phonemes[next_ + 1].start - 1
                                                          : syn_.samples.size();
       syn_settled_ = std::clamp(synf_.centre(s0 + j), std::max(lo, syn_settled_), std::max(lo, hi));
-      emit(horizon, false, out);
+      emit(piece_end, false, out);
     }
   } else if (!at_end && horizon > rec_settled_ + samples_of(kHoldMs, rate_)) {
     emit(horizon, false, out);  // a pause for the whole utterance, in pieces

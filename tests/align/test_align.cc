@@ -38,6 +38,13 @@ std::vector<int16_t> tone(double hz, double seconds, unsigned rate) {
   return s;
 }
 
+// Appends `seconds` of a -68 dBFS hiss (the recordings' floor in the tests below).
+void add_hiss(std::vector<int16_t>& audio, double seconds, unsigned rate) {
+  for (size_t i = 0; i < static_cast<size_t>(seconds * rate); ++i) {
+    audio.push_back(static_cast<int16_t>((static_cast<int>(i % 7) - 3) * 6));
+  }
+}
+
 Alignment aligned(const std::string& text, const std::vector<int16_t>& audio, unsigned rate) {
   Alignment a;
   std::string error;
@@ -274,6 +281,42 @@ TEST(Boundaries, DigitalSilenceIsNoFloorForTheEdges) {
   EXPECT_DOUBLE_EQ(starts[1], static_cast<double>(speech_ends));
 }
 
+// A weak onset (/f/, /h/, /dh/) rises out of the silence for tens of ms below the silence
+// threshold (floor + 20 dB): a 3 kHz sound rising from -64 to -40 dBFS over 60 ms out of a
+// -68 dBFS hiss, then the vowel. It starts where it rises kOnsetRiseDb above that hiss, within a
+// block of the rise; before, where it crossed the threshold, 40 ms late.
+TEST(Boundaries, WeakOnsetStartsWhereItRises) {
+  constexpr unsigned kRate = 16000;
+  std::vector<int16_t> audio(kRate / 2, 0);
+  add_hiss(audio, 0.3, kRate);
+  const size_t rise_begins = audio.size();
+  std::vector<int16_t> rise = tone(3000, 0.06, kRate);  // tone() is at -15 dBFS
+  for (size_t i = 0; i < rise.size(); ++i) {
+    const double db = -64 + 24.0 * static_cast<double>(i) / static_cast<double>(rise.size());
+    rise[i] = static_cast<int16_t>(rise[i] * std::pow(10.0, (db + 15) / 20));
+  }
+  audio.insert(audio.end(), rise.begin(), rise.end());
+  const std::vector<int16_t> vowel = tone(200, 0.5, kRate);
+  audio.insert(audio.end(), vowel.begin(), vowel.end());
+  const size_t speech_ends = audio.size();
+  add_hiss(audio, 0.3, kRate);
+  audio.resize(audio.size() + kRate / 2, 0);
+  const std::vector<tts::SpokenPhoneme> phonemes = {phoneme_at(0, 0), phoneme_at(1, 1),
+                                                    phoneme_at(0, 2)};
+  std::vector<double> starts = {static_cast<double>(rise_begins + rise.size()),  // the warp's
+                                static_cast<double>(speech_ends)};
+  snap_to_silence(phonemes, audio, kRate, starts);
+  EXPECT_NEAR(starts[0], static_cast<double>(rise_begins), 0.005 * kRate);
+  EXPECT_DOUBLE_EQ(starts[1], static_cast<double>(speech_ends));
+  // What rises before a stop's release is in its closure: the closure rule alone (ked's /t/),
+  // kStopClosureMs before the edge, not before the rise (10 ms before the rise, not 45).
+  const PhonemeAlphabet& arpabet = *find_alphabet(kArpabetAlphabet);
+  std::vector<double> stop_start = {static_cast<double>(rise_begins + rise.size())};
+  snap_to_silence({phoneme_at(0, 0), phoneme_at(*find_symbol(arpabet, "P"), 1)}, audio, kRate,
+                  stop_start);
+  EXPECT_GT(stop_start[0], static_cast<double>(rise_begins) - 0.02 * kRate);
+}
+
 // Festival's lead-in hum: 160 ms of a 100 Hz hum at -40 dBFS (25 dB below the speech), 45 ms
 // of hiss at the recording's floor, then the first sound. The warp puts the first sound at the hum,
 // whose start is an edge of silence too; the first sound starts after the hum (before, at the hum:
@@ -308,6 +351,30 @@ TEST(Boundaries, FirstSoundStartsAfterAHum) {
     EXPECT_DOUBLE_EQ(starts[0], static_cast<double>(below_db > 20 ? speech_begins : hum_begins));
     EXPECT_DOUBLE_EQ(starts[1], speech_ends);
   }
+}
+
+// Live, a hum that is the loudest sound heard so far is quieter than the threshold once the
+// speech comes: the warp's first sound at it, 195 ms before the speech, had no edge within the
+// radius and stayed there. The warp's first sound in silence starts at the next edge, within
+// kMaxHumMs: a hum at -52 dBFS (the threshold is the -68 dBFS hiss + 20 dB), 45 ms of hiss.
+TEST(Boundaries, FirstSoundInSilenceStartsAtTheNextEdge) {
+  constexpr unsigned kRate = 16000;
+  std::vector<int16_t> audio(kRate / 2, 0);
+  add_hiss(audio, 0.3, kRate);
+  const size_t hum_begins = audio.size();
+  std::vector<int16_t> hum = tone(100, 0.16, kRate);  // tone() is at -15 dBFS
+  for (int16_t& x : hum) x = static_cast<int16_t>(x * std::pow(10.0, -37 / 20.0));
+  audio.insert(audio.end(), hum.begin(), hum.end());
+  add_hiss(audio, 0.045, kRate);
+  const size_t speech_begins = audio.size();
+  const std::vector<int16_t> speech = tone(200, 0.5, kRate);
+  audio.insert(audio.end(), speech.begin(), speech.end());
+  add_hiss(audio, 0.3, kRate);
+  audio.resize(audio.size() + kRate / 2, 0);
+  const std::vector<tts::SpokenPhoneme> phonemes = {phoneme_at(0, 0), phoneme_at(1, 1)};
+  std::vector<double> starts = {static_cast<double>(hum_begins) + 0.01 * kRate};
+  snap_to_silence(phonemes, audio, kRate, starts);
+  EXPECT_DOUBLE_EQ(starts[0], static_cast<double>(speech_begins));
 }
 
 // A stop out of a pause starts at its closure, kStopClosureMs before its release, which is the
