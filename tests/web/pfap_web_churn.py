@@ -150,14 +150,24 @@ async def main():
     asyncio.get_running_loop().set_exception_handler(
         lambda loop, context: orphans.__setitem__(0, orphans[0] + 1))
 
+    # The server's first synthesis starts pfap-espeak, which then lives as long as the server
+    # (docs/tts.md) with a socket of the server's: a session that speaks comes first, alone, or
+    # in a slow run (the sanitizer build) the warm-up's sessions could close before speaking
+    # and the socket would be counted as left behind.
+    speaking = 1 if set(kinds) & set('me') else 0
     started = 0
-    await run(0, WARM_UP)
-    started = WARM_UP
+    if speaking:
+        try:
+            await cycle(port, 'e')
+        except Exception:  # noqa: BLE001 (as run()'s warm-up failures: the server is checked)
+            pass
+    await run(speaking, WARM_UP)
+    started = speaking + WARM_UP
     before = await settled((1 << 30, 1 << 30))
     start = time.monotonic()
-    failures = await run(WARM_UP, cycles)
+    failures = await run(started, cycles)
     took = time.monotonic() - start
-    started = WARM_UP + cycles
+    started += cycles
     after = await settled(before)
     left_open = sorted(opened - closed)
     server.terminate()
@@ -170,7 +180,7 @@ async def main():
         print(f)
     print(f'{cycles} cycles of kinds {kinds} ({concurrent} at a time, {len(failures)} client '
           f'errors, {orphans[0]} in aiortc\'s tasks) in {took:.1f} s '
-          f'after {WARM_UP} to warm up; pfap-web opened {len(opened)} sessions, closed '
+          f'after {speaking + WARM_UP} to warm up; pfap-web opened {len(opened)} sessions, closed '
           f'{len(closed)}; before: {before[0]} file descriptors, {before[1]} threads, RSS '
           f'{before[2]} KiB; after: {after[0]}, {after[1]}, {after[2]} KiB '
           f'({(after[2] - before[2]) / cycles:+.1f} KiB per cycle); GstObjects alive at exit '
