@@ -90,10 +90,13 @@ export function describeFds(pid) {
 /**
  * The open file descriptors and threads of process `pid`. The fds leave out TCP connections
  * that the peer has closed (CLOSE_WAIT): those are Janus's long polls, each held until Janus
- * answers it (30 s at most) after the page that asked has gone.
+ * answers it (30 s at most) after the page that asked has gone. Without `pipes`, they leave out
+ * pipes too: a sender's pfaptts holds one from pfap-espeak while a sentence is synthesized
+ * (docs/tts.md), so how many it holds depends on the moment.
  */
-export function resources(pid) {
-  const fds = describeFds(pid).filter((d) => d !== 'tcp CLOSE_WAIT').length;
+export function resources(pid, { pipes = true } = {}) {
+  const fds = describeFds(pid)
+    .filter((d) => d !== 'tcp CLOSE_WAIT' && (pipes || !d.startsWith('pipe:'))).length;
   return { fds, threads: readdirSync(`/proc/${pid}/task`).length };
 }
 
