@@ -131,10 +131,6 @@ bool send_request(const std::string& request, int fd, std::string& error) {
     std::memcpy(CMSG_DATA(c), &fd, sizeof fd);
     if (sendmsg(helper_socket, &m, MSG_NOSIGNAL) >= 0) return true;
     if (errno == EINTR) continue;
-    if (errno == EMSGSIZE || request.size() > wire::kMaxRequest) {
-      error = "the text is too long for espeak-ng (" + std::to_string(request.size()) + " bytes)";
-      return false;
-    }
     // pfap-espeak has died (its end of the socket closed).
     const int cause = errno;
     close(helper_socket);
@@ -159,6 +155,12 @@ bool call(Ask ask, std::string_view text, const VoiceSettings& settings,
   request.put(ask);
   put(request, settings);
   request.put(text);
+  // pfap-espeak reads at most that much, and would take a longer request for a broken one.
+  if (request.bytes.size() > wire::kMaxRequest) {
+    error = "the text is too long for espeak-ng (" + std::to_string(text.size()) +
+            " bytes; at most about " + std::to_string(wire::kMaxRequest / 1024) + " KiB)";
+    return false;
+  }
   int fds[2];
   // Close-on-exec: a child another thread forks and execs must not hold the pipe open.
   if (pipe2(fds, O_CLOEXEC) != 0) {

@@ -50,8 +50,9 @@ struct Synthesis {
 bool check_voice(const VoiceSettings& settings, unsigned& sample_rate, std::string& error);
 
 // Speaks plain UTF-8 `text` (no SSML). False with `error` set when pfap-espeak or espeak-ng
-// cannot start, has no such voice or dies. When `*cancel` becomes true, espeak-ng is stopped within 10 ms and
-// `out` is empty.
+// cannot start, has no such voice or dies, or when `text` is longer than one request to
+// pfap-espeak holds (about 128 KiB). When `*cancel` becomes true, espeak-ng is stopped within
+// 10 ms and `out` is empty.
 bool synthesize(std::string_view text, const VoiceSettings& settings, Synthesis& out,
                 std::string& error, const std::atomic<bool>* cancel = nullptr);
 

@@ -119,6 +119,16 @@ TEST(Espeak, OneHelperForAllCalls) {
   EXPECT_EQ(children(), helper);
 }
 
+// A text too long for one request to pfap-espeak is refused with the reason, and the helper
+// goes on speaking (pfaptts speaks pieces of at most 400 code points; pfapalign a whole text).
+TEST(Espeak, ATextTooLongForARequestIsAnError) {
+  Synthesis out;
+  std::string error;
+  EXPECT_FALSE(synthesize(std::string(200 * 1024, 'a'), {"en"}, out, error));
+  EXPECT_NE(error.find("too long"), std::string::npos) << error;
+  EXPECT_FALSE(say("Hello.").empty());
+}
+
 TEST(Espeak, ANewHelperWhenOneDied) {
   const std::vector<int16_t> first = say("Always remember the open ocean.");
   const std::vector<pid_t> helper = children();
