@@ -188,7 +188,10 @@ export function start({ canvas, audio, status, janusServer }) {
       trace: clock.startTrace, firstSound: clock.firstSound, estimates: stream?.estimates,
       clocks: stream?.clocks.slice(0, 10), firstPfapMs: stream?.firstPfapMs, phonemes: drawnPhonemes.phonemes.slice(0, 6),
     };
-    stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames);
+    stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames, { sent: clock.sentForMeasurement() });
+    // For the figures: the played audio's onsets alone, as measured before the sender's level
+    // was asked (docs/web.md, Lost clocks).
+    stats.lipSyncErrorsPlayedMs = lipSyncErrors(stats.envelope, stats.frames);
   };
 
   const onTrack = (track, mid, on) => {

@@ -75,6 +75,11 @@ export class SentLevel {
     this.found = null;
   }
 
+  /** The highest level sent (kept), 0 before any. */
+  peak() {
+    return this.segments.reduce((m, { levels }) => levels.reduce((n, v) => Math.max(n, v), m), 0);
+  }
+
   /** The first running time (ms) whose level is `rms` or more, or null. */
   firstAtLeast(rms) {
     for (const { startMs, levels } of this.segments) {

@@ -16,6 +16,10 @@ import { PfapReceiver, Viseme, parseRtp } from '../src/index.js';
 import { decodeLevels } from './clock.js';
 import { DrawnPhonemes, PlayoutClock, drawInTime, showCounts } from './playout.js';
 
+// How long before the matched time the sender's silence is looked at (lipSyncErrors): the
+// matches are exact to about 1 ms, the played onset is blurred by Opus by a few.
+const SENT_SILENCE_MARGIN_MS = 10;
+
 /**
  * Lip sync measured against the sound: each speech onset (the level passing 3 % of the
  * peak) after at least `silenceMs` of silence (under 1 %) in the played audio, paired with
@@ -23,12 +27,29 @@ import { DrawnPhonemes, PlayoutClock, drawInTime, showCounts } from './playout.j
  * first frame of such a phoneme after one of another): a "pa" sounds as its lips open, at
  * the start of its p, whose closure is the silence before it. The errors are frame time
  * minus onset time.
+ *
+ * With `sent` (PlayoutClock.sentForMeasurement), an onset counts only if the sender's level
+ * was silent too: under 1 % of its peak for the `silenceMs` that end SENT_SILENCE_MARGIN_MS
+ * before the running time the level's matches put the onset at. A vowel that a stall cut and
+ * that came back is an onset of the audio played, not of the audio sent: no syllable starts
+ * there (docs/web.md, "Lost clocks"). An onset the matches do not place (none, or another
+ * stream's) counts.
  * @param {{t: number, rms: number}[]} envelope played audio, 1 ms blocks, performance time
  * @param {{t: number, pressed: boolean}[]} frames drawn frames, performance time
+ * @param {{silenceMs?: number, windowMs?: number, sent?: {levelAt: (ms: number) => number,
+ *   peak: number, runningMsAt: (t: number) => number|null}}} [options]
  * @returns {number[]} ms
  */
-export function lipSyncErrors(envelope, frames, { silenceMs = 30, windowMs = 150 } = {}) {
+export function lipSyncErrors(envelope, frames, { silenceMs = 30, windowMs = 150, sent = null } = {}) {
   const peak = envelope.reduce((m, e) => Math.max(m, e.rms), 0);
+  const sentSilentBefore = (t) => {
+    const ms = sent?.runningMsAt(t) ?? null;
+    if (ms === null) return true;
+    for (let k = ms - SENT_SILENCE_MARGIN_MS - silenceMs; k <= ms - SENT_SILENCE_MARGIN_MS; ++k) {
+      if (sent.levelAt(k) >= sent.peak * 0.01) return false;
+    }
+    return true;
+  };
   const onsets = [];
   let quietSince = -Infinity;
   let quiet = true;
@@ -37,7 +58,7 @@ export function lipSyncErrors(envelope, frames, { silenceMs = 30, windowMs = 150
       if (!quiet) quietSince = e.t;
       quiet = true;
     } else if (e.rms > peak * 0.03) {
-      if (quiet && e.t - quietSince >= silenceMs) onsets.push(e.t);
+      if (quiet && e.t - quietSince >= silenceMs && sentSilentBefore(e.t)) onsets.push(e.t);
       quiet = false;
     }
   }
@@ -242,5 +263,8 @@ export function start({ canvas, audio, form, input, status, saying }) {
   }
 
   drawInTime({ receiver, canvas, stats, streamNs, drawn: drawnPhonemes });
-  stats.measureLipSync = () => (stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames));
+  stats.measureLipSync = () => {
+    stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames, { sent: clock.sentForMeasurement() });
+    stats.lipSyncErrorsPlayedMs = lipSyncErrors(stats.envelope, stats.frames);  // for the figures (docs/web.md)
+  };
 }

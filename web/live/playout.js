@@ -66,7 +66,8 @@ export class PlayoutClock {
     this.firstSound = null;
     this.firstSoundTried = false;  // the first sound heard since the reset has been looked at
     this.scannedTo = this.envelope.at(-1)?.t ?? -Infinity;  // heard since the reset: after this
-    this.corrections = [];  // {t: heard time, lag: ms}
+    this.corrections = [];  // each match: {t: heard time, lag: ms, m, stretch: as `matched`}
+    this.resetAt = this.scannedTo;  // heard before this: another stream's
     this.misses = 0;  // tap messages since the last match whose window held sound
     this.polls = [];  // getStats' inbound-rtp counters at each poll, for the figures
     // The stream's start, for the figures (docs/web.md, the first syllable): the running time
@@ -191,6 +192,25 @@ export class PlayoutClock {
     return now + m;
   }
 
+  /**
+   * The running time (ms) heard at performance time t as the level's matches say, not as the
+   * clock drew it: by the first match after t (its window, the 150 ms heard before it, holds t
+   * unless the clock was lost, and then it is the match that found the audio again), carried
+   * back over the stretching and concealment followed between; else by the last match. Null
+   * without a match, or for a time heard before the stream began.
+   */
+  matchedRunningMs(t) {
+    if (t <= this.resetAt) return null;
+    const match = this.corrections.find((c) => c.t >= t) ?? this.corrections.at(-1);
+    if (!match) return null;
+    return t + match.m + (valueAt(this.stretches, t, 0) - match.stretch) / (this.audioClockRate / 1000);
+  }
+
+  /** What lipSyncErrors (live.js) takes of the sender: its level and where the matches put the sound heard. */
+  sentForMeasurement() {
+    return { levelAt: (ms) => this.sent.at(ms), peak: this.sent.peak(), runningMsAt: (t) => this.matchedRunningMs(t) };
+  }
+
   // The first match searches around the readings, later ones around the last match.
   searchMappingAt(t) {
     return this.matched ? this.mappingAt(t) : valueAt(this.readings, t, null);
@@ -244,8 +264,8 @@ export class PlayoutClock {
     }
     this.misses = 0;
     this.matched = { m: this.searchMappingAt(newest) + lag, stretch: valueAt(this.stretches, newest, 0) };
-    // Each match's correction, for the figures (docs/web.md).
-    this.corrections.push({ t: newest, lag });
+    // Each match, for the figures (docs/web.md) and matchedRunningMs.
+    this.corrections.push({ t: newest, lag, ...this.matched });
     if (this.corrections.length > 2000) this.corrections.splice(0, 1000);
   }
 }
