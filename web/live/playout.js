@@ -7,6 +7,7 @@
 // receiver's synchronization source say roughly which running time is heard, the played
 // level found in the level the sender sent (clock.js) says exactly, and between matches the
 // jitter buffer's stretching and the concealment that delays the audio (getStats) are followed.
+import { poseFromFaps, renderFace } from '../src/index.js';
 import { SentLevel, matchLevels } from './clock.js';
 
 // The value of `history` ([from, value], in order) at heard time t.
@@ -108,6 +109,17 @@ export class PlayoutClock {
     return (this.context.baseLatency + (this.context.outputLatency || 0)) * 1000;
   }
 
+  /**
+   * Whether the synchronization source's readings are still used: until the level's first
+   * match (they say where it searches, and where the stream's first sound was sent); after it
+   * the matches and getStats' counts say all. A page reads them only while they are used:
+   * getSynchronizationSources() waits for WebRTC's worker thread, and under load took 7 % of
+   * a page's main thread, called at each frame (docs/web.md).
+   */
+  readingsUsed() {
+    return this.matched === null;
+  }
+
   /** A reading: the audio of running time `runningMs` is heard from performance time `heardFrom`. */
   reading(heardFrom, runningMs) {
     remember(this.readings, heardFrom, runningMs - heardFrom);
@@ -197,7 +209,8 @@ export class PlayoutClock {
    * clock drew it: by the first match after t (its window, the 150 ms heard before it, holds t
    * unless the clock was lost, and then it is the match that found the audio again), carried
    * back over the stretching and concealment followed between; else by the last match. Null
-   * without a match, or for a time heard before the stream began.
+   * without a match, or for a time heard before the stream began. Off by as much as the audio
+   * jumped between t and that match by what getStats does not count (20 ms, seen under load).
    */
   matchedRunningMs(t) {
     if (t <= this.resetAt) return null;
@@ -308,12 +321,19 @@ export class DrawnPhonemes {
  */
 export function drawInTime({ receiver, canvas, stats, streamNs, drawn }) {
   const ctx = canvas.getContext('2d');
+  let drawnFaps = null;  // the FAPs of the face on the canvas
   const frame = (now) => {
     const ns = streamNs(now);
     if (ns !== null) {
       stats.streamNs = ns;
       stats.endNs = receiver.animator.endNs;
-      receiver.draw(ctx, ns, { style: 'cartoon' });
+      // The face is drawn again only where it changed (receiver.draw draws the same): in the
+      // pauses and after the speech nothing is drawn, and Chromium composites nothing new.
+      const faps = receiver.faps(ns);
+      if (drawnFaps === null || faps.some((v, i) => v !== drawnFaps[i])) {
+        renderFace(ctx, poseFromFaps(faps), { style: 'cartoon' });
+        drawnFaps = faps;
+      }
       drawn.frame(now, ns);
     }
     requestAnimationFrame(frame);
