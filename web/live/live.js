@@ -16,11 +16,11 @@ import { PfapReceiver, Viseme, parseRtp } from '../src/index.js';
 import { decodeLevels } from './clock.js';
 import { DrawnPhonemes, PlayoutClock, drawInTime, showCounts } from './playout.js';
 
-// How far from a running time the level's matches put a played onset the sender's silence
-// may end (lipSyncErrors). In runs of the Janus test and the benchmark, played onsets came
-// within 3 ms of the sender's as a rule, and up to 28.6 ms after it where the start of a p was
-// not heard; the vowels that came back after a stall, 46 ms and more after their onset.
-const SENT_ONSET_MARGIN_MS = 30;
+// How far from the running time the level's matches put a played onset the sender's silence
+// may end (lipSyncErrors). In runs of the Janus test and the benchmark the played onsets of
+// syllables came within 3 ms of the sender's as a rule and up to 12.7 ms after it; a p that a
+// stall cut at its start and that came back, 16.7 to 28.6 ms after it; a vowel, 46 ms and more.
+const SENT_ONSET_MARGIN_MS = 15;
 
 /**
  * Lip sync measured against the sound: each speech onset (the level passing 3 % of the
