@@ -3,8 +3,10 @@
 // Janus beside N sessions of pfap-web, in one run on this machine (docs/web.md, "Broadcast
 // through Janus: measured"). N is PFAP_VIEWERS (20). For each side it prints the server's CPU
 // time for one text said to every viewer (Janus's with 1 viewer and with N, in all and during
-// the speech alone; pfap-web's with N sessions) and for each page whether it is whole and its
-// lip-sync errors (median, 95th percentile of |error|, ms).
+// the speech alone; pfap-web's with N sessions), Chromium's by process kind and the
+// renderers' by thread, and for each page whether it is whole and its lip-sync errors
+// (median, 95th percentile of |error|, ms). PFAP_PROFILE=1 adds where one page's main thread
+// spends the speech; PFAP_BENCH_OUT=FILE keeps every page's figures there.
 //
 //   sudo PFAP_VIEWERS=20 PFAP_TIMEOUT=900 PFAP_BROADCAST=build/tools/pfap-broadcast \
 //     PFAP_WEB=build/tools/pfap-web GST_PLUGIN_PATH=build/gst:build/ext \

@@ -196,6 +196,7 @@ export function start({ canvas, audio, status, janusServer }) {
     // For the figures: the played audio's onsets alone, as measured before the sender's level
     // was asked (docs/web.md, Lost clocks).
     stats.lipSyncErrorsPlayedMs = lipSyncErrors(stats.envelope, stats.frames);
+    stats.clock = clock.record();
   };
 
   const onTrack = (track, mid, on) => {

@@ -274,5 +274,6 @@ export function start({ canvas, audio, form, input, status, saying }) {
   stats.measureLipSync = () => {
     stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames, { sent: clock.sentForMeasurement() });
     stats.lipSyncErrorsPlayedMs = lipSyncErrors(stats.envelope, stats.frames);  // for the figures (docs/web.md)
+    stats.clock = clock.record();  // for the figures (docs/web.md)
   };
 }

@@ -219,6 +219,15 @@ export class PlayoutClock {
     return t + match.m + (valueAt(this.stretches, t, 0) - match.stretch) / (this.audioClockRate / 1000);
   }
 
+  /**
+   * What the figures keep of the clock, to look at each lip-sync error afterwards (docs/web.md,
+   * "Lost clocks"): its matches, what it followed of getStats, the sender's level.
+   */
+  record() {
+    const sent = this.sent.segments.map(({ startMs, levels }) => ({ startMs, levels: Array.from(levels) }));
+    return { matches: this.corrections, stretches: this.stretches, resetAt: this.resetAt, sent };
+  }
+
   /** What lipSyncErrors (live.js) takes of the sender: its level and where the matches put the sound heard. */
   sentForMeasurement() {
     return { levelAt: (ms) => this.sent.at(ms), peak: this.sent.peak(), runningMsAt: (t) => this.matchedRunningMs(t) };
