@@ -202,6 +202,7 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
     pageServer.close();
     await stop(janus);
     janus.cleanup();
+    out.janusLog = `${janus.out}${janus.log}`.slice(-20000);  // its warnings, for the figures file
     const whole = (sent) => (s) => s.phonemes === sent.phonemes && s.fapStateMatchesSender && s.streams === 1;
     out.janus = { one, many, chromium: manyKinds.byKind };
 
