@@ -3,13 +3,16 @@
 // Janus beside N sessions of pfap-web, in one run on this machine (docs/web.md, "Broadcast
 // through Janus: measured"). N is PFAP_VIEWERS (20). For each side it prints the server's CPU
 // time for one text said to every viewer (Janus's with 1 viewer and with N, in all and during
-// the speech alone; pfap-web's with N sessions) and for each page whether it is whole and its
-// lip-sync errors (median, 95th percentile of |error|, ms).
+// the speech alone; pfap-web's with N sessions), Chromium's by process kind and the
+// renderers' by thread, and for each page whether it is whole and its lip-sync errors
+// (median, 95th percentile of |error|, ms). PFAP_PROFILE=1 adds where one page's main thread
+// spends the speech; PFAP_BENCH_OUT=FILE keeps every page's figures there.
 //
 //   sudo PFAP_VIEWERS=20 PFAP_TIMEOUT=900 PFAP_BROADCAST=build/tools/pfap-broadcast \
 //     PFAP_WEB=build/tools/pfap-web GST_PLUGIN_PATH=build/gst:build/ext \
 //     tests/web/janus-broadcast.sh node web/bench/janus-viewers.browser.js
-import { writeFileSync } from 'node:fs';
+import { readFileSync, readdirSync, writeFileSync } from 'node:fs';
+import os from 'node:os';
 import path from 'node:path';
 import { test } from 'node:test';
 import { fileURLToPath } from 'node:url';
@@ -52,6 +55,118 @@ async function measured(pid, during) {
   return { cpu: last - start, wall, result };
 }
 
+// Chromium's processes (descendants of this node process) by kind: the browser, renderers
+// (one a page), the GPU process, and utility processes by service (audio, network, ...).
+function chromiumKinds() {
+  const parent = {};
+  const kind = {};
+  for (const pid of readdirSync('/proc').filter((d) => /^\d+$/.test(d))) {
+    try {
+      parent[pid] = readFileSync(`/proc/${pid}/stat`, 'utf8').split(') ')[1].split(' ')[1];
+      // Chromium rewrites its processes' titles: the arguments, space separated.
+      const args = readFileSync(`/proc/${pid}/cmdline`, 'utf8').split(/[\0 ]/);
+      if (!/chrom/.test(args[0])) continue;
+      const type = args.find((a) => a.startsWith('--type='))?.slice(7) ?? 'browser';
+      const service = args.find((a) => a.startsWith('--utility-sub-type='))?.slice(19).split('.')[0];
+      kind[pid] = type === 'utility' && service ? service : type;
+    } catch {
+      // gone
+    }
+  }
+  const ours = (pid) => {
+    for (let p = pid; p && p !== '0' && p !== '1'; p = parent[p]) if (p === String(process.pid)) return true;
+    return false;
+  };
+  return Object.fromEntries(Object.entries(kind).filter(([pid]) => ours(pid)));
+}
+
+// The CPU time (s) of each thread of process `pid`, by thread name (digits left out).
+function threadSeconds(pid) {
+  const threads = {};
+  for (const tid of readdirSync(`/proc/${pid}/task`)) {
+    const stat = readFileSync(`/proc/${pid}/task/${tid}/stat`, 'utf8');
+    const name = stat.slice(stat.indexOf('(') + 1, stat.lastIndexOf(')')).replace(/\d+/g, '');
+    const fields = stat.slice(stat.lastIndexOf(')') + 2).split(' ');
+    threads[tid] = { name, cpu: (Number(fields[11]) + Number(fields[12])) / 100 };
+  }
+  return threads;
+}
+
+// The CPU time of Chromium's processes by kind while `during` runs, read every 200 ms (a
+// process that ends, a closed page's renderer, keeps its last reading), and of the renderers'
+// threads by name; and the wall time.
+async function chromiumCpu(during) {
+  const first = {};
+  const last = {};
+  const kinds = {};
+  const read = () => {
+    for (const [pid, k] of Object.entries(chromiumKinds())) {
+      try {
+        const ts = k === 'renderer' ? threadSeconds(pid) : { [pid]: { name: '', cpu: cpuSeconds(pid) } };
+        for (const [tid, { name, cpu }] of Object.entries(ts)) {
+          first[tid] ??= cpu;
+          last[tid] = cpu;
+          kinds[tid] = k === 'renderer' ? `renderer ${name}` : k;
+        }
+      } catch {
+        // ended
+      }
+    }
+  };
+  read();
+  const poll = setInterval(read, 200);
+  const t0 = performance.now();
+  const result = await during();
+  clearInterval(poll);
+  const wall = (performance.now() - t0) / 1000;
+  const byKind = {};
+  for (const [id, k] of Object.entries(kinds)) {
+    byKind[k] ??= { count: 0, cpu: 0 };
+    byKind[k].count += 1;
+    byKind[k].cpu += last[id] - first[id];
+  }
+  return { wall, byKind, result };
+}
+
+// Chromium's CPU by process kind (how many) and the renderers' by thread name, the busiest
+// first; what used under 0.05 s left out.
+const kindRow = (label, { wall, byKind }) => `${label}, Chromium's CPU over ${wall.toFixed(1)} s: ` +
+  Object.entries(byKind).filter(([, { cpu }]) => cpu >= 0.05).sort((a, b) => b[1].cpu - a[1].cpu)
+    .map(([k, { count, cpu }]) => `${k} ${cpu.toFixed(2)} s (${count})`).join(', ');
+
+// With PFAP_PROFILE set: where one page's main thread spends its time while `during` runs
+// (CDP: the renderer's task and script durations, and V8's sampling profile by function).
+async function profiled(page, during) {
+  if (!process.env.PFAP_PROFILE) return { result: await during(), lines: [] };
+  const cdp = await page.context().newCDPSession(page);
+  await cdp.send('Performance.enable');
+  await cdp.send('Profiler.enable');
+  await cdp.send('Profiler.setSamplingInterval', { interval: 500 });
+  const metrics = async () => Object.fromEntries((await cdp.send('Performance.getMetrics')).metrics.map((m) => [m.name, m.value]));
+  const before = await metrics();
+  await cdp.send('Profiler.start');
+  const t0 = performance.now();
+  const result = await during();
+  const wall = (performance.now() - t0) / 1000;
+  const { profile } = await cdp.send('Profiler.stop');
+  const after = await metrics();
+  const self = {};
+  const byId = Object.fromEntries(profile.nodes.map((n) => [n.id, n]));
+  profile.samples.forEach((id, i) => {
+    const { functionName, url, lineNumber } = byId[id].callFrame;
+    const key = `${functionName || '(anonymous)'} ${url.split('/').at(-1)}:${lineNumber + 1}`;
+    self[key] = (self[key] ?? 0) + profile.timeDeltas[i] / 1000;
+  });
+  const d = (k) => (after[k] - before[k]).toFixed(2);
+  const lines = [
+    `one page's main thread over ${wall.toFixed(1)} s: tasks ${d('TaskDuration')} s, script ${d('ScriptDuration')} s, ` +
+      `layout ${d('LayoutDuration')} s, style ${d('RecalcStyleDuration')} s`,
+    ...Object.entries(self).sort((a, b) => b[1] - a[1]).slice(0, 15).map(([k, ms]) => `  ${ms.toFixed(0)} ms ${k}`),
+  ];
+  await cdp.detach();
+  return { result, lines };
+}
+
 function pageRows(label, pages, whole) {
   return pages.map((s, i) => {
     const errors = s.lipSyncErrorsMs;
@@ -63,7 +178,7 @@ function pageRows(label, pages, whole) {
 test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { timeout: 3600e3 }, async () => {
   const browser = await launchChromium();
   const out = { viewers: VIEWERS };
-  const lines = [];
+  const lines = [`load average at the start: ${os.loadavg().map((l) => l.toFixed(1)).join(', ')}`];
   try {
     // Janus: once with one viewer, once with N.
     const janus = await startJanus();
@@ -74,19 +189,22 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
       const whole = await measured(janus.pid, async () => {
         const pages = await inBatches(count, 5, () => openViewer(browser, pageServer, janus));
         const sender = startSender(TEXT);
-        const speech = await measured(janus.pid, () => exited(sender));
+        const { result: speech, lines: profile } = await profiled(pages[0], () => measured(janus.pid, () => exited(sender)));
+        lines.push(...profile);
         const all = await Promise.all(pages.map((p) => figures(p, { timeout: 120000 })));
         return { all, speech, sent: JSON.parse(sender.out.trim().split('\n').at(-1)) };
       });
       return { cpu: whole.cpu, wall: whole.wall, ...whole.result };
     };
     const one = await broadcast(1);
-    const many = await broadcast(VIEWERS);
+    const manyKinds = await chromiumCpu(() => broadcast(VIEWERS));
+    const many = manyKinds.result;
     pageServer.close();
     await stop(janus);
     janus.cleanup();
+    out.janusLog = `${janus.out}${janus.log}`.slice(-20000);  // its warnings, for the figures file
     const whole = (sent) => (s) => s.phonemes === sent.phonemes && s.fapStateMatchesSender && s.streams === 1;
-    out.janus = { one, many };
+    out.janus = { one, many, chromium: manyKinds.byKind };
 
     // pfap-web: N sessions, each its own pipeline.
     const server = run(process.env.PFAP_WEB, ['--port=0', `--web-dir=${webDir}`, `--text=${TEXT}`]);
@@ -97,12 +215,13 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
         if (m) resolve(m[1]);
       });
     });
-    const web = await measured(server.pid, async () => {
+    const webKinds = await chromiumCpu(() => measured(server.pid, async () => {
       const pages = await inBatches(VIEWERS, 5, () => newPage(browser, url));
       return Promise.all(pages.map((p) => figures(p, { timeout: 120000 })));
-    });
+    }));
+    const web = webKinds.result;
     await stop(server);
-    out.pfapWeb = web;
+    out.pfapWeb = { ...web, chromium: webKinds.byKind };
 
     const ms = (seconds) => `${(1000 * seconds).toFixed(1)} ms`;
     const janusPerViewer = (many.cpu - one.cpu) / (VIEWERS - 1);
@@ -117,6 +236,8 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
         `${ms(relayPerViewer)} during the speech`,
       `pfap-web, ${VIEWERS} sessions: ${ms(web.cpu)} of CPU in all, ${ms(webPerViewer)} per session (set up, the text spoken and sent)`,
       `pfap-web per session / Janus per added viewer: ${(webPerViewer / janusPerViewer).toFixed(1)}`,
+      kindRow(`Janus, ${VIEWERS} viewers`, manyKinds),
+      kindRow(`pfap-web, ${VIEWERS} pages`, webKinds),
       ...pageRows('Janus viewer', many.all, whole(many.sent)),
       ...pageRows('pfap-web page', web.result, (s) => s.phonemes === s.sender.phonemes && s.fapStateMatchesSender),
     );
@@ -125,12 +246,15 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
     // starts, and pair it. Both are printed: every onset, and all but the first.
     const summary = (label, pages, from) => {
       const e = pages.flatMap((s) => s.lipSyncErrorsMs.slice(from));
-      const worst = Math.max(...pages.map((s) => percentile(s.lipSyncErrorsMs.slice(from).map(Math.abs), 0.95)));
+      const p95s = pages.map((s) => percentile(s.lipSyncErrorsMs.slice(from).map(Math.abs), 0.95));
+      const within = p95s.filter((p) => p <= 20).length;
       return `${label}: ${e.length} onsets paired, min ${fixed(Math.min(...e))}, median ${fixed(percentile(e, 0.5))}, ` +
-        `max ${fixed(Math.max(...e))} ms, |error| p95 ${fixed(percentile(e.map(Math.abs), 0.95))} ms, worst page's p95 ${fixed(worst)} ms`;
+        `max ${fixed(Math.max(...e))} ms, |error| p95 ${fixed(percentile(e.map(Math.abs), 0.95))} ms, worst page's p95 ` +
+        `${fixed(Math.max(...p95s))} ms, pages with p95 <= 20 ms: ${within} of ${pages.length}`;
     };
     lines.push(summary('Janus, every onset', many.all, 0), summary('Janus, the first onset left out', many.all, 1),
-      summary('pfap-web, every onset', web.result, 0));
+      summary('pfap-web, every onset', web.result, 0),
+      `load average at the end: ${os.loadavg().map((l) => l.toFixed(1)).join(', ')}`);
   } finally {
     await browser.close();
     for (const line of lines) console.log(line);

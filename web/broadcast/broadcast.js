@@ -148,31 +148,35 @@ export function start({ canvas, audio, status, janusServer }) {
   // audio and the PFAP stream have both begun.
   function streamNs(now) {
     if (!stream || stream.firstPfapMs === null || !audioReceiver || !clock.context) return null;
-    const source = audioReceiver.getSynchronizationSources()[0];
-    if (!source) return null;
-    // Janus's timestamps, from an origin of their own: ms since the first reading of the
-    // stream, put at PFAP time by the estimate until the level has been matched (the readings
-    // say where the first match searches; the face waits for the sound).
-    stream.firstReading ??= source.rtpTimestamp;
-    const rtpMs = ((source.rtpTimestamp - stream.firstReading) >>> 0) / (AUDIO_CLOCK_RATE / 1000);
-    const handedAt = source.timestamp - performance.timeOrigin;
-    if (!clock.matched) {
-      const estimate = estimateMs(handedAt);
-      if (estimate === null) return null;
-      stream.base = estimate - rtpMs;
-      // For the figures (docs/web.md, "The first syllable").
-      if (stream.estimates.length < 120) {
-        stream.estimates.push({ t: now, handedAt, rtpMs, jitterBufferMs, latencyMs: clock.latencyMs(), estimate });
+    // The readings, while they are used (playout.js: until the level's first match, and at it
+    // for the figures).
+    if (clock.readingsUsed() || !stats.matched) {
+      const source = audioReceiver.getSynchronizationSources()[0];
+      if (!source) return null;
+      // Janus's timestamps, from an origin of their own: ms since the first reading of the
+      // stream, put at PFAP time by the estimate until the level has been matched (the readings
+      // say where the first match searches; the face waits for the sound).
+      stream.firstReading ??= source.rtpTimestamp;
+      const rtpMs = ((source.rtpTimestamp - stream.firstReading) >>> 0) / (AUDIO_CLOCK_RATE / 1000);
+      const handedAt = source.timestamp - performance.timeOrigin;
+      if (!clock.matched) {
+        const estimate = estimateMs(handedAt);
+        if (estimate === null) return null;
+        stream.base = estimate - rtpMs;
+        // For the figures (docs/web.md, "The first syllable").
+        if (stream.estimates.length < 120) {
+          stream.estimates.push({ t: now, handedAt, rtpMs, jitterBufferMs, latencyMs: clock.latencyMs(), estimate });
+        }
       }
-    }
-    // The chunk it names is heard from its timestamp plus the output's latency on.
-    const heardFrom = handedAt + clock.latencyMs();
-    clock.reading(heardFrom, rtpMs + stream.base);
-    if (!stats.matched && clock.matched) {
-      // How far the first estimate was from the level's match (docs/web.md).
-      stats.estimateOffMs = rtpMs + stream.base - heardFrom - clock.mappingAt(heardFrom);
-      stats.firstMatchAt = now;
-      stats.jitterBufferMs = jitterBufferMs;
+      // The chunk it names is heard from its timestamp plus the output's latency on.
+      const heardFrom = handedAt + clock.latencyMs();
+      clock.reading(heardFrom, rtpMs + stream.base);
+      if (!stats.matched && clock.matched) {
+        // How far the first estimate was from the level's match (docs/web.md).
+        stats.estimateOffMs = rtpMs + stream.base - heardFrom - clock.mappingAt(heardFrom);
+        stats.firstMatchAt = now;
+        stats.jitterBufferMs = jitterBufferMs;
+      }
     }
     stats.matched = clock.matched !== null;
     const running = clock.runningMs(now);
@@ -188,7 +192,11 @@ export function start({ canvas, audio, status, janusServer }) {
       trace: clock.startTrace, firstSound: clock.firstSound, estimates: stream?.estimates,
       clocks: stream?.clocks.slice(0, 10), firstPfapMs: stream?.firstPfapMs, phonemes: drawnPhonemes.phonemes.slice(0, 6),
     };
-    stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames);
+    stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames, { sent: clock.sentForMeasurement() });
+    // For the figures: the played audio's onsets alone, as measured before the sender's level
+    // was asked (docs/web.md, Lost clocks).
+    stats.lipSyncErrorsPlayedMs = lipSyncErrors(stats.envelope, stats.frames);
+    stats.clock = clock.record();
   };
 
   const onTrack = (track, mid, on) => {

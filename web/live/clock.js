@@ -75,6 +75,11 @@ export class SentLevel {
     this.found = null;
   }
 
+  /** The highest level sent (kept), 0 before any. */
+  peak() {
+    return this.segments.reduce((m, { levels }) => levels.reduce((n, v) => Math.max(n, v), m), 0);
+  }
+
   /** The first running time (ms) whose level is `rms` or more, or null. */
   firstAtLeast(rms) {
     for (const { startMs, levels } of this.segments) {
@@ -119,9 +124,14 @@ export function matchLevels(heard, sentAt, { searchMs = 50, minCorrelation = 0.9
   const meanA = heard.reduce((s, h) => s + h.rms, 0) / n;
   let varA = 0;
   for (const h of heard) varA += (h.rms - meanA) ** 2;
+  const b = new Float64Array(n);  // the sent level at each heard block's x + lag (one buffer: no garbage a lag)
   const correlation = (lag) => {
-    const b = heard.map((h) => sentAt(h.x + lag));
-    const meanB = b.reduce((s, v) => s + v, 0) / n;
+    let sumB = 0;
+    for (let i = 0; i < n; ++i) {
+      b[i] = sentAt(heard[i].x + lag);
+      sumB += b[i];
+    }
+    const meanB = sumB / n;
     let cov = 0;
     let varB = 0;
     for (let i = 0; i < n; ++i) {

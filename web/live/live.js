@@ -16,6 +16,12 @@ import { PfapReceiver, Viseme, parseRtp } from '../src/index.js';
 import { decodeLevels } from './clock.js';
 import { DrawnPhonemes, PlayoutClock, drawInTime, showCounts } from './playout.js';
 
+// How far from the running time the level's matches put a played onset the sender's silence
+// may end (lipSyncErrors). In runs of the Janus test and the benchmark the played onsets of
+// syllables came within 3 ms of the sender's as a rule and up to 12.7 ms after it; a p that a
+// stall cut at its start and that came back, 16.7 to 28.6 ms after it; a vowel, 46 ms and more.
+const SENT_ONSET_MARGIN_MS = 15;
+
 /**
  * Lip sync measured against the sound: each speech onset (the level passing 3 % of the
  * peak) after at least `silenceMs` of silence (under 1 %) in the played audio, paired with
@@ -23,12 +29,33 @@ import { DrawnPhonemes, PlayoutClock, drawInTime, showCounts } from './playout.j
  * first frame of such a phoneme after one of another): a "pa" sounds as its lips open, at
  * the start of its p, whose closure is the silence before it. The errors are frame time
  * minus onset time.
+ *
+ * With `sent` (PlayoutClock.sentForMeasurement), an onset counts only if it is one of the
+ * sender's too: its level under 1 % of its peak for `silenceMs` up to a moment within
+ * SENT_ONSET_MARGIN_MS of the running time the level's matches put the onset at. A vowel that
+ * a stall cut and that came back is an onset of the audio played, not of the audio sent: no
+ * syllable starts there (docs/web.md, "Lost clocks"). An onset the matches do not place (none,
+ * or another stream's) counts.
  * @param {{t: number, rms: number}[]} envelope played audio, 1 ms blocks, performance time
  * @param {{t: number, pressed: boolean}[]} frames drawn frames, performance time
+ * @param {{silenceMs?: number, windowMs?: number, sent?: {levelAt: (ms: number) => number,
+ *   peak: number, runningMsAt: (t: number) => number|null}}} [options]
  * @returns {number[]} ms
  */
-export function lipSyncErrors(envelope, frames, { silenceMs = 30, windowMs = 150 } = {}) {
+export function lipSyncErrors(envelope, frames, { silenceMs = 30, windowMs = 150, sent = null } = {}) {
   const peak = envelope.reduce((m, e) => Math.max(m, e.rms), 0);
+  const sentOnsetAt = (ms) => {
+    let quietMs = 0;  // the sender's level under 1 % of its peak for the quietMs before k
+    for (let k = Math.floor(ms - SENT_ONSET_MARGIN_MS - silenceMs); k <= ms + SENT_ONSET_MARGIN_MS; ++k) {
+      if (quietMs >= silenceMs && k >= ms - SENT_ONSET_MARGIN_MS) return true;
+      quietMs = sent.levelAt(k) < sent.peak * 0.01 ? quietMs + 1 : 0;
+    }
+    return false;
+  };
+  const sentOnsetNear = (t) => {
+    const ms = sent?.runningMsAt(t) ?? null;
+    return ms === null || sentOnsetAt(ms);
+  };
   const onsets = [];
   let quietSince = -Infinity;
   let quiet = true;
@@ -37,7 +64,7 @@ export function lipSyncErrors(envelope, frames, { silenceMs = 30, windowMs = 150
       if (!quiet) quietSince = e.t;
       quiet = true;
     } else if (e.rms > peak * 0.03) {
-      if (quiet && e.t - quietSince >= silenceMs) onsets.push(e.t);
+      if (quiet && e.t - quietSince >= silenceMs && sentOnsetNear(e.t)) onsets.push(e.t);
       quiet = false;
     }
   }
@@ -228,13 +255,15 @@ export function start({ canvas, audio, form, input, status, saying }) {
   // audio and the PFAP stream have both begun.
   function streamNs(now) {
     if (!timing || firstPfapTimestamp === null || !audioReceiver || !audioContext) return null;
-    const source = audioReceiver.getSynchronizationSources()[0];
-    if (!source) return null;
-    // The chunk it names is heard from its timestamp plus the latency on; until then the
-    // readings before hold (they differ when the jitter buffer stretches the audio).
-    const heardFrom = source.timestamp - performance.timeOrigin + clock.latencyMs();
-    const rtpMs = ((source.rtpTimestamp - timing.audioTimestampOffset) >>> 0) / timing.audioClockRate * 1000;
-    clock.reading(heardFrom, rtpMs);
+    if (clock.readingsUsed()) {
+      const source = audioReceiver.getSynchronizationSources()[0];
+      if (!source) return null;
+      // The chunk it names is heard from its timestamp plus the latency on; until then the
+      // readings before hold (they differ when the jitter buffer stretches the audio).
+      const heardFrom = source.timestamp - performance.timeOrigin + clock.latencyMs();
+      const rtpMs = ((source.rtpTimestamp - timing.audioTimestampOffset) >>> 0) / timing.audioClockRate * 1000;
+      clock.reading(heardFrom, rtpMs);
+    }
     const running = clock.runningMs(now);
     if (running === null) return null;  // not before the sound says (playout.js)
     const first = ((firstPfapTimestamp - timing.pfapTimestampOffset) >>> 0) / timing.pfapClockRate;
@@ -242,5 +271,9 @@ export function start({ canvas, audio, form, input, status, saying }) {
   }
 
   drawInTime({ receiver, canvas, stats, streamNs, drawn: drawnPhonemes });
-  stats.measureLipSync = () => (stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames));
+  stats.measureLipSync = () => {
+    stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames, { sent: clock.sentForMeasurement() });
+    stats.lipSyncErrorsPlayedMs = lipSyncErrors(stats.envelope, stats.frames);  // for the figures (docs/web.md)
+    stats.clock = clock.record();  // for the figures (docs/web.md)
+  };
 }

@@ -7,6 +7,7 @@
 // receiver's synchronization source say roughly which running time is heard, the played
 // level found in the level the sender sent (clock.js) says exactly, and between matches the
 // jitter buffer's stretching and the concealment that delays the audio (getStats) are followed.
+import { poseFromFaps, renderFace } from '../src/index.js';
 import { SentLevel, matchLevels } from './clock.js';
 
 // The value of `history` ([from, value], in order) at heard time t.
@@ -66,7 +67,8 @@ export class PlayoutClock {
     this.firstSound = null;
     this.firstSoundTried = false;  // the first sound heard since the reset has been looked at
     this.scannedTo = this.envelope.at(-1)?.t ?? -Infinity;  // heard since the reset: after this
-    this.corrections = [];  // {t: heard time, lag: ms}
+    this.corrections = [];  // each match: {t: heard time, lag: ms, m, stretch: as `matched`}
+    this.resetAt = this.scannedTo;  // heard before this: another stream's
     this.misses = 0;  // tap messages since the last match whose window held sound
     this.polls = [];  // getStats' inbound-rtp counters at each poll, for the figures
     // The stream's start, for the figures (docs/web.md, the first syllable): the running time
@@ -105,6 +107,17 @@ export class PlayoutClock {
   /** The output's latency, which the synchronization source's timestamp is before the sound. */
   latencyMs() {
     return (this.context.baseLatency + (this.context.outputLatency || 0)) * 1000;
+  }
+
+  /**
+   * Whether the synchronization source's readings are still used: until the level's first
+   * match (they say where it searches, and where the stream's first sound was sent); after it
+   * the matches and getStats' counts say all. A page reads them only while they are used:
+   * getSynchronizationSources() waits for WebRTC's worker thread, and under load took 7 % of
+   * a page's main thread, called at each frame (docs/web.md).
+   */
+  readingsUsed() {
+    return this.matched === null;
   }
 
   /** A reading: the audio of running time `runningMs` is heard from performance time `heardFrom`. */
@@ -191,6 +204,35 @@ export class PlayoutClock {
     return now + m;
   }
 
+  /**
+   * The running time (ms) heard at performance time t as the level's matches say, not as the
+   * clock drew it: by the first match after t (its window, the 150 ms heard before it, holds t
+   * unless the clock was lost, and then it is the match that found the audio again), carried
+   * back over the stretching and concealment followed between; else by the last match. Null
+   * without a match, or for a time heard before the stream began. Off by as much as the audio
+   * jumped between t and that match by what getStats does not count (20 ms, seen under load).
+   */
+  matchedRunningMs(t) {
+    if (t <= this.resetAt) return null;
+    const match = this.corrections.find((c) => c.t >= t) ?? this.corrections.at(-1);
+    if (!match) return null;
+    return t + match.m + (valueAt(this.stretches, t, 0) - match.stretch) / (this.audioClockRate / 1000);
+  }
+
+  /**
+   * What the figures keep of the clock, to look at each lip-sync error afterwards (docs/web.md,
+   * "Lost clocks"): its matches, what it followed of getStats, the sender's level.
+   */
+  record() {
+    const sent = this.sent.segments.map(({ startMs, levels }) => ({ startMs, levels: Array.from(levels) }));
+    return { matches: this.corrections, stretches: this.stretches, resetAt: this.resetAt, sent };
+  }
+
+  /** What lipSyncErrors (live.js) takes of the sender: its level and where the matches put the sound heard. */
+  sentForMeasurement() {
+    return { levelAt: (ms) => this.sent.at(ms), peak: this.sent.peak(), runningMsAt: (t) => this.matchedRunningMs(t) };
+  }
+
   // The first match searches around the readings, later ones around the last match.
   searchMappingAt(t) {
     return this.matched ? this.mappingAt(t) : valueAt(this.readings, t, null);
@@ -244,8 +286,8 @@ export class PlayoutClock {
     }
     this.misses = 0;
     this.matched = { m: this.searchMappingAt(newest) + lag, stretch: valueAt(this.stretches, newest, 0) };
-    // Each match's correction, for the figures (docs/web.md).
-    this.corrections.push({ t: newest, lag });
+    // Each match, for the figures (docs/web.md) and matchedRunningMs.
+    this.corrections.push({ t: newest, lag, ...this.matched });
     if (this.corrections.length > 2000) this.corrections.splice(0, 1000);
   }
 }
@@ -288,12 +330,19 @@ export class DrawnPhonemes {
  */
 export function drawInTime({ receiver, canvas, stats, streamNs, drawn }) {
   const ctx = canvas.getContext('2d');
+  let drawnFaps = null;  // the FAPs of the face on the canvas
   const frame = (now) => {
     const ns = streamNs(now);
     if (ns !== null) {
       stats.streamNs = ns;
       stats.endNs = receiver.animator.endNs;
-      receiver.draw(ctx, ns, { style: 'cartoon' });
+      // The face is drawn again only where it changed (receiver.draw draws the same): in the
+      // pauses and after the speech nothing is drawn, and Chromium composites nothing new.
+      const faps = receiver.faps(ns);
+      if (drawnFaps === null || faps.some((v, i) => v !== drawnFaps[i])) {
+        renderFace(ctx, poseFromFaps(faps), { style: 'cartoon' });
+        drawnFaps = faps;
+      }
       drawn.frame(now, ns);
     }
     requestAnimationFrame(frame);

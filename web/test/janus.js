@@ -210,7 +210,8 @@ export async function openViewer(browser, pageServer, janus) {
  */
 export async function figures(page, { timeout = 30000 } = {}) {
   // With a figures file asked for, also the played level and the frames of the stream's first
-  // 1.5 s of drawing (the first syllable: docs/web.md).
+  // 1.5 s of drawing (the first syllable: docs/web.md), and the whole of them with the clock's
+  // record, to look at each lip-sync error afterwards ("Lost clocks").
   const withStart = Boolean(process.env.PFAP_BROADCAST_OUT || process.env.PFAP_BENCH_OUT);
   const read = () => page.evaluate((withStart) => {
     const s = window.pfapStats;
@@ -221,6 +222,7 @@ export async function figures(page, { timeout = 30000 } = {}) {
       const within = (e) => e.t >= from - 300 && e.t < from + 1500;
       rest.start = { ...s.start, envelope: envelope.filter(within), frames: frames.filter(within) };
     }
+    if (withStart) Object.assign(rest, { envelope, frames });
     return rest;
   }, withStart);
   try {

@@ -6,6 +6,7 @@
 import assert from 'node:assert/strict';
 import { test } from 'node:test';
 
+import { lipSyncErrors } from '../live/live.js';
 import { DrawnPhonemes, PlayoutClock } from '../live/playout.js';
 
 // "pa. pa. pa.": a sharp onset every 337 ms, a vowel that decays, silence between (S16 RMS).
@@ -257,4 +258,76 @@ test('a lost packet moves no clock; at a stream\'s end the clock stops, then run
   assert.ok(Math.abs(clock.runningMs(3400) - (3000 - 30)) < 30, `the clock stops: ${clock.runningMs(3400)}`);
   assert.ok(Math.abs(clock.runningMs(4000) - (4000 - 140)) < 30, `${clock.runningMs(4000)}`);
   assert.ok(Math.abs(clock.runningMs(4400) - clock.runningMs(3900) - 500) < 1, `${clock.runningMs(3900)}, ${clock.runningMs(4400)}`);
+});
+
+// -- The measurement (live.js, lipSyncErrors) -------------------------------------------------
+// espeak-ng's "pa.": the p's burst from its onset, a long vowel, a pause (the closure of the
+// next p) to the next onset 337 ms later.
+const espeakPa = (ms) => {
+  const k = ((ms % 337) + 337) % 337;
+  if (k < 30) return 1500;
+  return k < 290 ? Math.round(8000 * Math.exp(-(k - 30) / 150) * (1 + 0.3 * Math.sin(k / 3))) : 0;
+};
+
+// The case a benchmark run showed (docs/web.md, Lost clocks): NetEq ran dry late in a "pa"'s
+// vowel, concealed for 117 ms (faded to silence here), and played the rest of the vowel 117 ms
+// late; the played level came back after 30 ms under 1 % and lipSyncErrors took that for an
+// onset, paired with the next "pa"'s frame (+145 ms there). `followed`: whether getStats'
+// counts show the stall (the clock follows it); if not, the clock is lost until a wide search.
+function stalledInVowel(followed) {
+  const clock = new PlayoutClock({ envelope: [] });
+  clock.sent.add(0, Array.from({ length: 8000 }, (_, i) => espeakPa(i)));
+  clock.reading(0, 0);
+  const frames = [];
+  const drawn = new DrawnPhonemes(frames);
+  for (let k = 0; k < 20; ++k) {
+    drawn.add((k * 337 - 20) * 1e6, false);
+    drawn.add(k * 337 * 1e6, true);  // p
+    drawn.add((k * 337 + 30) * 1e6, false);  // a
+  }
+  const onset = 4 * 337;
+  const { delay, counters } = stall({ fromMs: onset + 200, ms: 117 });
+  const quiet = (outputMs) => ({ ...counters(outputMs), concealedSamples: 5000 * SAMPLES_PER_MS });
+  let nextFrame = 0;
+  for (let t = 0; t < 3000; ++t) {
+    clock.envelope.push({ t, rms: delay(t) === null ? 0 : espeakPa(t - delay(t)) / 32768 });
+    if (t % 10 === 9) clock.matchHeard();
+    if (t % 25 === 0) clock.statsPolled((followed ? counters : quiet)(t - LATENCY_MS), t - LATENCY_MS, LATENCY_MS);
+    if (t >= nextFrame) {
+      nextFrame += FRAME_MS;
+      const ms = clock.runningMs(t);
+      if (ms !== null) drawn.frame(t, Math.round(ms * 1e6));
+    }
+  }
+  return { clock, frames, returnedAt: onset + 200 + 117, next: 5 * 337 + 117 };
+}
+
+test('lipSyncErrors: a vowel that a stall cut and that came back is no onset', () => {
+  const { clock, frames, returnedAt } = stalledInVowel(true);
+  // The played audio's onsets alone: the vowel's return among them, paired with the next p.
+  const played = lipSyncErrors(clock.envelope, frames);
+  const returned = played.filter((e) => e > 100);
+  assert.equal(returned.length, 1, `${played}`);
+  // Where the matches put its return, the sender's level was sounding: it counts no more, and
+  // every other onset counts as before.
+  assert.ok(Math.abs(clock.matchedRunningMs(returnedAt) - (returnedAt - 117)) < 3, `${clock.matchedRunningMs(returnedAt)}`);
+  const errors = lipSyncErrors(clock.envelope, frames, { sent: clock.sentForMeasurement() });
+  assert.deepEqual(errors, played.filter((e) => e !== returned[0]));
+  assert.equal(errors.length, 8);
+});
+
+test('lipSyncErrors: a lost clock is still measured, at the next syllable', () => {
+  // The same stall, which the counts do not show: the clock runs early until a wide search
+  // finds the audio again (and the matches in the stall's cut moved it by 19 ms). The vowel's
+  // return is still no onset (the match that found the audio says where it was); the next "pa"
+  // is drawn early and counted so.
+  const { clock, frames, next } = stalledInVowel(false);
+  const played = lipSyncErrors(clock.envelope, frames);
+  const errors = lipSyncErrors(clock.envelope, frames, { sent: clock.sentForMeasurement() });
+  assert.equal(errors.length, played.length - 1, `${played} against ${errors}`);
+  assert.equal(errors.length, 8);
+  const early = errors.filter((e) => e < -50);
+  assert.equal(early.length, 1, `${errors}`);
+  assert.ok(errors.every((e) => e < -50 || (e >= 0 && e <= FRAME_MS + 1)), `${errors}`);
+  assert.ok(frames.some((f, i) => f.pressed && !frames[i - 1].pressed && Math.abs(f.t - (next + early[0])) < 0.01));
 });
