@@ -184,7 +184,11 @@ test('Janus restarts mid-sentence: each viewer watches again and ends whole with
   const sender = startSender(TEXT);
   await new Promise((r) => setTimeout(r, 2000));
   const senderBefore = resources(sender.pid, { pipes: false });
-  assert.equal(await stop(janus), 0, janus.log);
+  // Killed, as a crash ends it: Debian's Janus 1.1.2 stopped by SIGTERM while viewers' data
+  // channels are open died of SIGFPE in its SCTP teardown in 1 of 8 runs (docs/web.md,
+  // "Faults"). Its clean stop is checked at the end, with no viewer left.
+  janus.kill('SIGKILL');
+  await exited(janus);
   janus.cleanup();
   janus = await startJanus();
   // The sender went on sending to ports nobody listened on: it holds what it held.
