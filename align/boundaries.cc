@@ -97,58 +97,104 @@ std::vector<bool> pause_frames(const std::vector<tts::SpokenPhoneme>& phonemes, 
   return rest;
 }
 
-void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
-                     std::span<const int16_t> audio, unsigned rate, std::vector<double>& starts) {
-  constexpr long kRadiusBlocks = kSnapRadiusMs / 5;
-  constexpr size_t kMinQuietBlocks = kMinSilenceMs / 5;
-  const size_t block = rate / 200;  // 5 ms
-  const size_t n = block > 0 ? audio.size() / block : 0;
-  if (n < 2 * kMinQuietBlocks) return;
-  std::vector<float> db(n);
-  for (size_t b = 0; b < n; ++b) {
-    double energy = 0;
-    for (size_t i = 0; i < block; ++i) {
-      const double x = audio[b * block + i] / 32768.0;
-      energy += x * x;
+namespace {
+
+// A recording's 5 ms blocks, loud or silent as snap_to_silence() (boundaries.h) hears them, and
+// where a sound after a pause starts among them.
+class Silence {
+ public:
+  Silence(std::span<const int16_t> audio, unsigned rate) : rate_(rate), block_(rate / 200) {
+    const size_t n = block_ > 0 ? audio.size() / block_ : 0;
+    if (n < 2 * kMinQuietBlocks) return;
+    db_.resize(n);
+    for (size_t b = 0; b < db_.size(); ++b) {
+      double energy = 0;
+      for (size_t i = 0; i < block_; ++i) {
+        const double x = audio[b * block_ + i] / 32768.0;
+        energy += x * x;
+      }
+      db_[b] = static_cast<float>(10 * std::log10(energy / static_cast<double>(block_) + 1e-12));
     }
-    db[b] = static_cast<float>(10 * std::log10(energy / static_cast<double>(block) + 1e-12));
+    // The floor leaves out digital silence (blocks more than kFloorRangeDb below the loudest):
+    // zeros before a recording put it at -120 dB, and every hum and fading end above it sounded.
+    loudest_ = *std::max_element(db_.begin(), db_.end());
+    std::vector<float> heard;
+    std::copy_if(db_.begin(), db_.end(), std::back_inserter(heard),
+                 [&](float d) { return d > loudest_ - kFloorRangeDb; });
+    std::sort(heard.begin(), heard.end());
+    threshold_ = std::min(heard[heard.size() / 10] + 20, loudest_ - 20);
   }
-  // The floor leaves out digital silence (blocks more than kFloorRangeDb below the loudest):
-  // zeros before a recording put it at -120 dB, and every hum and fading end above it sounded.
-  const float loudest = *std::max_element(db.begin(), db.end());
-  std::vector<float> heard;
-  std::copy_if(db.begin(), db.end(), std::back_inserter(heard),
-               [&](float d) { return d > loudest - kFloorRangeDb; });
-  std::sort(heard.begin(), heard.end());
-  const float threshold = std::min(heard[heard.size() / 10] + 20, loudest - 20);
-  auto quiet_blocks = [&](long from, long step) {
-    size_t count = 0;
-    for (long b = from; b >= 0 && b < static_cast<long>(n) && db[b] < threshold; b += step) {
-      ++count;
+
+  bool empty() const { return db_.empty(); }
+  long blocks() const { return static_cast<long>(db_.size()); }
+  size_t block() const { return block_; }
+
+  // Speech ends (sound, then silence) or begins (silence, then sound) between blocks b - 1 and b.
+  bool ends_at(long b) const {
+    return b >= 1 && b < blocks() && loud(b - 1) && quiet_blocks(b, 1) >= kMinQuietBlocks;
+  }
+  bool begins_at(long b) const {
+    return b >= 1 && b < blocks() && loud(b) && quiet_blocks(b - 1, -1) >= kMinQuietBlocks;
+  }
+
+  // The first edge into sound within kMaxHumMs after block `b`, when `b` starts a silence.
+  long next_onset(long b) const {
+    if (b < 1 || quiet_blocks(b, 1) < kMinQuietBlocks) return -1;
+    for (long e = b + 1; e < blocks() && e - b <= kMaxHumMs / 5; ++e) {
+      if (begins_at(e)) return e;
     }
+    return -1;
+  }
+
+  // Where `sound` starts, in samples, when speech begins with it at the edge `b`: past a hum
+  // when it is the first sound, at its closure when it is a stop, else where it rises out of
+  // the silence.
+  double sound_start(const tts::SpokenPhoneme& sound, bool first, long b) const {
+    const long edge = first ? past_hum(b) : b;
+    const auto block = static_cast<double>(block_);
+    // A stop's closure is as silent as the pause before it: the edge is its release. What
+    // rises before a release is in its closure (ked's /t/): the closure rule alone.
+    if (is_stop(sound)) {
+      return std::max(static_cast<double>(edge) * block - double{kStopClosureMs} * rate_ / 1000,
+                      0.0);
+    }
+    return static_cast<double>(rise_start(edge)) * block;
+  }
+
+ private:
+  static constexpr size_t kMinQuietBlocks = kMinSilenceMs / 5;
+
+  bool loud(long b) const { return db_[static_cast<size_t>(b)] >= threshold_; }
+
+  size_t quiet_blocks(long from, long step) const {
+    size_t count = 0;
+    for (long b = from; b >= 0 && b < blocks() && !loud(b); b += step) ++count;
     return count;
-  };
+  }
+
   // From the edge at block `b`: the edge after the hum that `b` starts, or `b` when what
   // follows it is louder or goes on without silence.
-  auto past_hum = [&](long b) {
+  long past_hum(long b) const {
     constexpr long kMaxHumBlocks = kMaxHumMs / 5;
-    for (long e = b; e < static_cast<long>(n) && e - b <= kMaxHumBlocks; ++e) {
-      if (db[e] >= loudest - kHumBelowLoudestDb) return b;
+    for (long e = b; e < blocks() && e - b <= kMaxHumBlocks; ++e) {
+      if (db_[static_cast<size_t>(e)] >= loudest_ - kHumBelowLoudestDb) return b;
       const auto quiet = static_cast<long>(quiet_blocks(e, 1));
       if (quiet >= static_cast<long>(kMinQuietBlocks)) {
-        if (e + quiet >= static_cast<long>(n)) return b;
+        if (e + quiet >= blocks()) return b;
         b = e + quiet;
         e = b - 1;
       }
     }
     return b;
-  };
+  }
+
   // From the onset edge at block `b`: where the sound starts to rise out of the silence just
   // before it (the median of its blocks, digital silence left out), at most kMaxRiseMs back.
-  auto rise_start = [&](long b) {
+  long rise_start(long b) const {
     std::vector<float> before;
-    for (long e = std::max(0L, b - kRadiusBlocks); e < b; ++e) {
-      if (db[e] < threshold && db[e] > loudest - kFloorRangeDb) before.push_back(db[e]);
+    for (long e = std::max(0L, b - static_cast<long>(kSnapRadiusMs / 5)); e < b; ++e) {
+      const float d = db_[static_cast<size_t>(e)];
+      if (d < threshold_ && d > loudest_ - kFloorRangeDb) before.push_back(d);
     }
     if (before.empty()) return b;
     std::nth_element(before.begin(), before.begin() + static_cast<long>(before.size() / 2),
@@ -156,53 +202,63 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
     const float rising = before[before.size() / 2] + kOnsetRiseDb;
     constexpr long kMaxRiseBlocks = kMaxRiseMs / 5;
     long e = b;
-    while (e > 0 && b - e < kMaxRiseBlocks && db[e - 1] >= rising) --e;
-    return e > 0 && db[e - 1] < rising ? e : b;  // else no silence before the rise
-  };
-  // The first edge into sound within kMaxHumMs after block `b`, when `b` starts a silence.
-  auto next_onset = [&](long b) {
-    if (b < 1 || quiet_blocks(b, 1) < kMinQuietBlocks) return -1L;
-    for (long e = b + 1; e < static_cast<long>(n) && e - b <= kMaxHumMs / 5; ++e) {
-      if (db[e] >= threshold && quiet_blocks(e - 1, -1) >= kMinQuietBlocks) return e;
-    }
-    return -1L;
-  };
+    while (e > 0 && b - e < kMaxRiseBlocks && db_[static_cast<size_t>(e - 1)] >= rising) --e;
+    return e > 0 && db_[static_cast<size_t>(e - 1)] < rising ? e : b;  // else no silence before
+  }
+
+  unsigned rate_;
+  size_t block_;
+  std::vector<float> db_;
+  float loudest_ = 0, threshold_ = 0;
+};
+
+}  // namespace
+
+void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
+                     std::span<const int16_t> audio, unsigned rate, std::vector<double>& starts) {
+  constexpr long kRadiusBlocks = kSnapRadiusMs / 5;
+  const Silence silence(audio, rate);
+  if (silence.empty()) return;
+  const auto block = static_cast<double>(silence.block());
   for (size_t k = 1; k < phonemes.size() && k <= starts.size(); ++k) {
     const bool speech_ends = is_pause(phonemes[k]) && !is_pause(phonemes[k - 1]);
     const bool speech_begins = !is_pause(phonemes[k]) && is_pause(phonemes[k - 1]);
     if (!speech_ends && !speech_begins) continue;
     // The edge between blocks b - 1 and b nearest the warp's boundary.
-    const long at = std::lround(starts[k - 1] / static_cast<double>(block));
+    const long at = std::lround(starts[k - 1] / block);
     for (long d = 0; d <= kRadiusBlocks; ++d) {
-      long found = [&] {
-        for (long b : {at - d, at + d}) {
-          if (b < 1 || b >= static_cast<long>(n)) continue;
-          if (speech_ends && db[b - 1] >= threshold && quiet_blocks(b, 1) >= kMinQuietBlocks) {
-            return b;
-          }
-          if (speech_begins && db[b] >= threshold && quiet_blocks(b - 1, -1) >= kMinQuietBlocks) {
-            return b;
-          }
+      long found = -1;
+      for (long b : {at - d, at + d}) {
+        if (speech_ends ? silence.ends_at(b) : silence.begins_at(b)) {
+          found = b;
+          break;
         }
-        return -1L;
-      }();
+      }
       // The warp can put the first sound in the silence before it, at a hum quieter than the
       // threshold, farther than the radius: it starts at the next edge.
-      if (found < 0 && d == kRadiusBlocks && speech_begins && k == 1) found = next_onset(at);
+      if (found < 0 && d == kRadiusBlocks && speech_begins && k == 1) {
+        found = silence.next_onset(at);
+      }
       if (found >= 0) {
-        const long edge = speech_begins && k == 1 ? past_hum(found) : found;
-        starts[k - 1] = static_cast<double>(edge) * static_cast<double>(block);
-        // A stop's closure is as silent as the pause before it: the edge is its release. What
-        // rises before a release is in its closure (ked's /t/): the closure rule alone.
-        if (speech_begins && is_stop(phonemes[k])) {
-          starts[k - 1] = std::max(starts[k - 1] - double{kStopClosureMs} * rate / 1000, 0.0);
-        } else if (speech_begins) {
-          starts[k - 1] = static_cast<double>(rise_start(edge)) * static_cast<double>(block);
-        }
+        starts[k - 1] = speech_begins ? silence.sound_start(phonemes[k], k == 1, found)
+                                      : static_cast<double>(found) * block;
         break;
       }
     }
   }
+}
+
+size_t next_sound_start(const tts::SpokenPhoneme& sound, std::span<const int16_t> audio,
+                        unsigned rate, size_t from) {
+  const Silence silence(audio, rate);
+  if (silence.empty()) return audio.size();
+  const auto b0 = static_cast<long>((from + silence.block() - 1) / silence.block());
+  for (long b = std::max(b0, 1L); b < silence.blocks(); ++b) {
+    if (silence.begins_at(b)) {
+      return static_cast<size_t>(std::lround(silence.sound_start(sound, true, b)));
+    }
+  }
+  return audio.size();
 }
 
 }  // namespace pfap::align

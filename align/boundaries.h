@@ -93,4 +93,11 @@ inline constexpr unsigned kMaxHumMs = 300;
 void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
                      std::span<const int16_t> audio, unsigned rate, std::vector<double>& starts);
 
+// Where `sound`, the first sound after a pause at the start, starts in `audio` at the first edge
+// into sound at or after sample `from`, as snap_to_silence() starts it at that edge (past a hum,
+// at a stop's closure, where an onset rises: possibly before `from`); audio.size() when no such
+// edge follows. Live, the pause before the first sound is not given out past it (live.h).
+size_t next_sound_start(const tts::SpokenPhoneme& sound, std::span<const int16_t> audio,
+                        unsigned rate, size_t from);
+
 }  // namespace pfap::align

@@ -182,6 +182,7 @@ void LiveAligner::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
     };
     const size_t hold = samples_of(kHoldMs, rate_);
     size_t piece_end = horizon;
+    bool first_waits = false;  // the first sound's start is placed, and waits for the hold
     while (next_ + 1 < syn_.phonemes.size()) {
       const size_t b = syn_.phonemes[next_ + 1].start;
       size_t at = map(b);
@@ -192,10 +193,20 @@ void LiveAligner::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
       // not given out past it meanwhile.
       if (!at_end && next_ == 0 && at + hold > horizon) {
         piece_end = std::max(at, rec_settled_);
+        first_waits = true;
         break;
       }
       syn_settled_ = b;
       emit(std::clamp(at, rec_settled_, n), true, out);
+    }
+    if (!at_end && next_ == 0 && !first_waits && syn_.phonemes.size() > 1) {
+      // Before the warp places the first sound, the pause stops where the first sound would
+      // start at the first edge into sound, for kHoldMs at most: the warp hears frames below
+      // kSpeechLevelDb as silence, so it places a weak onset late, and a start is never put
+      // before what was given out.
+      const size_t onset =
+          rec_first_ + next_sound_start(syn_.phonemes[1], rec_, rate_, rec_settled_ - rec_first_);
+      piece_end = std::max(std::min(onset, horizon), horizon - std::min(horizon, hold));
     }
     if (!at_end && horizon > rec_settled_ + hold && piece_end > rec_settled_) {
       // The phoneme goes on past the hold: a piece up to the horizon, and the warp restarts

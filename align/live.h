@@ -5,11 +5,13 @@
 // last settled boundary to the synthetic speech that follows it, a pause allowed between
 // words; boundaries next to a pause move onto the recording's edge of silence as in align().
 // A boundary is settled once kLookahead of audio follows it (the first sound's start once
-// kLookahead + kHold does: whether a hum starts there shows in the speech after it, and the
-// pause before it waits there); a phoneme still going on kLookahead + kHold before the newest
-// audio is sent in pieces. So every phoneme (or piece)
-// is given out by the time kLookahead + kHold + kStep and one block of push() more audio
-// than its start has come.
+// kLookahead + kHold does: whether a hum starts there shows in the speech after it). The pause
+// before the first sound is given out up to that start and no further, and before the warp has
+// placed it, up to where the first edge into sound would start it (a weak onset, which the warp
+// places late), for kHold at most. A phoneme still going on kLookahead + kHold before the newest
+// audio is sent in pieces.
+// So every phoneme (or piece) is given out by the time kLookahead + kHold + kStep and one block
+// of push() more audio than its start has come.
 // The method, its bound and its measured accuracy: docs/align.md, "Live".
 #pragma once
 

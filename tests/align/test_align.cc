@@ -377,6 +377,43 @@ TEST(Boundaries, FirstSoundInSilenceStartsAtTheNextEdge) {
   EXPECT_DOUBLE_EQ(starts[0], static_cast<double>(speech_begins));
 }
 
+// Live, the pause before the first sound stops where the first edge into sound at or after
+// what was given out would start it, as snap_to_silence() would: past Festival's lead-in hum
+// (-40 dBFS, then 45 ms of hiss), where a weak onset rises (-64 to -40 dBFS over 60 ms), a stop
+// at its closure; the audio's end when no edge follows.
+TEST(Boundaries, NextSoundStartIsAtTheFirstEdgeAfter) {
+  constexpr unsigned kRate = 16000;
+  std::vector<int16_t> audio(kRate / 2, 0);
+  add_hiss(audio, 0.3, kRate);
+  std::vector<int16_t> hum = tone(100, 0.16, kRate);  // tone() is at -15 dBFS
+  for (int16_t& x : hum) x = static_cast<int16_t>(x * std::pow(10.0, -25 / 20.0));
+  audio.insert(audio.end(), hum.begin(), hum.end());
+  add_hiss(audio, 0.045, kRate);
+  const size_t rise_begins = audio.size();
+  std::vector<int16_t> rise = tone(3000, 0.06, kRate);
+  for (size_t i = 0; i < rise.size(); ++i) {
+    const double db = -64 + 24.0 * static_cast<double>(i) / static_cast<double>(rise.size());
+    rise[i] = static_cast<int16_t>(rise[i] * std::pow(10.0, (db + 15) / 20));
+  }
+  audio.insert(audio.end(), rise.begin(), rise.end());
+  const size_t vowel_begins = audio.size();
+  const std::vector<int16_t> vowel = tone(200, 0.5, kRate);
+  audio.insert(audio.end(), vowel.begin(), vowel.end());
+  add_hiss(audio, 0.3, kRate);
+  const PhonemeAlphabet& arpabet = *find_alphabet(kArpabetAlphabet);
+  const tts::SpokenPhoneme sound = phoneme_at(1, 1);
+  const tts::SpokenPhoneme stop = phoneme_at(*find_symbol(arpabet, "P"), 1);
+  EXPECT_NEAR(static_cast<double>(next_sound_start(sound, audio, kRate, 0)),
+              static_cast<double>(rise_begins), 0.005 * kRate);
+  for (const tts::SpokenPhoneme& p : {sound, stop}) {
+    std::vector<double> starts = {static_cast<double>(vowel_begins)};
+    snap_to_silence({phoneme_at(0, 0), p}, audio, kRate, starts);
+    EXPECT_DOUBLE_EQ(static_cast<double>(next_sound_start(p, audio, kRate, kRate / 2)), starts[0]);
+  }
+  EXPECT_EQ(next_sound_start(sound, audio, kRate, vowel_begins), audio.size());
+  EXPECT_EQ(next_sound_start(sound, vowel, kRate, 0), vowel.size());  // no silence
+}
+
 // A stop out of a pause starts at its closure, kStopClosureMs before its release, which is the
 // edge of silence; another sound at the edge.
 TEST(Boundaries, StopOutOfAPauseStartsAtItsClosure) {
