@@ -83,7 +83,12 @@ async def run(sessions, stop_timeout_s, short=False):
     again = SHORT_TEXT if short else None
     peers = [asyncio.ensure_future(open_session(port, p, q, again))
              for p, q in zip(packets, leave)]
-    await asyncio.wait_for(asyncio.gather(*(p.wait() for p in packets)), 60)
+    try:
+        await asyncio.wait_for(asyncio.gather(*(p.wait() for p in packets)), 60)
+    except BaseException:
+        server.kill()  # peers that never had their first packet: no server left running
+        server.wait()
+        raise
     if short:
         await asyncio.sleep(1)
     mid_sentence = sum(not p.done() for p in peers)
