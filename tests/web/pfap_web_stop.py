@@ -59,9 +59,10 @@ def stacks(pid):
                        stdout=sys.stderr, stderr=subprocess.DEVNULL, timeout=120)
 
 
-# A GLib CRITICAL seen in 2 of about 30 stops in the sanitizer build, in a stop that finished
-# and in one that gave up, and not understood: a hash table changed as it was walked, in a
-# library of the stack (docs/web.md, "Stopping"). Printed, not failed on; any other fails.
+# A GLib CRITICAL of GStreamer's, not of the stop: a data race in gst-plugins-good 1.22.0's
+# rtpsession (its RTCP thread walks the session's sources while an RTCP packet adds one),
+# fixed in 1.22.3, which Debian 12 does not have. About 1 stop in 30 in the sanitizer build,
+# before the signal too (docs/web.md, "Stopping"). Printed, not failed on; any other fails.
 KNOWN_CRITICAL = "g_hash_table_foreach: assertion 'version == hash_table->version' failed"
 
 
@@ -83,7 +84,12 @@ async def run(sessions, stop_timeout_s, short=False):
     again = SHORT_TEXT if short else None
     peers = [asyncio.ensure_future(open_session(port, p, q, again))
              for p, q in zip(packets, leave)]
-    await asyncio.wait_for(asyncio.gather(*(p.wait() for p in packets)), 60)
+    try:
+        await asyncio.wait_for(asyncio.gather(*(p.wait() for p in packets)), 60)
+    except BaseException:
+        server.kill()  # peers that never had their first packet: no server left running
+        server.wait()
+        raise
     if short:
         await asyncio.sleep(1)
     mid_sentence = sum(not p.done() for p in peers)
