@@ -199,7 +199,8 @@ const pfap::align::VisemeModel& model() {
       std::string field;
       while (std::getline(fields, field, ',')) {
         if (field.find_first_not_of(" \t") != std::string::npos)
-          numbers.push_back(std::stof(field));
+          numbers.push_back(
+              std::strtof(field.c_str(), nullptr));  // as the compiler reads a denormal
       }
     }
     auto model = pfap::align::VisemeModel::from_numbers(numbers);
