@@ -10,8 +10,6 @@
 namespace pfap::align {
 namespace {
 
-constexpr size_t kContextFrames = kVisemePastFrames + 1 + kVisemeAheadFrames;
-constexpr size_t kInputs = kContextFrames * kVisemeMfccs;
 constexpr size_t kHeader = 7;  // kind, mfccs, past, ahead, hidden1, hidden2, visemes
 constexpr float kKind = 2;     // 2: with the cepstral mean's prior
 // The numbers before the layers: the inputs' means and scales, and the cepstral mean's prior.
@@ -43,16 +41,20 @@ const VisemeModel& VisemeModel::builtin() {
 }
 
 std::unique_ptr<VisemeModel> VisemeModel::from_numbers(std::span<const float> n) {
-  if (n.size() < kHeader || n[0] != kKind || n[1] != kVisemeMfccs || n[2] != kVisemePastFrames ||
-      n[3] != kVisemeAheadFrames || n[6] != kVisemeCount || n[4] < 1 || n[5] < 1 ||
-      n[4] > 1024 || n[5] > 1024) {
+  auto whole = [](float v, size_t low, size_t high) {
+    return v >= static_cast<float>(low) && v <= static_cast<float>(high) && v == std::floor(v);
+  };
+  if (n.size() < kHeader || n[0] != kKind || n[1] != kVisemeMfccs ||
+      !whole(n[2], 0, kMaxVisemePastFrames) || n[3] != kVisemeAheadFrames || n[6] != kVisemeCount ||
+      !whole(n[4], 1, 1024) || !whole(n[5], 1, 1024)) {
     return nullptr;
   }
   auto model = std::make_unique<VisemeModel>();
+  model->past_ = static_cast<size_t>(n[2]);
   model->hidden1_ = static_cast<size_t>(n[4]);
   model->hidden2_ = static_cast<size_t>(n[5]);
-  const size_t h1 = model->hidden1_, h2 = model->hidden2_;
-  const size_t want = kNormalization + h1 * (kInputs + 1) + h2 * (h1 + 1) + kVisemeCount * (h2 + 1);
+  const size_t inputs = model->inputs(), h1 = model->hidden1_, h2 = model->hidden2_;
+  const size_t want = kNormalization + h1 * (inputs + 1) + h2 * (h1 + 1) + kVisemeCount * (h2 + 1);
   if (n.size() != kHeader + want) return nullptr;
   model->params_.assign(n.begin() + kHeader, n.end());
   return model;
@@ -63,8 +65,9 @@ void VisemeModel::probabilities(std::span<const float> context, std::span<float>
   const float* mean = p;
   const float* scale = p + kVisemeMfccs;
   p += kNormalization;
-  std::array<float, kInputs> x;
-  for (size_t i = 0; i < kInputs; ++i) {
+  const size_t inputs = this->inputs();
+  std::vector<float> x(inputs);
+  for (size_t i = 0; i < inputs; ++i) {
     x[i] = (context[i] - mean[i % kVisemeMfccs]) * scale[i % kVisemeMfccs];
   }
   // layer: out[r] = b[r] + sum W[r][c] in[c], ReLU but on the last
@@ -79,7 +82,7 @@ void VisemeModel::probabilities(std::span<const float> context, std::span<float>
     p += n_in * n_out + n_out;
   };
   std::vector<float> h1(hidden1_), h2(hidden2_);
-  layer(x.data(), kInputs, hidden1_, h1.data(), true);
+  layer(x.data(), inputs, hidden1_, h1.data(), true);
   layer(h1.data(), hidden1_, hidden2_, h2.data(), true);
   layer(h2.data(), hidden2_, kVisemeCount, out.data(), false);
   const float top = *std::max_element(out.begin(), out.end());
@@ -95,7 +98,7 @@ VisemeDetector::VisemeDetector(unsigned rate, size_t max_run_frames, VisemeSmoot
       smoothing_(smoothing),
       resampler_(rate),
       cepstral_mean_(model.cepstral_prior()) {
-  for (size_t k = 0; k < kVisemePastFrames; ++k) {
+  for (size_t k = 0; k < model.past_frames(); ++k) {
     context_.insert(context_.end(), silence_frame().begin(), silence_frame().end());
   }
 }
@@ -137,7 +140,7 @@ void VisemeDetector::take_frames(std::vector<VisemeRun>& out) {
   for (size_t at = 0; at < coefficients_.size(); at += kVisemeMfccs) {
     context_.insert(context_.end(), coefficients_.begin() + static_cast<std::ptrdiff_t>(at),
                     coefficients_.begin() + static_cast<std::ptrdiff_t>(at + kVisemeMfccs));
-    if (context_.size() < kInputs) continue;
+    if (context_.size() < model_.inputs()) continue;
     classify(out);
     context_.erase(context_.begin(), context_.begin() + kVisemeMfccs);
   }

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // A frame-level viseme detector for live audio without a text: the 15 Oculus visemes (the
-// MPEG-4 visemes with silence, pfap::Viseme) of each 10 ms frame, from MFCCs with 80 ms of
-// past and 40 ms ahead through a small network (align/viseme_model.txt, made by
-// tools/viseme-train), smoothed into runs. Live: push audio as it comes, take the runs
+// MPEG-4 visemes with silence, pfap::Viseme) of each 10 ms frame, from MFCCs with the model's
+// past (80 ms in today's) and 40 ms ahead through a small network (align/viseme_model.txt,
+// made by tools/viseme-train), smoothed into runs. Live: push audio as it comes, take the runs
 // that are settled; each needs at most kVisemeLookaheadMs of audio after its frames. No
 // GStreamer; web/src/viseme_detector.js is the same in JavaScript. docs/align.md, "A viseme
 // detector".
@@ -24,9 +24,10 @@ namespace pfap::align {
 // which is MPEG-4 viseme k (docs/visemes.md).
 inline constexpr size_t kVisemeCount = 15;
 
-// The model's context: frames before and after the one it decides.
-inline constexpr size_t kVisemePastFrames = 8;
+// The model's context: frames after the one it decides (fixed: the lookahead), and at most
+// how many before (the model file says how many).
 inline constexpr size_t kVisemeAheadFrames = 4;
+inline constexpr size_t kMaxVisemePastFrames = 100;
 // Smoothing: each frame's probabilities averaged with its neighbours' kSmoothFrames either
 // side; the viseme shown changes when another's averaged probability beats it by a margin,
 // and not before it has been shown a number of frames (docs/align.md).
@@ -65,8 +66,8 @@ struct VisemeRun {
   Viseme viseme = Viseme::kNone;
 };
 
-// The network's weights (a multilayer perceptron: kVisemeMfccs x 13 frames in, two hidden
-// layers with ReLU, kVisemeCount out), read from the text of align/viseme_model.txt.
+// The network's weights (a multilayer perceptron: kVisemeMfccs x the context's frames in, two
+// hidden layers with ReLU, kVisemeCount out), read from the text of align/viseme_model.txt.
 class VisemeModel {
  public:
   // The model built into the library (align/viseme_model.txt at build time).
@@ -74,9 +75,12 @@ class VisemeModel {
   // The model of `numbers` (the file's numbers in order); nullptr if they do not make one.
   static std::unique_ptr<VisemeModel> from_numbers(std::span<const float> numbers);
 
-  // Each viseme's probability for the frame of `context` (kVisemePastFrames + 1 +
+  // Each viseme's probability for the frame of `context` (past_frames() + 1 +
   // kVisemeAheadFrames frames of kVisemeMfccs, oldest first), into `out` (kVisemeCount).
   void probabilities(std::span<const float> context, std::span<float> out) const;
+  size_t past_frames() const { return past_; }
+  // The network's inputs: kVisemeMfccs a frame of the context.
+  size_t inputs() const { return (past_ + 1 + kVisemeAheadFrames) * kVisemeMfccs; }
   size_t weights() const { return params_.size(); }
   // The training set's mean of c1..c12 over frames of sound: where CepstralMean starts.
   std::span<const float> cepstral_prior() const {
@@ -84,7 +88,7 @@ class VisemeModel {
   }
 
  private:
-  size_t hidden1_ = 0, hidden2_ = 0;
+  size_t past_ = 0, hidden1_ = 0, hidden2_ = 0;
   std::vector<float> params_;  // mean, scale, cepstral prior, then W1 b1 W2 b2 W3 b3, row-major
 };
 

@@ -19,6 +19,7 @@
 //   pfap-viseme-data trace WAV OUT.json
 //       the detector's probabilities and runs for WAV, in 20 ms blocks, as JSON: the
 //       fixture tests/web compares web/src/viseme_detector.js with
+// eval and trace use the model of the file PFAP_VISEME_MODEL if set, else the built-in one.
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -28,6 +29,7 @@
 #include <ctime>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -182,6 +184,35 @@ int features(int argc, char** argv) {
   return 0;
 }
 
+// The model of PFAP_VISEME_MODEL (a file as align/viseme_model.txt; to compare models without
+// building each in), else the built-in one. Exits if the file holds no model.
+const pfap::align::VisemeModel& model() {
+  static const std::unique_ptr<pfap::align::VisemeModel> from_file =
+      []() -> std::unique_ptr<pfap::align::VisemeModel> {
+    const char* path = std::getenv("PFAP_VISEME_MODEL");
+    if (path == nullptr) return nullptr;
+    std::ifstream in(path);
+    std::vector<float> numbers;
+    std::string line;
+    while (std::getline(in, line)) {
+      std::stringstream fields(line.substr(0, line.find("//")));
+      std::string field;
+      while (std::getline(fields, field, ',')) {
+        if (field.find_first_not_of(" \t") != std::string::npos)
+          numbers.push_back(
+              std::strtof(field.c_str(), nullptr));  // as the compiler reads a denormal
+      }
+    }
+    auto model = pfap::align::VisemeModel::from_numbers(numbers);
+    if (model == nullptr) {
+      std::fprintf(stderr, "%s: not a viseme model of this version\n", path);
+      std::exit(1);
+    }
+    return model;
+  }();
+  return from_file != nullptr ? *from_file : pfap::align::VisemeModel::builtin();
+}
+
 // The detector over `samples` in 20 ms blocks, as a live source gives them.
 std::vector<pfap::align::VisemeRun> detect(const std::vector<int16_t>& samples, unsigned rate,
                                            std::vector<float>* trace = nullptr) {
@@ -190,7 +221,7 @@ std::vector<pfap::align::VisemeRun> detect(const std::vector<int16_t>& samples, 
   pfap::align::VisemeSmoothing smoothing;
   if (const char* m = std::getenv("PFAP_VISEME_MARGIN")) smoothing.switch_margin = std::stof(m);
   if (const char* m = std::getenv("PFAP_VISEME_MIN_RUN")) smoothing.min_run_frames = std::stoul(m);
-  pfap::align::VisemeDetector detector(rate, 0, smoothing);
+  pfap::align::VisemeDetector detector(rate, 0, smoothing, model());
   detector.trace(trace);
   std::vector<pfap::align::VisemeRun> runs;
   const size_t block = std::max(1u, rate / 50);

@@ -368,6 +368,52 @@ TEST(VisemeDetector, ModelNumbersAreChecked) {
   std::vector<float> right{2, 13, 8, 4, 2, 2, 15};
   right.resize(size);
   EXPECT_NE(VisemeModel::from_numbers(right), nullptr);
+  // The past context is the file's, whole frames up to kMaxVisemePastFrames; the frames
+  // ahead are the lookahead's, fixed.
+  for (float past : {0.0f, 24.0f, 8.5f, static_cast<float>(kMaxVisemePastFrames + 1), -1.0f}) {
+    const bool whole = past >= 0 && past <= kMaxVisemePastFrames && past == std::floor(past);
+    std::vector<float> other{2, 13, past, 4, 2, 2, 15};
+    other.resize(7 + 26 + 12 + 2 * (13 * (static_cast<size_t>(std::max(past, 0.0f)) + 5) + 1) +
+                 2 * 3 + 15 * 3);
+    EXPECT_EQ(VisemeModel::from_numbers(other) != nullptr, whole) << past;
+  }
+}
+
+constexpr float kBuiltinNumbers[] = {
+#include "viseme_model.txt"
+};
+
+// The built-in model with `extra` more frames of past whose weights are 0: the same network,
+// so the same probabilities, if the detector feeds the context oldest first as the file says.
+std::vector<float> with_more_past(size_t extra) {
+  std::vector<float> n(std::begin(kBuiltinNumbers), std::end(kBuiltinNumbers));
+  const auto past = static_cast<size_t>(n[2]), hidden1 = static_cast<size_t>(n[4]);
+  const size_t inputs = (past + 1 + kVisemeAheadFrames) * kVisemeMfccs;
+  const size_t layer1 = 7 + 2 * kVisemeMfccs + (kVisemeMfccs - 1);
+  n[2] = static_cast<float>(past + extra);
+  for (size_t r = hidden1; r-- > 0;) {
+    n.insert(n.begin() + static_cast<std::ptrdiff_t>(layer1 + r * inputs), extra * kVisemeMfccs,
+             0.0f);
+  }
+  return n;
+}
+
+TEST(VisemeDetector, ThePastContextIsTheModelsOwn) {
+  const Spoken s = spoken(kSentences[0]);
+  auto trace = [&](const VisemeModel& model) {
+    VisemeDetector detector(s.rate, 0, {}, model);
+    std::vector<float> probabilities;
+    detector.trace(&probabilities);
+    std::vector<VisemeRun> runs;
+    detector.push(std::span<const int16_t>(s.samples), runs);
+    detector.finish(runs);
+    return probabilities;
+  };
+  const std::vector<float> builtin = trace(VisemeModel::builtin());
+  const auto longer = VisemeModel::from_numbers(with_more_past(16));
+  ASSERT_NE(longer, nullptr);
+  EXPECT_EQ(longer->past_frames(), VisemeModel::builtin().past_frames() + 16);
+  EXPECT_EQ(trace(*longer), builtin);
 }
 
 }  // namespace

@@ -2,7 +2,8 @@
 // The viseme detector's speed in Node: a WAV file (default: 10 s of a seeded noisy chirp at
 // 48 kHz, resampled as a page's AudioContext gives it) pushed in 128-sample blocks, as an
 // AudioWorklet's render quanta. Prints the real-time factor (processor time over audio time),
-// best of 3 runs. Run: node bench/viseme.js [FILE.wav] (docs/align.md, "A viseme detector")
+// best of 3 runs. Run: node bench/viseme.js [FILE.wav] (docs/align.md, "A viseme detector");
+// PFAP_VISEME_MODEL=FILE: another model than align/viseme_model.txt, to compare them.
 import { readFileSync } from 'node:fs';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -10,7 +11,8 @@ import { fileURLToPath } from 'node:url';
 import { VisemeDetector, parseVisemeModel } from '../src/index.js';
 
 const root = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..', '..');
-const model = parseVisemeModel(readFileSync(path.join(root, 'align', 'viseme_model.txt'), 'utf8'));
+const modelFile = process.env.PFAP_VISEME_MODEL ?? path.join(root, 'align', 'viseme_model.txt');
+const model = parseVisemeModel(readFileSync(modelFile, 'utf8'));
 
 function audio() {
   const file = process.argv[2];

@@ -2,7 +2,7 @@
 // The frame-level viseme detector of align/viseme_detector.{h,cc} in JavaScript, step by
 // step the same (tests/web checks that both give the same visemes on the same audio): any
 // rate resampled to 16 kHz, 13 MFCCs of a 25 ms window every 10 ms, c1..c12 less their
-// running mean over the stream, a small network over 8 frames before and 4 after
+// running mean over the stream, a small network over the model's frames before (8 in today's) and 4 after
 // (align/viseme_model.txt), smoothed into runs of the 15 Oculus visemes. At most 60 ms of audio ahead. docs/align.md, "A viseme detector".
 
 /** The alphabet of the detector's phonemes: symbol k is Oculus viseme k (= MPEG-4 viseme k). */
@@ -32,10 +32,8 @@ const HIGH_HZ = 7600;
 const LOG_FLOOR = 1e-10;
 const CUTOFF = 0.45;
 const ZERO_CROSSINGS = 16;
-const PAST = 8;
 const AHEAD = 4;
-const CONTEXT = PAST + 1 + AHEAD;
-const INPUTS = CONTEXT * MFCCS;
+const MAX_PAST = 100;  // frames before; the model file says how many
 const VISEMES = 15;
 const SMOOTH = 1;
 const HEADER = 7;
@@ -266,20 +264,22 @@ export function parseVisemeModel(text) {
     .filter((s) => s !== '')
     .map(Number);
   const [kind, mfccs, past, ahead, hidden1, hidden2, visemes] = numbers;
-  const want = HEADER + NORMALIZATION + hidden1 * (INPUTS + 1) + hidden2 * (hidden1 + 1) + VISEMES * (hidden2 + 1);
-  if (kind !== KIND || mfccs !== MFCCS || past !== PAST || ahead !== AHEAD || visemes !== VISEMES ||
-      !(hidden1 >= 1 && hidden1 <= 1024 && hidden2 >= 1 && hidden2 <= 1024) ||
+  const inputs = (past + 1 + AHEAD) * MFCCS;
+  const want = HEADER + NORMALIZATION + hidden1 * (inputs + 1) + hidden2 * (hidden1 + 1) + VISEMES * (hidden2 + 1);
+  const whole = (n, low, high) => Number.isInteger(n) && n >= low && n <= high;
+  if (kind !== KIND || mfccs !== MFCCS || !whole(past, 0, MAX_PAST) || ahead !== AHEAD || visemes !== VISEMES ||
+      !whole(hidden1, 1, 1024) || !whole(hidden2, 1, 1024) ||
       numbers.length !== want || numbers.some((n) => !Number.isFinite(n))) {
     throw new Error('not a viseme model of this version (align/viseme_model.txt)');
   }
-  return { hidden1, hidden2, params: Float32Array.from(numbers.slice(HEADER)) };
+  return { past, inputs, hidden1, hidden2, params: Float32Array.from(numbers.slice(HEADER)) };
 }
 
 function probabilities(model, context, out) {
-  const { params, hidden1, hidden2 } = model;
+  const { params, inputs, hidden1, hidden2 } = model;
   let p = NORMALIZATION;
-  const x = new Float32Array(INPUTS);
-  for (let i = 0; i < INPUTS; i++) {
+  const x = new Float32Array(inputs);
+  for (let i = 0; i < inputs; i++) {
     x[i] = f32(context[i] - params[i % MFCCS]) * params[MFCCS + (i % MFCCS)];
   }
   const layer = (input, nIn, nOut, relu) => {
@@ -293,7 +293,7 @@ function probabilities(model, context, out) {
     p += nIn * nOut + nOut;
     return result;
   };
-  const h1 = layer(x, INPUTS, hidden1, true);
+  const h1 = layer(x, inputs, hidden1, true);
   const h2 = layer(h1, hidden1, hidden2, true);
   const logits = layer(h2, hidden2, VISEMES, false);
   let top = -Infinity;
@@ -328,7 +328,7 @@ export class VisemeDetector {
     this.mfcc = new MfccFrames();
     this.cepstralMean = new CepstralMean(model.params.subarray(2 * MFCCS, NORMALIZATION));
     this.context = [];
-    for (let k = 0; k < PAST; k++) this.context.push(...SILENCE_FRAME);
+    for (let k = 0; k < model.past; k++) this.context.push(...SILENCE_FRAME);
     this.classified = 0;
     this.probs = [];
     this.decided = 0;
@@ -375,7 +375,7 @@ export class VisemeDetector {
   takeFrames(coefficients, out) {
     for (let at = 0; at < coefficients.length; at += MFCCS) {
       for (let i = 0; i < MFCCS; i++) this.context.push(coefficients[at + i]);
-      if (this.context.length < INPUTS) continue;
+      if (this.context.length < this.model.inputs) continue;
       const p = new Float32Array(VISEMES);
       probabilities(this.model, this.context, p);
       if (this.traceTo) this.traceTo.push(...p);

@@ -5,7 +5,7 @@
 // within float tolerance and the same runs. Needs PFAP_VISEME_DATA (tests/web/meson.build).
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { test } from 'node:test';
@@ -20,9 +20,9 @@ const model = parseVisemeModel(readFileSync(path.join(root, 'align', 'viseme_mod
 // Float32 weights, float in C++ and double here: the probabilities differ in the 6th digit.
 const TOLERANCE = 1e-4;
 
-function detect({ rate, samples }) {
+function detect({ rate, samples }, withModel = model) {
   const trace = [];
-  const detector = new VisemeDetector(rate, { model, trace });
+  const detector = new VisemeDetector(rate, { model: withModel, trace });
   const runs = [];
   const block = Math.floor(rate / 50);
   const floats = Float32Array.from(samples, (s) => s / 32768);
@@ -65,6 +65,39 @@ test('the JavaScript detector gives the C++ one\'s visemes on the same audio', {
   }
 });
 
+// align/viseme_model.txt with `extra` more frames of past whose weights are 0: the same
+// network, if the context is fed oldest first as the file says.
+function withMorePast(text, extra) {
+  const n = text.replace(/\/\/[^\n]*/g, '').split(',').map((s) => s.trim()).filter((s) => s !== '');
+  const [past, hidden1] = [Number(n[2]), Number(n[4])];
+  const inputs = (past + 1 + 4) * 13;
+  const layer1 = 7 + 26 + 12;
+  n[2] = String(past + extra);
+  for (let r = hidden1 - 1; r >= 0; r--) n.splice(layer1 + r * inputs, 0, ...new Array(extra * 13).fill('0'));
+  return n.join(',\n');
+}
+
+test('a model\'s own past context, in C++ and JavaScript alike', { skip: tool === undefined && 'PFAP_VISEME_DATA not set' }, () => {
+  const dir = mkdtempSync(path.join(tmpdir(), 'pfap-viseme-'));
+  try {
+    execFileSync(tool, ['speak', 'en-us+f2', '165', '55', dir, 's'], { input: 'Glue the sheet to the dark blue background.\n' });
+    const file = path.join(dir, 'longer.txt');
+    writeFileSync(file, withMorePast(readFileSync(path.join(root, 'align', 'viseme_model.txt'), 'utf8'), 16));
+    const longer = parseVisemeModel(readFileSync(file, 'utf8'));
+    assert.equal(longer.past, model.past + 16);
+    const wav = path.join(dir, 's-001.wav');
+    execFileSync(tool, ['trace', wav, path.join(dir, 's.json')], { env: { ...process.env, PFAP_VISEME_MODEL: file } });
+    const cpp = JSON.parse(readFileSync(path.join(dir, 's.json'), 'utf8'));
+    const js = detect(readWav(wav), longer);
+    assert.deepEqual(js.trace, detect(readWav(wav)).trace);  // the same network
+    assert.equal(js.trace.length, cpp.probabilities.length);
+    js.trace.forEach((p, i) => assert.ok(Math.abs(p - cpp.probabilities[i]) <= TOLERANCE, `frame ${Math.floor(i / 15)}`));
+    assert.deepEqual(js.runs, cpp.runs);
+  } finally {
+    rmSync(dir, { recursive: true, force: true });
+  }
+});
+
 test('the model file is checked, and the detector declares at most 60 ms ahead', () => {
   assert.ok(VISEME_LOOKAHEAD_MS <= 60);
   assert.equal(OCULUS_VISEMES.length, 15);
@@ -74,6 +107,13 @@ test('the model file is checked, and the detector declares at most 60 ms ahead',
   assert.throws(() => parseVisemeModel(kind1), /not a viseme model/);
   assert.doesNotThrow(() => parseVisemeModel(kind1.replace(/^1/, '2')));
   assert.throws(() => parseVisemeModel('// nothing'), /not a viseme model/);
+  // The past context is the file's, whole frames up to 100; the frames ahead are fixed.
+  for (const past of [0, 24, 8.5, 101, -1]) {
+    const layers = 2 * ((Math.max(past, 0) + 5) * 13 + 1) + 2 * 3 + 15 * 3;
+    const text = `2, 13, ${past}, 4, 2, 2, 15, ${new Array(26 + 12 + layers).fill(0).join(', ')}`;
+    if (Number.isInteger(past) && past >= 0 && past <= 100) assert.equal(parseVisemeModel(text).past, past);
+    else assert.throws(() => parseVisemeModel(text), /not a viseme model/);
+  }
   assert.throws(() => new VisemeDetector(16000), /needs a model/);
   // Silence: one pause run covering every frame, at any rate.
   for (const rate of [8000, 44100]) {
