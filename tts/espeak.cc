@@ -31,7 +31,7 @@ using wire::Writer;
 // in one process gave other audio and alignments that differed by up to 300 ms (issue 31). So
 // espeak-ng runs in a helper program, pfap-espeak, that the first call starts (posix_spawn: the
 // caller, which may be large and many-threaded, never runs its own code in a child). It starts
-// espeak-ng, never speaks, and forks a child per synthesis whose espeak-ng never has
+// espeak-ng, never speaks, and forks a child per request whose espeak-ng never has
 // (pfap-espeak.cc). Each call sends it a request with the write end of a fresh pipe, on which
 // the answer comes (espeakwire.h).
 std::mutex helper_mutex;  // held while pfap-espeak starts and while a request is sent
