@@ -55,6 +55,16 @@ export function decodeLevelMessage(bytes) {
   return { ssrc: view.getUint32(4), timestamp: view.getUint32(8), levels };
 }
 
+// A segment's level at running time `ms` (not before its start): between two blocks' starts
+// interpolated, toward 0 after its last block, 0 after that.
+function levelIn({ startMs, levels }, ms) {
+  const x = ms - startMs;
+  const k = Math.floor(x);
+  if (k >= levels.length) return 0;
+  const next = k + 1 < levels.length ? levels[k + 1] : 0;
+  return levels[k] + (next - levels[k]) * (x - k);
+}
+
 /**
  * The sender's level by running time, from the server's "envelope" messages (decodeLevels).
  */
@@ -98,12 +108,34 @@ export class SentLevel {
       ? near : this.segments.findLastIndex((seg) => seg.startMs <= ms);
     if (i < 0) return 0;
     this.found = i;
-    const { startMs, levels } = this.segments[i];
-    const x = ms - startMs;
-    const k = Math.floor(x);
-    if (k >= levels.length) return 0;
-    const next = k + 1 < levels.length ? levels[k + 1] : 0;
-    return levels[k] + (next - levels[k]) * (x - k);
+    return levelIn(this.segments[i], ms);
+  }
+
+  /**
+   * at(ms + lag) for `count` lags from `firstLag` in 1 ms steps, into out[offset + j × stride]
+   * for the j-th: the same values, with one segment search, not one a lag.
+   */
+  sampleLags(ms, firstLag, count, out, offset = 0, stride = 1) {
+    const { segments } = this;
+    // The last segment that starts at or before the first time (at's), -1 if none does.
+    let lo = 0;
+    let hi = segments.length;
+    const first = ms + firstLag;
+    while (lo < hi) {
+      const mid = (lo + hi) >> 1;
+      if (segments[mid].startMs <= first) lo = mid + 1;
+      else hi = mid;
+    }
+    let s = lo - 1;
+    let nextStart = s + 1 < segments.length ? segments[s + 1].startMs : Infinity;
+    for (let j = 0; j < count; ++j) {
+      const t = ms + (firstLag + j);
+      if (t >= nextStart) {
+        while (s + 1 < segments.length && segments[s + 1].startMs <= t) ++s;
+        nextStart = s + 1 < segments.length ? segments[s + 1].startMs : Infinity;
+      }
+      out[offset + j * stride] = s >= 0 ? levelIn(segments[s], t) : 0;
+    }
   }
 }
 
@@ -113,40 +145,61 @@ export class SentLevel {
  * 1 ms steps within ±searchMs (Pearson correlation of the two levels), refined between steps
  * by a parabola. Null unless the window holds at least `minSpeechMs` of sound, the best
  * correlation reaches `minCorrelation` and lies inside the search range.
+ *
+ * The sums are SentLevel.at's values and the correlation's, in the same order, so the lag is
+ * the same to the bit; what it saves is the lookups: each block walks the sender's segments
+ * once over its lags, not a search and a call for each.
  * @param {{x: number, rms: number}[]} heard
- * @param {(ms: number) => number} sentAt
+ * @param {SentLevel} sent
  * @returns {number|null} ms
  */
-export function matchLevels(heard, sentAt, { searchMs = 50, minCorrelation = 0.9, minSpeechMs = 20 } = {}) {
-  const peak = heard.reduce((m, h) => Math.max(m, h.rms), 0);
-  if (peak === 0 || heard.filter((h) => h.rms > peak * 0.1).length < minSpeechMs) return null;
+export function matchLevels(heard, sent, { searchMs = 50, minCorrelation = 0.9, minSpeechMs = 20 } = {}) {
   const n = heard.length;
-  const meanA = heard.reduce((s, h) => s + h.rms, 0) / n;
+  let peak = 0;
+  for (const h of heard) peak = Math.max(peak, h.rms);
+  let speech = 0;
+  for (const h of heard) if (h.rms > peak * 0.1) ++speech;
+  if (peak === 0 || speech < minSpeechMs) return null;
+  let sumA = 0;
+  for (const h of heard) sumA += h.rms;
+  const meanA = sumA / n;
+  const lags = 2 * searchMs + 1;
+  const { a, b, scores } = scratch(n, lags);
   let varA = 0;
-  for (const h of heard) varA += (h.rms - meanA) ** 2;
-  const b = new Float64Array(n);  // the sent level at each heard block's x + lag (one buffer: no garbage a lag)
-  const correlation = (lag) => {
+  for (let i = 0; i < n; ++i) {
+    a[i] = heard[i].rms - meanA;
+    varA += a[i] ** 2;
+  }
+  // b[j × n + i]: the sent level at heard block i's x + lag j (j = 0 is -searchMs).
+  for (let i = 0; i < n; ++i) sent.sampleLags(heard[i].x, -searchMs, lags, b, i, n);
+  for (let j = 0; j < lags; ++j) {
+    const row = j * n;
     let sumB = 0;
-    for (let i = 0; i < n; ++i) {
-      b[i] = sentAt(heard[i].x + lag);
-      sumB += b[i];
-    }
+    for (let i = 0; i < n; ++i) sumB += b[row + i];
     const meanB = sumB / n;
     let cov = 0;
     let varB = 0;
     for (let i = 0; i < n; ++i) {
-      cov += (heard[i].rms - meanA) * (b[i] - meanB);
-      varB += (b[i] - meanB) ** 2;
+      const d = b[row + i] - meanB;
+      cov += a[i] * d;
+      varB += d ** 2;
     }
-    return varB > 0 ? cov / Math.sqrt(varA * varB) : -1;
-  };
-  const scores = [];
-  for (let lag = -searchMs; lag <= searchMs; ++lag) scores.push(correlation(lag));
+    scores[j] = varB > 0 ? cov / Math.sqrt(varA * varB) : -1;
+  }
   let best = 0;
-  for (let i = 1; i < scores.length; ++i) if (scores[i] > scores[best]) best = i;
-  if (scores[best] < minCorrelation || best === 0 || best === scores.length - 1) return null;
+  for (let j = 1; j < lags; ++j) if (scores[j] > scores[best]) best = j;
+  if (scores[best] < minCorrelation || best === 0 || best === lags - 1) return null;
   const [l, c, r] = [scores[best - 1], scores[best], scores[best + 1]];
   const curvature = l - 2 * c + r;
   const step = curvature < 0 ? Math.max(-0.5, Math.min(0.5, (l - r) / (2 * curvature))) : 0;
   return best - searchMs + step;
+}
+
+// matchLevels' buffers, kept from one match to the next (a match every 10 ms: no garbage).
+let buffers = { a: new Float64Array(0), b: new Float64Array(0), scores: new Float64Array(0) };
+function scratch(n, lags) {
+  if (buffers.a.length < n || buffers.b.length < n * lags || buffers.scores.length < lags) {
+    buffers = { a: new Float64Array(n), b: new Float64Array(n * lags), scores: new Float64Array(lags) };
+  }
+  return buffers;
 }

@@ -278,7 +278,7 @@ export class PlayoutClock {
       heard.push({ x: env[i].t + this.searchMappingAt(env[i].t), rms: env[i].rms });
     }
     const searchMs = !this.matched ? this.firstSearchMs : this.misses >= 30 ? this.lostSearchMs : this.searchMs;
-    const lag = matchLevels(heard.reverse(), (ms) => this.sent.at(ms), { searchMs });
+    const lag = matchLevels(heard.reverse(), this.sent, { searchMs });
     if (lag === null) {
       const peak = heard.reduce((m, h) => Math.max(m, h.rms), 0);
       if (this.matched && peak > 1e-3 && heard.filter((h) => h.rms > peak * 0.1).length >= 20) ++this.misses;

@@ -64,7 +64,7 @@ test('matchLevels finds the lag at an onset, to a fraction of a millisecond', ()
   sent.add(1000e6, levels);
   for (const lag of [-37.5, -12.3, 0, 4.6, 21]) {
     // 150 ms ending 40 ms into the third onset (at 674 ms), as the page has it then.
-    const found = matchLevels(heardOf(levels, 1000, 1000 + 674 - 110, 1000 + 674 + 40, lag), (ms) => sent.at(ms));
+    const found = matchLevels(heardOf(levels, 1000, 1000 + 674 - 110, 1000 + 674 + 40, lag), sent);
     assert.ok(found !== null && Math.abs(found - lag) < 0.5, `lag ${lag}: found ${found}`);
   }
 });
@@ -73,10 +73,10 @@ test('matchLevels says nothing in silence, nor beyond its search range', () => {
   const levels = speech(2000);
   const sent = new SentLevel();
   sent.add(0, levels);
-  assert.equal(matchLevels(heardOf(levels, 0, 150, 300, 5), (ms) => sent.at(ms)), null);  // silence
-  assert.equal(matchLevels(heardOf(levels, 0, 564, 714, 80), (ms) => sent.at(ms)), null);
+  assert.equal(matchLevels(heardOf(levels, 0, 150, 300, 5), sent), null);  // silence
+  assert.equal(matchLevels(heardOf(levels, 0, 564, 714, 80), sent), null);
   // Nothing sent there: no match.
-  assert.equal(matchLevels(heardOf(levels, 0, 564, 714, 5), () => 0), null);
+  assert.equal(matchLevels(heardOf(levels, 0, 564, 714, 5), new SentLevel()), null);
 });
 
 // The sender's code (tools/speech_level.h, encode_levels), for the round trip below.
@@ -137,7 +137,97 @@ test('matchLevels finds the same lag in the level as the sender codes it', () =>
   const sent = new SentLevel();
   sent.add(1000e6, decodeLevels(encodeLevels(levels)));
   for (const lag of [-37.5, -12.3, 0, 4.6, 21]) {
-    const found = matchLevels(heardOf(levels, 1000, 1000 + 674 - 110, 1000 + 674 + 40, lag), (ms) => sent.at(ms));
+    const found = matchLevels(heardOf(levels, 1000, 1000 + 674 - 110, 1000 + 674 + 40, lag), sent);
     assert.ok(found !== null && Math.abs(found - lag) < 0.5, `lag ${lag}: found ${found}`);
   }
+});
+
+// matchLevels as it was before it sampled the sent level a block at a time (ba4fbdd): a
+// lookup a lag. The reference for the test below.
+function matchLevelsByLookup(heard, sentAt, { searchMs = 50, minCorrelation = 0.9, minSpeechMs = 20 } = {}) {
+  const peak = heard.reduce((m, h) => Math.max(m, h.rms), 0);
+  if (peak === 0 || heard.filter((h) => h.rms > peak * 0.1).length < minSpeechMs) return null;
+  const n = heard.length;
+  const meanA = heard.reduce((s, h) => s + h.rms, 0) / n;
+  let varA = 0;
+  for (const h of heard) varA += (h.rms - meanA) ** 2;
+  const b = new Float64Array(n);
+  const correlation = (lag) => {
+    let sumB = 0;
+    for (let i = 0; i < n; ++i) {
+      b[i] = sentAt(heard[i].x + lag);
+      sumB += b[i];
+    }
+    const meanB = sumB / n;
+    let cov = 0;
+    let varB = 0;
+    for (let i = 0; i < n; ++i) {
+      cov += (heard[i].rms - meanA) * (b[i] - meanB);
+      varB += (b[i] - meanB) ** 2;
+    }
+    return varB > 0 ? cov / Math.sqrt(varA * varB) : -1;
+  };
+  const scores = [];
+  for (let lag = -searchMs; lag <= searchMs; ++lag) scores.push(correlation(lag));
+  let best = 0;
+  for (let i = 1; i < scores.length; ++i) if (scores[i] > scores[best]) best = i;
+  if (scores[best] < minCorrelation || best === 0 || best === scores.length - 1) return null;
+  const [l, c, r] = [scores[best - 1], scores[best], scores[best + 1]];
+  const curvature = l - 2 * c + r;
+  const step = curvature < 0 ? Math.max(-0.5, Math.min(0.5, (l - r) / (2 * curvature))) : 0;
+  return best - searchMs + step;
+}
+
+// A deterministic generator (xorshift32), for noise the test can repeat.
+function random(seed) {
+  let s = seed >>> 0 || 1;
+  return () => {
+    s ^= s << 13;
+    s ^= s >>> 17;
+    s ^= s << 5;
+    return (s >>> 0) / 2 ** 32;
+  };
+}
+
+test('matchLevels finds the lag a lookup a lag found, on stretched, noisy, lost and cut levels', () => {
+  const rand = random(28);
+  const levels = speech(6000);
+  const sent = new SentLevel();
+  // As the pages get it: 20 ms messages from a running time off the ms grid, coded, out of
+  // order at times, one lost (a gap), one sent twice.
+  const startMs = 5000.123457;
+  const messages = [];
+  for (let k = 0; k < levels.length; k += 20) messages.push(k);
+  for (let k = 0; k + 1 < messages.length; k += 7) [messages[k], messages[k + 1]] = [messages[k + 1], messages[k]];
+  for (const k of messages) {
+    if (k === 1340) continue;
+    sent.add((startMs + k) * 1e6, decodeLevels(encodeLevels(levels.slice(k, k + 20))));
+    if (k === 2000) sent.add((startMs + k) * 1e6, decodeLevels(encodeLevels(levels.slice(k, k + 20))));
+  }
+  let compared = 0;
+  let found = 0;
+  for (let end = 400; end < 5800; end += 40) {
+    // 150 blocks of 1 ms heard, put by a mapping that the stretching moves at one block and
+    // that is off by up to ±140 ms (a lost clock's), on a performance-time grid off the sent.
+    const lag = (rand() - 0.5) * 280;
+    const stretchAt = Math.floor(rand() * 150);
+    const stretch = rand() < 0.5 ? 0 : (rand() - 0.5) * 12;
+    const heard = [];
+    for (let i = 0; i < 150; ++i) {
+      const t = end - 150 + i + 1e-9 * Math.floor(rand() * 1000);
+      const moved = i >= stretchAt ? stretch : 0;
+      const ms = startMs + t + moved;
+      heard.push({ x: ms - lag + 0.37, rms: (sent.at(ms) / 32768) * (1 + 0.1 * (rand() - 0.5)) + 1e-4 * rand() });
+    }
+    for (const searchMs of [50, 150]) {
+      const before = matchLevelsByLookup(heard, (ms) => sent.at(ms), { searchMs });
+      const after = matchLevels(heard, sent, { searchMs });
+      assert.ok(before === after || Math.abs(before - after) <= 1e-9, `window ending ${end}, ±${searchMs}: ${before} then ${after}`);
+      ++compared;
+      if (after !== null) ++found;
+    }
+  }
+  // Both searches, in speech and in silence, found and not.
+  assert.equal(compared, 270);
+assert.ok(found > 50 && found < compared - 50, `${found} found of ${compared}`);
 });
