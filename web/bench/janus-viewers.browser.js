@@ -179,9 +179,11 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
   const browser = await launchChromium();
   const out = { viewers: VIEWERS };
   const lines = [`load average at the start: ${os.loadavg().map((l) => l.toFixed(1)).join(', ')}`];
+  let janus = null;
+  let server = null;
   try {
     // Janus: once with one viewer, once with N.
-    const janus = await startJanus();
+    janus = await startJanus();
     const pageServer = await servePages();
     // Janus's CPU time over the whole (the viewers' sessions set up, the speech relayed) and
     // over the speech alone (the sender's run, in real time).
@@ -207,7 +209,7 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
     out.janus = { one, many, chromium: manyKinds.byKind };
 
     // pfap-web: N sessions, each its own pipeline.
-    const server = run(process.env.PFAP_WEB, ['--port=0', `--web-dir=${webDir}`, `--text=${TEXT}`]);
+    server = run(process.env.PFAP_WEB, ['--port=0', `--web-dir=${webDir}`, `--text=${TEXT}`]);
     const url = await new Promise((resolve, reject) => {
       server.on('exit', (code) => reject(new Error(`pfap-web exited (${code}): ${server.log}`)));
       server.stdout.on('data', () => {
@@ -257,6 +259,13 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
       `load average at the end: ${os.loadavg().map((l) => l.toFixed(1)).join(', ')}`);
   } finally {
     await browser.close();
+    // A run that failed half-way (a page's figures not in time) stops its servers too: their
+    // pipes would keep node waiting for the harness's timeout.
+    if (server) await stop(server);
+    if (janus && janus.exitCode === null && janus.signalCode === null) {
+      await stop(janus);
+      janus.cleanup();
+    }
     for (const line of lines) console.log(line);
     if (process.env.PFAP_BENCH_OUT) writeFileSync(process.env.PFAP_BENCH_OUT, JSON.stringify({ ...out, lines }));
   }
