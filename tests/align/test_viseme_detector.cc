@@ -354,7 +354,8 @@ TEST(VisemeDetector, RatesOutsideTheRangeAreTakenAsTheNearest) {
 
 TEST(VisemeDetector, ModelNumbersAreChecked) {
   EXPECT_GT(VisemeModel::builtin().weights(), 10000u);
-  EXPECT_LT(VisemeModel::builtin().weights(), 40000u);
+  // A small network: 48,949 weights take 0.6 % of a core (docs/align.md), the aim 2 %.
+  EXPECT_LT(VisemeModel::builtin().weights(), 100000u);
   EXPECT_EQ(VisemeModel::from_numbers(std::vector<float>{}), nullptr);
   EXPECT_EQ(VisemeModel::from_numbers(std::vector<float>{2, 13, 8, 4, 2, 2, 15}), nullptr);
   // Kind 2: the means and scales of 13 coefficients, the cepstral prior of 12, the layers.
