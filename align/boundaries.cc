@@ -161,6 +161,18 @@ class Silence {
     return static_cast<double>(rise_start(edge)) * block;
   }
 
+  // Where `sound` ends, in samples, when speech ends with it at the edge `b`: a stop's closure
+  // is silence, so at the last edge into silence within kMaxStopReleaseMs, its release's end.
+  double sound_end(const tts::SpokenPhoneme& sound, long b) const {
+    long end = b;
+    if (is_stop(sound)) {
+      for (long e = b + 1; e < blocks() && e - b <= kMaxStopReleaseMs / 5; ++e) {
+        if (ends_at(e)) end = e;
+      }
+    }
+    return static_cast<double>(end) * static_cast<double>(block_);
+  }
+
  private:
   static constexpr size_t kMinQuietBlocks = kMinSilenceMs / 5;
 
@@ -241,7 +253,7 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
       }
       if (found >= 0) {
         starts[k - 1] = speech_begins ? silence.sound_start(phonemes[k], k == 1, found)
-                                      : static_cast<double>(found) * block;
+                                      : silence.sound_end(phonemes[k - 1], found);
         break;
       }
     }

@@ -58,6 +58,10 @@ inline constexpr float kFloorRangeDb = 90;
 // How long a stop's closure after a pause is taken to be: silence cannot tell; on the Festival
 // kal corpus 40 to 80 ms gave the same first-sound p90, 50 was chosen (docs/align.md).
 inline constexpr unsigned kStopClosureMs = 50;
+// A stop before a pause ends where its release ends: at the last edge into silence at most this
+// long after the edge where its closure begins (its closure 25..75 ms on slt, then a burst).
+// Chosen on kal (docs/align.md).
+inline constexpr unsigned kMaxStopReleaseMs = 100;
 
 // A weak onset (/f/, /h/, /dh/) rises out of silence more slowly than a vowel, for tens of ms
 // below the silence threshold: an onset starts where it first rises kOnsetRiseDb above the
@@ -86,7 +90,8 @@ inline constexpr unsigned kMaxHumMs = 300;
 // kFloorRangeDb of the loudest: digital silence (zeros before or after the speech, however
 // long) has no level to be a floor. A stop (p t k b d g ch jh) out of a pause starts
 // kStopClosureMs before the edge: its closure is silent, the edge its release, and phonetic
-// labels (and the lips) start it at its closure. The first sound starts after any hum
+// labels (and the lips) start it at its closure; one into a pause ends where its release ends
+// (kMaxStopReleaseMs), not at its closure. The first sound starts after any hum
 // (kHumBelowLoudestDb); when the warp puts it in silence with no edge within the radius (live,
 // at a hum that the speech heard since makes silence), at the next edge within kMaxHumMs. An
 // onset starts where it rises out of the silence (kOnsetRiseDb).

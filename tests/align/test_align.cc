@@ -436,6 +436,32 @@ TEST(Boundaries, StopOutOfAPauseStartsAtItsClosure) {
   }
 }
 
+TEST(Boundaries, StopBeforeAPauseEndsWhereItsReleaseEnds) {
+  // A vowel, a stop's 50 ms closure (silence), its 20 ms release, then silence: a stop ends
+  // at its release's end, other sounds where their sound ends.
+  constexpr unsigned kRate = 16000;
+  std::vector<int16_t> audio(kRate / 2, 0);
+  const std::vector<int16_t> vowel = tone(200, 0.5, kRate), burst = tone(3000, 0.02, kRate);
+  audio.insert(audio.end(), vowel.begin(), vowel.end());
+  const double closure = static_cast<double>(audio.size());
+  audio.resize(audio.size() + kRate / 20, 0);
+  audio.insert(audio.end(), burst.begin(), burst.end());
+  const double release_end = static_cast<double>(audio.size());
+  audio.resize(audio.size() + kRate / 2, 0);
+  const PhonemeAlphabet& arpabet = *find_alphabet(kArpabetAlphabet);
+  const struct {
+    const char* name;
+    bool stop;
+  } kCases[] = {{"T", true}, {"K", true}, {"AA", false}, {"N", false}};
+  for (const auto& [name, stop] : kCases) {
+    SCOPED_TRACE(name);
+    std::vector<double> starts = {closure + 0.01 * kRate};  // the warp's: in the closure
+    snap_to_silence({phoneme_at(*find_symbol(arpabet, name), 0), phoneme_at(0, 1)}, audio, kRate,
+                    starts);
+    EXPECT_DOUBLE_EQ(starts[0], stop ? release_end : closure);
+  }
+}
+
 TEST(Aligner, KeepsWordStartsStressAndBookmarks) {
   const std::string text = "Hello <FAP 4 1 0 1> world.";
   const tts::Speech truth = phonetic_truth(text, {"en", 140, 30, 100});
