@@ -60,7 +60,7 @@ inline constexpr float kFloorRangeDb = 90;
 inline constexpr unsigned kStopClosureMs = 50;
 // A stop before a pause ends where its release ends: at the last edge into silence at most this
 // long after the edge where its closure begins (its closure 25..75 ms on slt, then a burst).
-// Chosen on kal (docs/align.md).
+// The one bound tried, measured on kal, ked and slt (docs/align.md).
 inline constexpr unsigned kMaxStopReleaseMs = 100;
 
 // A weak onset (/f/, /h/, /dh/) rises out of silence more slowly than a vowel, for tens of ms
