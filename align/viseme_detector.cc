@@ -66,7 +66,8 @@ void VisemeModel::probabilities(std::span<const float> context, std::span<float>
   const float* scale = p + kVisemeMfccs;
   p += kNormalization;
   const size_t inputs = this->inputs();
-  std::vector<float> x(inputs);
+  // On the stack, as large as any model's inputs: no allocation a frame.
+  std::array<float, (kMaxVisemePastFrames + 1 + kVisemeAheadFrames) * kVisemeMfccs> x;
   for (size_t i = 0; i < inputs; ++i) {
     x[i] = (context[i] - mean[i % kVisemeMfccs]) * scale[i % kVisemeMfccs];
   }

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // A frame-level viseme detector for live audio without a text: the 15 Oculus visemes (the
 // MPEG-4 visemes with silence, pfap::Viseme) of each 10 ms frame, from MFCCs with the model's
-// past (80 ms in today's) and 40 ms ahead through a small network (align/viseme_model.txt,
+// past (160 ms in today's) and 40 ms ahead through a small network (align/viseme_model.txt,
 // made by tools/viseme-train), smoothed into runs. Live: push audio as it comes, take the runs
 // that are settled; each needs at most kVisemeLookaheadMs of audio after its frames. No
 // GStreamer; web/src/viseme_detector.js is the same in JavaScript. docs/align.md, "A viseme

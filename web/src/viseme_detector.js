@@ -2,7 +2,7 @@
 // The frame-level viseme detector of align/viseme_detector.{h,cc} in JavaScript, step by
 // step the same (tests/web checks that both give the same visemes on the same audio): any
 // rate resampled to 16 kHz, 13 MFCCs of a 25 ms window every 10 ms, c1..c12 less their
-// running mean over the stream, a small network over the model's frames before (8 in today's) and 4 after
+// running mean over the stream, a small network over the model's frames before (16 in today's) and 4 after
 // (align/viseme_model.txt), smoothed into runs of the 15 Oculus visemes. At most 60 ms of audio ahead. docs/align.md, "A viseme detector".
 
 /** The alphabet of the detector's phonemes: symbol k is Oculus viseme k (= MPEG-4 viseme k). */
