@@ -20,8 +20,9 @@
 
 namespace pfap::tts::wire {
 
-// A request's most bytes: a piece's text is far shorter, and an AF_UNIX datagram must fit in
-// the socket's default send buffer (212992 bytes).
+// A request's most bytes: pfaptts's pieces and pfapalign's longest text (24,200 code points,
+// under 97 KB) are shorter, and an AF_UNIX datagram must fit in the socket's default send
+// buffer (212992 bytes).
 inline constexpr size_t kMaxRequest = 128 * 1024;
 
 // The file descriptor of pfap-espeak's end of the socket.
