@@ -7,7 +7,6 @@
 // receiver's synchronization source say roughly which running time is heard, the played
 // level found in the level the sender sent (clock.js) says exactly, and between matches the
 // jitter buffer's stretching and the concealment that delays the audio (getStats) are followed.
-import { poseFromFaps, renderFace } from '../src/index.js';
 import { SentLevel, matchLevels } from './clock.js';
 
 // The value of `history` ([from, value], in order) at heard time t.
@@ -330,19 +329,14 @@ export class DrawnPhonemes {
  */
 export function drawInTime({ receiver, canvas, stats, streamNs, drawn }) {
   const ctx = canvas.getContext('2d');
-  let drawnFaps = null;  // the FAPs of the face on the canvas
   const frame = (now) => {
     const ns = streamNs(now);
     if (ns !== null) {
       stats.streamNs = ns;
       stats.endNs = receiver.animator.endNs;
-      // The face is drawn again only where it changed (receiver.draw draws the same): in the
-      // pauses and after the speech nothing is drawn, and Chromium composites nothing new.
-      const faps = receiver.faps(ns);
-      if (drawnFaps === null || faps.some((v, i) => v !== drawnFaps[i])) {
-        renderFace(ctx, poseFromFaps(faps), { style: 'cartoon' });
-        drawnFaps = faps;
-      }
+      // The face is drawn again only where it changed (PfapReceiver.draw): in the pauses and
+      // after the speech nothing is drawn, and Chromium composites nothing new.
+      receiver.draw(ctx, ns, { style: 'cartoon' });
       drawn.frame(now, ns);
     }
     requestAnimationFrame(frame);
