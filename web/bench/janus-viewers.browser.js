@@ -18,7 +18,8 @@ import { test } from 'node:test';
 import { fileURLToPath } from 'node:url';
 
 import {
-  cpuSeconds, exited, figures, launchChromium, newPage, openViewer, run, servePages, startJanus, startSender, stop,
+  cpuSeconds, exited, figures, launchChromium, newPage, openViewer, procStat, run, servePages, startJanus, startSender,
+  stop,
 } from '../test/janus.js';
 
 const webDir = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
@@ -62,7 +63,7 @@ function chromiumKinds() {
   const kind = {};
   for (const pid of readdirSync('/proc').filter((d) => /^\d+$/.test(d))) {
     try {
-      parent[pid] = readFileSync(`/proc/${pid}/stat`, 'utf8').split(') ')[1].split(' ')[1];
+      parent[pid] = procStat(`/proc/${pid}/stat`).ppid;
       // Chromium rewrites its processes' titles: the arguments, space separated.
       const args = readFileSync(`/proc/${pid}/cmdline`, 'utf8').split(/[\0 ]/);
       if (!/chrom/.test(args[0])) continue;
@@ -84,10 +85,8 @@ function chromiumKinds() {
 function threadSeconds(pid) {
   const threads = {};
   for (const tid of readdirSync(`/proc/${pid}/task`)) {
-    const stat = readFileSync(`/proc/${pid}/task/${tid}/stat`, 'utf8');
-    const name = stat.slice(stat.indexOf('(') + 1, stat.lastIndexOf(')')).replace(/\d+/g, '');
-    const fields = stat.slice(stat.lastIndexOf(')') + 2).split(' ');
-    threads[tid] = { name, cpu: (Number(fields[11]) + Number(fields[12])) / 100 };
+    const { name, cpu } = procStat(`/proc/${pid}/task/${tid}/stat`);
+    threads[tid] = { name: name.replace(/\d+/g, ''), cpu };
   }
   return threads;
 }

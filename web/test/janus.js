@@ -53,10 +53,25 @@ export function exited(child) {
   return new Promise((resolve) => (child.exitCode !== null ? resolve(child.exitCode) : child.once('exit', resolve)));
 }
 
+/**
+ * A process's or thread's `stat` file (`/proc/PID/stat`, `/proc/PID/task/TID/stat`): its name,
+ * its parent's pid and the CPU time (user and system, s) it has used. The name is between
+ * parentheses and may hold any character, ") " and digits included: the fields follow the last ")".
+ */
+export function procStat(file) {
+  const stat = readFileSync(file, 'utf8');
+  const close = stat.lastIndexOf(')');
+  const fields = stat.slice(close + 2).split(' ');  // from the state, the third field
+  return {
+    name: stat.slice(stat.indexOf('(') + 1, close),
+    ppid: fields[1],
+    cpu: (Number(fields[11]) + Number(fields[12])) / 100,  // utime, stime in clock ticks (USER_HZ 100)
+  };
+}
+
 /** CPU time (user and system, s) that process `pid` has used. */
 export function cpuSeconds(pid) {
-  const fields = readFileSync(`/proc/${pid}/stat`, 'utf8').split(') ')[1].split(' ');
-  return (Number(fields[11]) + Number(fields[12])) / 100;  // utime, stime in clock ticks (USER_HZ 100)
+  return procStat(`/proc/${pid}/stat`).cpu;
 }
 
 // The sockets of process `pid` by inode: 'tcp ESTABLISHED' and the like, 'udp', 'unix', 'netlink'.
