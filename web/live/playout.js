@@ -25,6 +25,10 @@ const FIRST_SOUND_RMS = 100;
 const FIRST_SOUND_QUIET_MS = 100;
 // The audio's packet duration (the senders' Opus frames): what NetEq conceals for a lost packet.
 const PACKET_S = 0.02;
+// How much better than the peak the clock is on another lag must score for a match to move
+// the clock there (matchLevels' holdMargin): above the near ties of a voiced level's pitch
+// periods seen in pages (0.001 to 0.014), below what a real move scored (0.13 and more).
+const HOLD_MARGIN = 0.03;
 // Silent concealment for longer than this, with no audio decoded, is the audio's end, not a stall.
 const SILENT_END_MS = 500;
 
@@ -277,7 +281,10 @@ export class PlayoutClock {
       heard.push({ x: env[i].t + this.searchMappingAt(env[i].t), rms: env[i].rms });
     }
     const searchMs = !this.matched ? this.firstSearchMs : this.misses >= 30 ? this.lostSearchMs : this.searchMs;
-    const lag = matchLevels(heard.reverse(), this.sent, { searchMs });
+    // A clock that has matched and is not lost stays on its peak unless another is clearly
+    // better: not one pitch period off on a near tie (matchLevels).
+    const holdMargin = this.matched && this.misses < 30 ? HOLD_MARGIN : 0;
+    const lag = matchLevels(heard.reverse(), this.sent, { searchMs, holdMargin });
     if (lag === null) {
       const peak = heard.reduce((m, h) => Math.max(m, h.rms), 0);
       if (this.matched && peak > 1e-3 && heard.filter((h) => h.rms > peak * 0.1).length >= 20) ++this.misses;
