@@ -49,9 +49,9 @@ async function measured(pid, during) {
   let last = start;
   const poll = setInterval(() => { try { last = cpuSeconds(pid); } catch { /* ended */ } }, 200);
   const t0 = performance.now();
-  const result = await during();
+  // A run that fails half-way stops reading too: the interval would keep node running.
+  const result = await during().finally(() => clearInterval(poll));
   const wall = (performance.now() - t0) / 1000;
-  clearInterval(poll);
   try { last = cpuSeconds(pid); } catch { /* ended */ }
   return { cpu: last - start, wall, result };
 }
@@ -115,8 +115,7 @@ async function chromiumCpu(during) {
   read();
   const poll = setInterval(read, 200);
   const t0 = performance.now();
-  const result = await during();
-  clearInterval(poll);
+  const result = await during().finally(() => clearInterval(poll));
   const wall = (performance.now() - t0) / 1000;
   const byKind = {};
   for (const [id, k] of Object.entries(kinds)) {
@@ -206,6 +205,33 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
     out.janusLog = `${janus.out}${janus.log}`.slice(-20000);  // its warnings, for the figures file
     const whole = (sent) => (s) => s.phonemes === sent.phonemes && s.fapStateMatchesSender && s.streams === 1;
     out.janus = { one, many, chromium: manyKinds.byKind };
+    const ms = (seconds) => `${(1000 * seconds).toFixed(1)} ms`;
+    const janusPerViewer = (many.cpu - one.cpu) / (VIEWERS - 1);
+    const relayPerViewer = (many.speech.cpu - one.speech.cpu) / (VIEWERS - 1);
+    // pfap-web's pages never pair a stream's first onset (its audio starts with the speech, so
+    // no measured silence comes before it); the Janus viewers hear silence before the sender
+    // starts, and pair it. Both are printed: every onset, and all but the first.
+    const summary = (label, pages, from) => {
+      const e = pages.flatMap((s) => s.lipSyncErrorsMs.slice(from));
+      const p95s = pages.map((s) => percentile(s.lipSyncErrorsMs.slice(from).map(Math.abs), 0.95));
+      const within = p95s.filter((p) => p <= 20).length;
+      return `${label}: ${e.length} onsets paired, min ${fixed(Math.min(...e))}, median ${fixed(percentile(e, 0.5))}, ` +
+        `max ${fixed(Math.max(...e))} ms, |error| p95 ${fixed(percentile(e.map(Math.abs), 0.95))} ms, worst page's p95 ` +
+        `${fixed(Math.max(...p95s))} ms, pages with p95 <= 20 ms: ${within} of ${pages.length}`;
+    };
+    // The Janus half's figures first: they stand even if the pfap-web half fails.
+    lines.push(
+      `the text: ${one.speech.wall.toFixed(1)} s of speech (the sender's run), ${one.sent.packets} PFAP packets; ` +
+        `with ${VIEWERS} viewers the sender's run took ${many.speech.wall.toFixed(1)} s`,
+      `Janus, 1 viewer: ${ms(one.cpu)} of CPU in all, ${ms(one.speech.cpu)} during the speech`,
+      `Janus, ${VIEWERS} viewers: ${ms(many.cpu)} of CPU in all, ${ms(many.speech.cpu)} during the speech ` +
+        `(${(100 * many.speech.cpu / many.speech.wall).toFixed(2)} % of a core)`,
+      `Janus per added viewer: ${ms(janusPerViewer)} in all (session set up and the text relayed), ` +
+        `${ms(relayPerViewer)} during the speech`,
+      kindRow(`Janus, ${VIEWERS} viewers`, manyKinds),
+      ...pageRows('Janus viewer', many.all, whole(many.sent)),
+      summary('Janus, every onset', many.all, 0), summary('Janus, the first onset left out', many.all, 1),
+    );
 
     // pfap-web: N sessions, each its own pipeline.
     server = run(process.env.PFAP_WEB, ['--port=0', `--web-dir=${webDir}`, `--text=${TEXT}`]);
@@ -224,37 +250,14 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
     await stop(server);
     out.pfapWeb = { ...web, chromium: webKinds.byKind };
 
-    const ms = (seconds) => `${(1000 * seconds).toFixed(1)} ms`;
-    const janusPerViewer = (many.cpu - one.cpu) / (VIEWERS - 1);
-    const relayPerViewer = (many.speech.cpu - one.speech.cpu) / (VIEWERS - 1);
     const webPerViewer = web.cpu / VIEWERS;
     lines.push(
-      `the text: ${one.speech.wall.toFixed(1)} s of speech (the sender's run), ${one.sent.packets} PFAP packets`,
-      `Janus, 1 viewer: ${ms(one.cpu)} of CPU in all, ${ms(one.speech.cpu)} during the speech`,
-      `Janus, ${VIEWERS} viewers: ${ms(many.cpu)} of CPU in all, ${ms(many.speech.cpu)} during the speech ` +
-        `(${(100 * many.speech.cpu / many.speech.wall).toFixed(2)} % of a core)`,
-      `Janus per added viewer: ${ms(janusPerViewer)} in all (session set up and the text relayed), ` +
-        `${ms(relayPerViewer)} during the speech`,
       `pfap-web, ${VIEWERS} sessions: ${ms(web.cpu)} of CPU in all, ${ms(webPerViewer)} per session (set up, the text spoken and sent)`,
       `pfap-web per session / Janus per added viewer: ${(webPerViewer / janusPerViewer).toFixed(1)}`,
-      kindRow(`Janus, ${VIEWERS} viewers`, manyKinds),
       kindRow(`pfap-web, ${VIEWERS} pages`, webKinds),
-      ...pageRows('Janus viewer', many.all, whole(many.sent)),
       ...pageRows('pfap-web page', web.result, (s) => s.phonemes === s.sender.phonemes && s.fapStateMatchesSender),
     );
-    // pfap-web's pages never pair a stream's first onset (its audio starts with the speech, so
-    // no measured silence comes before it); the Janus viewers hear silence before the sender
-    // starts, and pair it. Both are printed: every onset, and all but the first.
-    const summary = (label, pages, from) => {
-      const e = pages.flatMap((s) => s.lipSyncErrorsMs.slice(from));
-      const p95s = pages.map((s) => percentile(s.lipSyncErrorsMs.slice(from).map(Math.abs), 0.95));
-      const within = p95s.filter((p) => p <= 20).length;
-      return `${label}: ${e.length} onsets paired, min ${fixed(Math.min(...e))}, median ${fixed(percentile(e, 0.5))}, ` +
-        `max ${fixed(Math.max(...e))} ms, |error| p95 ${fixed(percentile(e.map(Math.abs), 0.95))} ms, worst page's p95 ` +
-        `${fixed(Math.max(...p95s))} ms, pages with p95 <= 20 ms: ${within} of ${pages.length}`;
-    };
-    lines.push(summary('Janus, every onset', many.all, 0), summary('Janus, the first onset left out', many.all, 1),
-      summary('pfap-web, every onset', web.result, 0),
+    lines.push(summary('pfap-web, every onset', web.result, 0),
       `load average at the end: ${os.loadavg().map((l) => l.toFixed(1)).join(', ')}`);
   } finally {
     await browser.close();
