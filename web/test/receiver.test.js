@@ -117,13 +117,19 @@ test('a new SSRC is a new stream: uncertain, asking for a complete state, until 
   assert.equal(requests.length, 2);
 });
 
-test('the face takes each event when its time comes, not when its packet does', () => {
+// A receiver given a complete state, then AA from 0 to 100 ms and M with a smile from 100 ms,
+// both packets at once, ahead of their time, as a sender with a delay sends them.
+function smileAfterAa() {
   const receiver = new PfapReceiver();
   const rtp = (seq, timestamp, payload) => makeRtp({ payloadType: 96, sequenceNumber: seq, timestamp, ssrc: 5, payload });
   receiver.receive(rtp(1, 0, encodePayload({ complete: true, coverage: 0, recovery: [], phonemes: [] })));
-  // Both packets come at once, ahead of their time, as a sender with a delay sends them.
-  receiver.receive(rtp(2, 0, phonemePacket(1)));  // AA from 0 to 100 ms
-  receiver.receive(rtp(3, 4410, phonemePacket(22, [{ index: 12, amplitude: 300, transition: 0, curve: 1 }])));  // M from 100 ms
+  receiver.receive(rtp(2, 0, phonemePacket(1)));
+  receiver.receive(rtp(3, 4410, phonemePacket(22, [{ index: 12, amplitude: 300, transition: 0, curve: 1 }])));
+  return receiver;
+}
+
+test('the face takes each event when its time comes, not when its packet does', () => {
+  const receiver = smileAfterAa();
   assert.equal(receiver.faps(50_000_000)[12], 0, 'the smile is not there before its phoneme');
   assert.equal(receiver.animator.describe(50_000_000), 'AA');
   assert.equal(receiver.faps(150_000_000)[12], 300);
@@ -131,11 +137,7 @@ test('the face takes each event when its time comes, not when its packet does', 
 });
 
 test('draw() draws where the face would differ from the canvas, and the canvas always shows the face', () => {
-  const receiver = new PfapReceiver();
-  const rtp = (seq, timestamp, payload) => makeRtp({ payloadType: 96, sequenceNumber: seq, timestamp, ssrc: 5, payload });
-  receiver.receive(rtp(1, 0, encodePayload({ complete: true, coverage: 0, recovery: [], phonemes: [] })));
-  receiver.receive(rtp(2, 0, phonemePacket(1)));  // AA from 0 to 100 ms
-  receiver.receive(rtp(3, 4410, phonemePacket(22, [{ index: 12, amplitude: 300, transition: 0, curve: 1 }])));  // M from 100 ms
+  const receiver = smileAfterAa();
   const canvas = createCanvas(64, 48);
   const ctx = canvas.getContext('2d');
   // What the canvas holds is the face at timeNs, as renderFace draws it on a fresh canvas.
