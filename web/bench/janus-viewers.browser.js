@@ -24,6 +24,8 @@ import {
 
 const webDir = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const VIEWERS = Number(process.env.PFAP_VIEWERS ?? 20);
+// How long a page may take to load: at N = 20 on this machine one took over 30 s (playwright's default).
+const LOAD_TIMEOUT_MS = 120000;
 // As pfap-web's browser test measures lip sync: sharp onsets after silence.
 const TEXT = 'pa. pa. pa. pa. pa. pa. pa. pa. pa. pa.';
 
@@ -187,7 +189,7 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
     // over the speech alone (the sender's run, in real time).
     const broadcast = async (count) => {
       const whole = await measured(janus.pid, async () => {
-        const pages = await inBatches(count, 5, () => openViewer(browser, pageServer, janus));
+        const pages = await inBatches(count, 5, () => openViewer(browser, pageServer, janus, { timeout: LOAD_TIMEOUT_MS }));
         const sender = startSender(TEXT);
         const { result: speech, lines: profile } = await profiled(pages[0], () => measured(janus.pid, () => exited(sender)));
         lines.push(...profile);
@@ -243,7 +245,7 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
       });
     });
     const webKinds = await chromiumCpu(() => measured(server.pid, async () => {
-      const pages = await inBatches(VIEWERS, 5, () => newPage(browser, url));
+      const pages = await inBatches(VIEWERS, 5, () => newPage(browser, url, { timeout: LOAD_TIMEOUT_MS }));
       return Promise.all(pages.map((p) => figures(p, { timeout: 120000 })));
     }));
     const web = webKinds.result;

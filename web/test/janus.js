@@ -192,28 +192,31 @@ export function launchChromium() {
   });
 }
 
-/** Opens `url` in a new page of `browser`, its console and failed loads kept in `.messages`. */
-export async function newPage(browser, url) {
+/**
+ * Opens `url` in a new page of `browser`, its console and failed loads kept in `.messages`;
+ * `timeout` bounds the load (ms; playwright's 30 s by default).
+ */
+export async function newPage(browser, url, { timeout } = {}) {
   const page = await browser.newPage({ viewport: { width: 640, height: 720 } });
   const messages = [];
   page.on('console', (m) => messages.push(m.text()));
   page.on('response', (r) => r.status() >= 400 && messages.push(`${r.status()} ${r.url()}`));
   page.messages = messages;
-  await page.goto(url);
+  await page.goto(url, { timeout });
   return page;
 }
 
 /** Resolves once the viewer page receives the mountpoint's data stream. */
-export async function watching(page, janus) {
-  await page.waitForFunction(() => window.pfapStats?.dataOpen, null, { timeout: 30000, polling: 100 })
+export async function watching(page, janus, { timeout = 30000 } = {}) {
+  await page.waitForFunction(() => window.pfapStats?.dataOpen, null, { timeout, polling: 100 })
     .catch((e) => { throw new Error(`${e.message}\npage: ${page.messages.join('\n')}\njanus: ${janus.out}${janus.log}`); });
 }
 
-/** Opens a viewer page; resolves once it receives the mountpoint's data stream. */
-export async function openViewer(browser, pageServer, janus) {
+/** Opens a viewer page; resolves once it receives the mountpoint's data stream (`timeout` bounds each, ms). */
+export async function openViewer(browser, pageServer, janus, options = {}) {
   const { port } = pageServer.address();
-  const page = await newPage(browser, `http://127.0.0.1:${port}/broadcast/?janus=http://127.0.0.1:${JANUS_PORT}/janus`);
-  await watching(page, janus);
+  const page = await newPage(browser, `http://127.0.0.1:${port}/broadcast/?janus=http://127.0.0.1:${JANUS_PORT}/janus`, options);
+  await watching(page, janus, options);
   return page;
 }
 
