@@ -180,11 +180,12 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
   const out = { viewers: VIEWERS };
   const lines = [`load average at the start: ${os.loadavg().map((l) => l.toFixed(1)).join(', ')}`];
   let janus = null;
+  let pageServer = null;
   let server = null;
   try {
     // Janus: once with one viewer, once with N.
     janus = await startJanus();
-    const pageServer = await servePages();
+    pageServer = await servePages();
     // Janus's CPU time over the whole (the viewers' sessions set up, the speech relayed) and
     // over the speech alone (the sender's run, in real time).
     const broadcast = async (count) => {
@@ -201,7 +202,6 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
     const one = await broadcast(1);
     const manyKinds = await chromiumCpu(() => broadcast(VIEWERS));
     const many = manyKinds.result;
-    pageServer.close();
     await stop(janus);
     janus.cleanup();
     out.janusLog = `${janus.out}${janus.log}`.slice(-20000);  // its warnings, for the figures file
@@ -264,7 +264,8 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
   } finally {
     await browser.close();
     // A run that failed half-way (a page's figures not in time) stops its servers too: their
-    // pipes would keep node waiting for the harness's timeout.
+    // pipes and the pages' server would keep node waiting for the harness's timeout.
+    pageServer?.close();
     if (server) await stop(server);
     if (janus && janus.exitCode === null && janus.signalCode === null) {
       await stop(janus);
