@@ -18,11 +18,14 @@ import { test } from 'node:test';
 import { fileURLToPath } from 'node:url';
 
 import {
-  cpuSeconds, exited, figures, launchChromium, newPage, openViewer, run, servePages, startJanus, startSender, stop,
+  cpuSeconds, exited, figures, launchChromium, newPage, openViewer, procStat, run, servePages, startJanus, startSender,
+  stop,
 } from '../test/janus.js';
 
 const webDir = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..');
 const VIEWERS = Number(process.env.PFAP_VIEWERS ?? 20);
+// How long a page may take to load: at N = 20 on this machine one took over 30 s (playwright's default).
+const LOAD_TIMEOUT_MS = 120000;
 // As pfap-web's browser test measures lip sync: sharp onsets after silence.
 const TEXT = 'pa. pa. pa. pa. pa. pa. pa. pa. pa. pa.';
 
@@ -48,9 +51,9 @@ async function measured(pid, during) {
   let last = start;
   const poll = setInterval(() => { try { last = cpuSeconds(pid); } catch { /* ended */ } }, 200);
   const t0 = performance.now();
-  const result = await during();
+  // A run that fails half-way stops reading too: the interval would keep node running.
+  const result = await during().finally(() => clearInterval(poll));
   const wall = (performance.now() - t0) / 1000;
-  clearInterval(poll);
   try { last = cpuSeconds(pid); } catch { /* ended */ }
   return { cpu: last - start, wall, result };
 }
@@ -62,7 +65,7 @@ function chromiumKinds() {
   const kind = {};
   for (const pid of readdirSync('/proc').filter((d) => /^\d+$/.test(d))) {
     try {
-      parent[pid] = readFileSync(`/proc/${pid}/stat`, 'utf8').split(') ')[1].split(' ')[1];
+      parent[pid] = procStat(`/proc/${pid}/stat`).ppid;
       // Chromium rewrites its processes' titles: the arguments, space separated.
       const args = readFileSync(`/proc/${pid}/cmdline`, 'utf8').split(/[\0 ]/);
       if (!/chrom/.test(args[0])) continue;
@@ -84,10 +87,8 @@ function chromiumKinds() {
 function threadSeconds(pid) {
   const threads = {};
   for (const tid of readdirSync(`/proc/${pid}/task`)) {
-    const stat = readFileSync(`/proc/${pid}/task/${tid}/stat`, 'utf8');
-    const name = stat.slice(stat.indexOf('(') + 1, stat.lastIndexOf(')')).replace(/\d+/g, '');
-    const fields = stat.slice(stat.lastIndexOf(')') + 2).split(' ');
-    threads[tid] = { name, cpu: (Number(fields[11]) + Number(fields[12])) / 100 };
+    const { name, cpu } = procStat(`/proc/${pid}/task/${tid}/stat`);
+    threads[tid] = { name: name.replace(/\d+/g, ''), cpu };
   }
   return threads;
 }
@@ -116,8 +117,7 @@ async function chromiumCpu(during) {
   read();
   const poll = setInterval(read, 200);
   const t0 = performance.now();
-  const result = await during();
-  clearInterval(poll);
+  const result = await during().finally(() => clearInterval(poll));
   const wall = (performance.now() - t0) / 1000;
   const byKind = {};
   for (const [id, k] of Object.entries(kinds)) {
@@ -180,16 +180,17 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
   const out = { viewers: VIEWERS };
   const lines = [`load average at the start: ${os.loadavg().map((l) => l.toFixed(1)).join(', ')}`];
   let janus = null;
+  let pageServer = null;
   let server = null;
   try {
     // Janus: once with one viewer, once with N.
     janus = await startJanus();
-    const pageServer = await servePages();
+    pageServer = await servePages();
     // Janus's CPU time over the whole (the viewers' sessions set up, the speech relayed) and
     // over the speech alone (the sender's run, in real time).
     const broadcast = async (count) => {
       const whole = await measured(janus.pid, async () => {
-        const pages = await inBatches(count, 5, () => openViewer(browser, pageServer, janus));
+        const pages = await inBatches(count, 5, () => openViewer(browser, pageServer, janus, { timeout: LOAD_TIMEOUT_MS }));
         const sender = startSender(TEXT);
         const { result: speech, lines: profile } = await profiled(pages[0], () => measured(janus.pid, () => exited(sender)));
         lines.push(...profile);
@@ -201,48 +202,14 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
     const one = await broadcast(1);
     const manyKinds = await chromiumCpu(() => broadcast(VIEWERS));
     const many = manyKinds.result;
-    pageServer.close();
     await stop(janus);
     janus.cleanup();
     out.janusLog = `${janus.out}${janus.log}`.slice(-20000);  // its warnings, for the figures file
     const whole = (sent) => (s) => s.phonemes === sent.phonemes && s.fapStateMatchesSender && s.streams === 1;
     out.janus = { one, many, chromium: manyKinds.byKind };
-
-    // pfap-web: N sessions, each its own pipeline.
-    server = run(process.env.PFAP_WEB, ['--port=0', `--web-dir=${webDir}`, `--text=${TEXT}`]);
-    const url = await new Promise((resolve, reject) => {
-      server.on('exit', (code) => reject(new Error(`pfap-web exited (${code}): ${server.log}`)));
-      server.stdout.on('data', () => {
-        const m = /open (http:\S+)/.exec(server.out);
-        if (m) resolve(m[1]);
-      });
-    });
-    const webKinds = await chromiumCpu(() => measured(server.pid, async () => {
-      const pages = await inBatches(VIEWERS, 5, () => newPage(browser, url));
-      return Promise.all(pages.map((p) => figures(p, { timeout: 120000 })));
-    }));
-    const web = webKinds.result;
-    await stop(server);
-    out.pfapWeb = { ...web, chromium: webKinds.byKind };
-
     const ms = (seconds) => `${(1000 * seconds).toFixed(1)} ms`;
     const janusPerViewer = (many.cpu - one.cpu) / (VIEWERS - 1);
     const relayPerViewer = (many.speech.cpu - one.speech.cpu) / (VIEWERS - 1);
-    const webPerViewer = web.cpu / VIEWERS;
-    lines.push(
-      `the text: ${one.speech.wall.toFixed(1)} s of speech (the sender's run), ${one.sent.packets} PFAP packets`,
-      `Janus, 1 viewer: ${ms(one.cpu)} of CPU in all, ${ms(one.speech.cpu)} during the speech`,
-      `Janus, ${VIEWERS} viewers: ${ms(many.cpu)} of CPU in all, ${ms(many.speech.cpu)} during the speech ` +
-        `(${(100 * many.speech.cpu / many.speech.wall).toFixed(2)} % of a core)`,
-      `Janus per added viewer: ${ms(janusPerViewer)} in all (session set up and the text relayed), ` +
-        `${ms(relayPerViewer)} during the speech`,
-      `pfap-web, ${VIEWERS} sessions: ${ms(web.cpu)} of CPU in all, ${ms(webPerViewer)} per session (set up, the text spoken and sent)`,
-      `pfap-web per session / Janus per added viewer: ${(webPerViewer / janusPerViewer).toFixed(1)}`,
-      kindRow(`Janus, ${VIEWERS} viewers`, manyKinds),
-      kindRow(`pfap-web, ${VIEWERS} pages`, webKinds),
-      ...pageRows('Janus viewer', many.all, whole(many.sent)),
-      ...pageRows('pfap-web page', web.result, (s) => s.phonemes === s.sender.phonemes && s.fapStateMatchesSender),
-    );
     // pfap-web's pages never pair a stream's first onset (its audio starts with the speech, so
     // no measured silence comes before it); the Janus viewers hear silence before the sender
     // starts, and pair it. Both are printed: every onset, and all but the first.
@@ -254,13 +221,51 @@ test(`${VIEWERS} viewers through Janus beside ${VIEWERS} pfap-web sessions`, { t
         `max ${fixed(Math.max(...e))} ms, |error| p95 ${fixed(percentile(e.map(Math.abs), 0.95))} ms, worst page's p95 ` +
         `${fixed(Math.max(...p95s))} ms, pages with p95 <= 20 ms: ${within} of ${pages.length}`;
     };
-    lines.push(summary('Janus, every onset', many.all, 0), summary('Janus, the first onset left out', many.all, 1),
-      summary('pfap-web, every onset', web.result, 0),
+    // The Janus half's figures first: they stand even if the pfap-web half fails.
+    lines.push(
+      `the text: ${one.speech.wall.toFixed(1)} s of speech (the sender's run), ${one.sent.packets} PFAP packets; ` +
+        `with ${VIEWERS} viewers the sender's run took ${many.speech.wall.toFixed(1)} s`,
+      `Janus, 1 viewer: ${ms(one.cpu)} of CPU in all, ${ms(one.speech.cpu)} during the speech`,
+      `Janus, ${VIEWERS} viewers: ${ms(many.cpu)} of CPU in all, ${ms(many.speech.cpu)} during the speech ` +
+        `(${(100 * many.speech.cpu / many.speech.wall).toFixed(2)} % of a core)`,
+      `Janus per added viewer: ${ms(janusPerViewer)} in all (session set up and the text relayed), ` +
+        `${ms(relayPerViewer)} during the speech`,
+      kindRow(`Janus, ${VIEWERS} viewers`, manyKinds),
+      ...pageRows('Janus viewer', many.all, whole(many.sent)),
+      summary('Janus, every onset', many.all, 0), summary('Janus, the first onset left out', many.all, 1),
+    );
+
+    // pfap-web: N sessions, each its own pipeline.
+    server = run(process.env.PFAP_WEB, ['--port=0', `--web-dir=${webDir}`, `--text=${TEXT}`]);
+    const url = await new Promise((resolve, reject) => {
+      server.on('exit', (code) => reject(new Error(`pfap-web exited (${code}): ${server.log}`)));
+      server.stdout.on('data', () => {
+        const m = /open (http:\S+)/.exec(server.out);
+        if (m) resolve(m[1]);
+      });
+    });
+    const webKinds = await chromiumCpu(() => measured(server.pid, async () => {
+      const pages = await inBatches(VIEWERS, 5, () => newPage(browser, url, { timeout: LOAD_TIMEOUT_MS }));
+      return Promise.all(pages.map((p) => figures(p, { timeout: 120000 })));
+    }));
+    const web = webKinds.result;
+    await stop(server);
+    out.pfapWeb = { ...web, chromium: webKinds.byKind };
+
+    const webPerViewer = web.cpu / VIEWERS;
+    lines.push(
+      `pfap-web, ${VIEWERS} sessions: ${ms(web.cpu)} of CPU in all, ${ms(webPerViewer)} per session (set up, the text spoken and sent)`,
+      `pfap-web per session / Janus per added viewer: ${(webPerViewer / janusPerViewer).toFixed(1)}`,
+      kindRow(`pfap-web, ${VIEWERS} pages`, webKinds),
+      ...pageRows('pfap-web page', web.result, (s) => s.phonemes === s.sender.phonemes && s.fapStateMatchesSender),
+    );
+    lines.push(summary('pfap-web, every onset', web.result, 0),
       `load average at the end: ${os.loadavg().map((l) => l.toFixed(1)).join(', ')}`);
   } finally {
     await browser.close();
     // A run that failed half-way (a page's figures not in time) stops its servers too: their
-    // pipes would keep node waiting for the harness's timeout.
+    // pipes and the pages' server would keep node waiting for the harness's timeout.
+    pageServer?.close();
     if (server) await stop(server);
     if (janus && janus.exitCode === null && janus.signalCode === null) {
       await stop(janus);

@@ -146,6 +146,14 @@ export class SentLevel {
  * by a parabola. Null unless the window holds at least `minSpeechMs` of sound, the best
  * correlation reaches `minCorrelation` and lies inside the search range.
  *
+ * With `holdMargin`, the lag is the correlation's peak that lag 0 lies on (climbed to from
+ * there) unless another scores more than `holdMargin` higher. A voiced level rises and falls
+ * with its pitch period, so its correlation peaks every 10 ms or so, nearly as high: in the
+ * pages a clock that was right moved by one such period at a match and back at a later one
+ * (scores 0.001 to 0.014 apart), and drew a "pa" 12 ms late meanwhile (docs/web.md, "Lost
+ * clocks"). A clock that has matched passes it; the audio moved by what getStats did not
+ * count scores far higher where it went (0.13 to 0.41 more in those pages).
+ *
  * The sums are SentLevel.at's values and the correlation's, in the same order, so the lag is
  * the same to the bit; what it saves is the lookups: each block walks the sender's segments
  * once over its lags, not a search and a call for each.
@@ -153,7 +161,7 @@ export class SentLevel {
  * @param {SentLevel} sent
  * @returns {number|null} ms
  */
-export function matchLevels(heard, sent, { searchMs = 50, minCorrelation = 0.9, minSpeechMs = 20 } = {}) {
+export function matchLevels(heard, sent, { searchMs = 50, minCorrelation = 0.9, minSpeechMs = 20, holdMargin = 0 } = {}) {
   const n = heard.length;
   let peak = 0;
   for (const h of heard) peak = Math.max(peak, h.rms);
@@ -189,6 +197,12 @@ export function matchLevels(heard, sent, { searchMs = 50, minCorrelation = 0.9, 
   let best = 0;
   for (let j = 1; j < lags; ++j) if (scores[j] > scores[best]) best = j;
   if (scores[best] < minCorrelation || best === 0 || best === lags - 1) return null;
+  if (holdMargin > 0) {
+    let held = searchMs;  // lag 0
+    const up = scores[held + 1] > scores[held] ? 1 : -1;
+    while (held + up > 0 && held + up < lags - 1 && scores[held + up] > scores[held]) held += up;
+    if (scores[best] - scores[held] <= holdMargin && scores[held] >= minCorrelation) best = held;
+  }
   const [l, c, r] = [scores[best - 1], scores[best], scores[best + 1]];
   const curvature = l - 2 * c + r;
   const step = curvature < 0 ? Math.max(-0.5, Math.min(0.5, (l - r) / (2 * curvature))) : 0;

@@ -7,7 +7,6 @@
 // receiver's synchronization source say roughly which running time is heard, the played
 // level found in the level the sender sent (clock.js) says exactly, and between matches the
 // jitter buffer's stretching and the concealment that delays the audio (getStats) are followed.
-import { poseFromFaps, renderFace } from '../src/index.js';
 import { SentLevel, matchLevels } from './clock.js';
 
 // The value of `history` ([from, value], in order) at heard time t.
@@ -26,6 +25,10 @@ const FIRST_SOUND_RMS = 100;
 const FIRST_SOUND_QUIET_MS = 100;
 // The audio's packet duration (the senders' Opus frames): what NetEq conceals for a lost packet.
 const PACKET_S = 0.02;
+// How much better than the peak the clock is on another lag must score for a match to move
+// the clock there (matchLevels' holdMargin): above the near ties of a voiced level's pitch
+// periods seen in pages (0.001 to 0.014), below what a real move scored (0.13 and more).
+const HOLD_MARGIN = 0.03;
 // Silent concealment for longer than this, with no audio decoded, is the audio's end, not a stall.
 const SILENT_END_MS = 500;
 
@@ -278,7 +281,10 @@ export class PlayoutClock {
       heard.push({ x: env[i].t + this.searchMappingAt(env[i].t), rms: env[i].rms });
     }
     const searchMs = !this.matched ? this.firstSearchMs : this.misses >= 30 ? this.lostSearchMs : this.searchMs;
-    const lag = matchLevels(heard.reverse(), this.sent, { searchMs });
+    // A clock that has matched and is not lost stays on its peak unless another is clearly
+    // better: not one pitch period off on a near tie (matchLevels).
+    const holdMargin = this.matched && this.misses < 30 ? HOLD_MARGIN : 0;
+    const lag = matchLevels(heard.reverse(), this.sent, { searchMs, holdMargin });
     if (lag === null) {
       const peak = heard.reduce((m, h) => Math.max(m, h.rms), 0);
       if (this.matched && peak > 1e-3 && heard.filter((h) => h.rms > peak * 0.1).length >= 20) ++this.misses;
@@ -330,19 +336,14 @@ export class DrawnPhonemes {
  */
 export function drawInTime({ receiver, canvas, stats, streamNs, drawn }) {
   const ctx = canvas.getContext('2d');
-  let drawnFaps = null;  // the FAPs of the face on the canvas
   const frame = (now) => {
     const ns = streamNs(now);
     if (ns !== null) {
       stats.streamNs = ns;
       stats.endNs = receiver.animator.endNs;
-      // The face is drawn again only where it changed (receiver.draw draws the same): in the
-      // pauses and after the speech nothing is drawn, and Chromium composites nothing new.
-      const faps = receiver.faps(ns);
-      if (drawnFaps === null || faps.some((v, i) => v !== drawnFaps[i])) {
-        renderFace(ctx, poseFromFaps(faps), { style: 'cartoon' });
-        drawnFaps = faps;
-      }
+      // The face is drawn again only where it changed (PfapReceiver.draw): in the pauses and
+      // after the speech nothing is drawn, and Chromium composites nothing new.
+      receiver.draw(ctx, ns, { style: 'cartoon' });
       drawn.frame(now, ns);
     }
     requestAnimationFrame(frame);

@@ -211,7 +211,11 @@ export declare class PfapReceiver {
   advance(timeNs: number): void;
   faps(timeNs: number): Float64Array;
   pose(timeNs: number): FacePose;
-  draw(ctx: CanvasRenderingContext2D, timeNs: number, options?: { style?: 'cartoon' | 'line'; overlay?: boolean }): void;
+  /**
+   * Draws the face at timeNs; returns whether it drew: only where it differs from the face the
+   * last draw left on ctx (FAPs, style, overlay, another ctx, the canvas resized), or with force
+   */
+  draw(ctx: CanvasRenderingContext2D, timeNs: number, options?: { style?: 'cartoon' | 'line'; overlay?: boolean; force?: boolean }): boolean;
   reset(): void;
 }
 

@@ -5,6 +5,7 @@
 // recovery receiver, then phoneme and state events.
 
 import { Animator } from './animator.js';
+import { poseFromFaps } from './face_model.js';
 import { NS_PER_MS } from './model.js';
 import { decodePayload } from './payload.js';
 import { ARPABET_ALPHABET, findAlphabet, findPhoneme } from './phoneme_table.js';
@@ -51,6 +52,7 @@ export class PfapReceiver {
     this.recovery = new RecoveryReceiver({ retryNs: options.retryNs });
     this.animator = new Animator(this.alphabet);
     this._pending = []; // events received whose time the face has not reached, oldest first
+    this._drawn = null; // what the last draw() put on its canvas: {ctx, width, height, style, overlay, faps}
     /** Counters, as rtppfapdepay's stats property. */
     this.stats = {
       packets: 0, malformedRtp: 0, malformedPayload: 0, otherPayloadType: 0, late: 0, phonemes: 0,
@@ -219,13 +221,28 @@ export class PfapReceiver {
   /**
    * Draws the face at `timeNs` on a canvas 2D context, in `style` ('cartoon' or 'line'), with
    * pfapface's debug overlay (the phoneme sounding and the FAPs not at 0) when `overlay`.
+   * Returns whether it drew: the face is drawn again only where it would differ from the one
+   * the last draw left on this context (other FAPs, style or overlay text, another context, or
+   * the canvas resized, which clears it), so that a page drawing at every animation frame
+   * leaves the canvas alone in the pauses and Chromium composites nothing new. `force` draws
+   * anyway, for a page that draws on the canvas itself between calls.
    * @param {CanvasRenderingContext2D} ctx
    * @param {number} timeNs
-   * @param {{style?: 'cartoon'|'line', overlay?: boolean}} [options]
+   * @param {{style?: 'cartoon'|'line', overlay?: boolean, force?: boolean}} [options]
+   * @returns {boolean}
    */
   draw(ctx, timeNs, options = {}) {
-    const pose = this.pose(timeNs);
-    renderFace(ctx, pose, { style: options.style, overlay: options.overlay ? this.animator.describe(timeNs) : '' });
+    const faps = this.faps(timeNs);
+    const overlay = options.overlay ? this.animator.describe(timeNs) : '';
+    const { width, height } = ctx.canvas;
+    const last = this._drawn;
+    if (!options.force && last !== null && last.ctx === ctx && last.width === width && last.height === height
+        && last.style === options.style && last.overlay === overlay && faps.every((v, i) => v === last.faps[i])) {
+      return false;
+    }
+    renderFace(ctx, poseFromFaps(faps), { style: options.style, overlay });
+    this._drawn = { ctx, width, height, style: options.style, overlay, faps };
+    return true;
   }
 
   /** Back to no packet seen. */

@@ -79,6 +79,29 @@ test('matchLevels says nothing in silence, nor beyond its search range', () => {
   assert.equal(matchLevels(heardOf(levels, 0, 564, 714, 5), new SentLevel()), null);
 });
 
+test('matchLevels with holdMargin stays on the peak lag 0 lies on against a near tie a pitch period away, and moves where the level says', () => {
+  // A vowel whose level rises and falls with a 10 ms pitch period: its correlation peaks every
+  // 10 ms, nearly as high.
+  const voiced = (ms) => {
+    const k = ((ms % 337) + 337) % 337;
+    return k < 200 ? Math.round(6000 * Math.exp(-k / 400) * (1 + 0.6 * Math.cos((2 * Math.PI * k) / 10))) : 0;
+  };
+  const sent = new SentLevel();
+  sent.add(0, Array.from({ length: 3000 }, (_, i) => voiced(i)));
+  const heard = (fromMs, level) => Array.from({ length: 150 }, (_, i) => ({ x: fromMs + i, rms: level(fromMs + i) / 32768 }));
+  // Mid-vowel, blurred a little toward one period later: a near tie.
+  const blurred = heard(714, (x) => 0.48 * sent.at(x) + 0.52 * sent.at(x + 10));
+  const moved = matchLevels(blurred, sent);
+  assert.ok(Math.abs(moved - 10) < 0.5, `without holdMargin ${moved}`);
+  const held = matchLevels(blurred, sent, { holdMargin: 0.03 });
+  assert.ok(Math.abs(held) < 0.5, `with holdMargin ${held}`);
+  // The audio moved: over an onset by a period or more, or mid-vowel by other than a period.
+  for (const [fromMs, lag] of [[574, 10], [574, -10], [574, 12], [574, 25], [714, 12], [714, -4]]) {
+    const found = matchLevels(heard(fromMs, (x) => sent.at(x + lag)), sent, { holdMargin: 0.03 });
+    assert.ok(found !== null && Math.abs(found - lag) < 0.5, `from ${fromMs}, lag ${lag}: found ${found}`);
+  }
+});
+
 // The sender's code (tools/speech_level.h, encode_levels), for the round trip below.
 function encodeLevels(levels) {
   const codes = levels.map((rms) => Math.min(255, Math.round(16 * Math.log2(1 + Math.max(rms, 0)))));

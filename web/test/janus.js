@@ -53,10 +53,25 @@ export function exited(child) {
   return new Promise((resolve) => (child.exitCode !== null ? resolve(child.exitCode) : child.once('exit', resolve)));
 }
 
+/**
+ * A process's or thread's `stat` file (`/proc/PID/stat`, `/proc/PID/task/TID/stat`): its name,
+ * its parent's pid and the CPU time (user and system, s) it has used. The name is between
+ * parentheses and may hold any character, ") " and digits included: the fields follow the last ")".
+ */
+export function procStat(file) {
+  const stat = readFileSync(file, 'utf8');
+  const close = stat.lastIndexOf(')');
+  const fields = stat.slice(close + 2).split(' ');  // from the state, the third field
+  return {
+    name: stat.slice(stat.indexOf('(') + 1, close),
+    ppid: fields[1],
+    cpu: (Number(fields[11]) + Number(fields[12])) / 100,  // utime, stime in clock ticks (USER_HZ 100)
+  };
+}
+
 /** CPU time (user and system, s) that process `pid` has used. */
 export function cpuSeconds(pid) {
-  const fields = readFileSync(`/proc/${pid}/stat`, 'utf8').split(') ')[1].split(' ');
-  return (Number(fields[11]) + Number(fields[12])) / 100;  // utime, stime in clock ticks (USER_HZ 100)
+  return procStat(`/proc/${pid}/stat`).cpu;
 }
 
 // The sockets of process `pid` by inode: 'tcp ESTABLISHED' and the like, 'udp', 'unix', 'netlink'.
@@ -177,28 +192,31 @@ export function launchChromium() {
   });
 }
 
-/** Opens `url` in a new page of `browser`, its console and failed loads kept in `.messages`. */
-export async function newPage(browser, url) {
+/**
+ * Opens `url` in a new page of `browser`, its console and failed loads kept in `.messages`;
+ * `timeout` bounds the load (ms; playwright's 30 s by default).
+ */
+export async function newPage(browser, url, { timeout } = {}) {
   const page = await browser.newPage({ viewport: { width: 640, height: 720 } });
   const messages = [];
   page.on('console', (m) => messages.push(m.text()));
   page.on('response', (r) => r.status() >= 400 && messages.push(`${r.status()} ${r.url()}`));
   page.messages = messages;
-  await page.goto(url);
+  await page.goto(url, { timeout });
   return page;
 }
 
 /** Resolves once the viewer page receives the mountpoint's data stream. */
-export async function watching(page, janus) {
-  await page.waitForFunction(() => window.pfapStats?.dataOpen, null, { timeout: 30000, polling: 100 })
+export async function watching(page, janus, { timeout = 30000 } = {}) {
+  await page.waitForFunction(() => window.pfapStats?.dataOpen, null, { timeout, polling: 100 })
     .catch((e) => { throw new Error(`${e.message}\npage: ${page.messages.join('\n')}\njanus: ${janus.out}${janus.log}`); });
 }
 
-/** Opens a viewer page; resolves once it receives the mountpoint's data stream. */
-export async function openViewer(browser, pageServer, janus) {
+/** Opens a viewer page; resolves once it receives the mountpoint's data stream (`timeout` bounds each, ms). */
+export async function openViewer(browser, pageServer, janus, options = {}) {
   const { port } = pageServer.address();
-  const page = await newPage(browser, `http://127.0.0.1:${port}/broadcast/?janus=http://127.0.0.1:${JANUS_PORT}/janus`);
-  await watching(page, janus);
+  const page = await newPage(browser, `http://127.0.0.1:${port}/broadcast/?janus=http://127.0.0.1:${JANUS_PORT}/janus`, options);
+  await watching(page, janus, options);
   return page;
 }
 

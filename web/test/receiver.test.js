@@ -11,7 +11,7 @@ import path from 'node:path';
 
 import { createCanvas } from '@napi-rs/canvas';
 
-import { PfapReceiver, decodePayload, encodePayload, makeRtp } from '../src/index.js';
+import { PfapReceiver, decodePayload, encodePayload, makeRtp, renderFace } from '../src/index.js';
 import { exportVectors, fromHex, sourceRoot } from './libpfap.js';
 
 const RATE = 44100;
@@ -117,17 +117,70 @@ test('a new SSRC is a new stream: uncertain, asking for a complete state, until 
   assert.equal(requests.length, 2);
 });
 
-test('the face takes each event when its time comes, not when its packet does', () => {
+// A receiver given a complete state, then AA from 0 to 100 ms and M with a smile from 100 ms,
+// both packets at once, ahead of their time, as a sender with a delay sends them.
+function smileAfterAa() {
   const receiver = new PfapReceiver();
   const rtp = (seq, timestamp, payload) => makeRtp({ payloadType: 96, sequenceNumber: seq, timestamp, ssrc: 5, payload });
   receiver.receive(rtp(1, 0, encodePayload({ complete: true, coverage: 0, recovery: [], phonemes: [] })));
-  // Both packets come at once, ahead of their time, as a sender with a delay sends them.
-  receiver.receive(rtp(2, 0, phonemePacket(1)));  // AA from 0 to 100 ms
-  receiver.receive(rtp(3, 4410, phonemePacket(22, [{ index: 12, amplitude: 300, transition: 0, curve: 1 }])));  // M from 100 ms
+  receiver.receive(rtp(2, 0, phonemePacket(1)));
+  receiver.receive(rtp(3, 4410, phonemePacket(22, [{ index: 12, amplitude: 300, transition: 0, curve: 1 }])));
+  return receiver;
+}
+
+test('the face takes each event when its time comes, not when its packet does', () => {
+  const receiver = smileAfterAa();
   assert.equal(receiver.faps(50_000_000)[12], 0, 'the smile is not there before its phoneme');
   assert.equal(receiver.animator.describe(50_000_000), 'AA');
   assert.equal(receiver.faps(150_000_000)[12], 300);
   assert.match(receiver.animator.describe(150_000_000), /^M 12:300/);
+});
+
+test('draw() draws where the face would differ from the canvas, and the canvas always shows the face', () => {
+  const receiver = smileAfterAa();
+  const canvas = createCanvas(64, 48);
+  const ctx = canvas.getContext('2d');
+  // What the canvas holds is the face at timeNs, as renderFace draws it on a fresh canvas.
+  const showsFace = (c, timeNs, style) => {
+    const fresh = createCanvas(c.width, c.height);
+    renderFace(fresh.getContext('2d'), receiver.pose(timeNs), { style });
+    const pixels = (x) => Buffer.from(x.getContext('2d').getImageData(0, 0, x.width, x.height).data);
+    return pixels(c).equals(pixels(fresh));
+  };
+  const frameNs = 16_666_667;
+  assert.equal(receiver.draw(ctx, 50_000_000), true, 'the first draw');
+  assert.ok(showsFace(canvas, 50_000_000));
+  assert.equal(receiver.draw(ctx, 150_000_000), true, 'the smile came');
+  assert.ok(showsFace(canvas, 150_000_000));
+  // Long after the speech the face is still: frame after frame nothing is drawn.
+  const still = 5e9;
+  assert.equal(receiver.draw(ctx, still), true);
+  assert.equal(receiver.draw(ctx, still + frameNs), false);
+  assert.equal(receiver.draw(ctx, still + 2 * frameNs), false);
+  assert.ok(showsFace(canvas, still + 2 * frameNs));
+  // Other options draw; the same again does not.
+  assert.equal(receiver.draw(ctx, still, { style: 'line' }), true);
+  assert.ok(showsFace(canvas, still, 'line'));
+  assert.equal(receiver.draw(ctx, still, { style: 'line' }), false);
+  assert.equal(receiver.draw(ctx, still, { overlay: true }), true);
+  assert.equal(receiver.draw(ctx, still, { overlay: true }), false);
+  assert.equal(receiver.draw(ctx, still), true, 'the overlay goes');
+  assert.ok(showsFace(canvas, still));
+  // Resizing a canvas clears it: the next draw draws.
+  canvas.width = 80;
+  assert.equal(receiver.draw(ctx, still + 3 * frameNs), true, 'the canvas resized');
+  assert.ok(showsFace(canvas, still));
+  canvas.height = 60;
+  assert.equal(receiver.draw(ctx, still + 4 * frameNs), true, 'the canvas resized');
+  assert.equal(receiver.draw(ctx, still + 5 * frameNs), false);
+  // Another canvas gets its face; force draws anyway.
+  const other = createCanvas(64, 48);
+  assert.equal(receiver.draw(other.getContext('2d'), still), true, 'another canvas');
+  assert.ok(showsFace(other, still));
+  assert.equal(receiver.draw(other.getContext('2d'), still), false);
+  other.getContext('2d').clearRect(0, 0, 64, 48);
+  assert.equal(receiver.draw(other.getContext('2d'), still, { force: true }), true, 'forced');
+  assert.ok(showsFace(other, still));
 });
 
 test('a receiver nobody draws keeps at most 4096 events for the face', () => {
