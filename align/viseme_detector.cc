@@ -14,6 +14,9 @@ constexpr size_t kHeader = 7;  // kind, mfccs, past, ahead, hidden1, hidden2, vi
 constexpr float kKind = 2;     // 2: with the cepstral mean's prior
 // The numbers before the layers: the inputs' means and scales, and the cepstral mean's prior.
 constexpr size_t kNormalization = 2 * kVisemeMfccs + (kVisemeMfccs - 1);
+// A hidden layer's units at most: the reader refuses more, and the network's scratch on the
+// stack is that large.
+constexpr size_t kMaxHiddenUnits = 1024;
 
 // The model tools/viseme-train wrote: its numbers, C++ and JavaScript read the same file.
 constexpr float kBuiltinNumbers[] = {
@@ -46,7 +49,7 @@ std::unique_ptr<VisemeModel> VisemeModel::from_numbers(std::span<const float> n)
   };
   if (n.size() < kHeader || n[0] != kKind || n[1] != kVisemeMfccs ||
       !whole(n[2], 0, kMaxVisemePastFrames) || n[3] != kVisemeAheadFrames || n[6] != kVisemeCount ||
-      !whole(n[4], 1, 1024) || !whole(n[5], 1, 1024)) {
+      !whole(n[4], 1, kMaxHiddenUnits) || !whole(n[5], 1, kMaxHiddenUnits)) {
     return nullptr;
   }
   auto model = std::make_unique<VisemeModel>();
@@ -66,8 +69,9 @@ void VisemeModel::probabilities(std::span<const float> context, std::span<float>
   const float* scale = p + kVisemeMfccs;
   p += kNormalization;
   const size_t inputs = this->inputs();
-  // On the stack, as large as any model's inputs: no allocation a frame.
+  // On the stack, as large as any model's inputs and layers: no allocation a frame.
   std::array<float, (kMaxVisemePastFrames + 1 + kVisemeAheadFrames) * kVisemeMfccs> x;
+  std::array<float, kMaxHiddenUnits> h1, h2;
   for (size_t i = 0; i < inputs; ++i) {
     x[i] = (context[i] - mean[i % kVisemeMfccs]) * scale[i % kVisemeMfccs];
   }
@@ -82,7 +86,6 @@ void VisemeModel::probabilities(std::span<const float> context, std::span<float>
     }
     p += n_in * n_out + n_out;
   };
-  std::vector<float> h1(hidden1_), h2(hidden2_);
   layer(x.data(), inputs, hidden1_, h1.data(), true);
   layer(h1.data(), hidden1_, hidden2_, h2.data(), true);
   layer(h2.data(), hidden2_, kVisemeCount, out.data(), false);
