@@ -57,11 +57,15 @@ export function decodeLevelMessage(bytes) {
 
 // A segment's level at running time `ms` (not before its start): between two blocks' starts
 // interpolated, toward 0 after its last block, 0 after that.
-function levelIn({ startMs, levels }, ms) {
+// The level at `ms` in `segment`, 0 past its end; its last block leads to the first of `after`
+// (the next segment) where that starts right at its end, as the sender's messages follow one
+// another, and to 0 where nothing follows.
+function levelIn({ startMs, levels }, ms, after) {
   const x = ms - startMs;
   const k = Math.floor(x);
   if (k >= levels.length) return 0;
-  const next = k + 1 < levels.length ? levels[k + 1] : 0;
+  const next = k + 1 < levels.length ? levels[k + 1]
+    : after !== undefined && after.startMs === startMs + levels.length ? after.levels[0] : 0;
   return levels[k] + (next - levels[k]) * (x - k);
 }
 
@@ -108,7 +112,7 @@ export class SentLevel {
       ? near : this.segments.findLastIndex((seg) => seg.startMs <= ms);
     if (i < 0) return 0;
     this.found = i;
-    return levelIn(this.segments[i], ms);
+    return levelIn(this.segments[i], ms, this.segments[i + 1]);
   }
 
   /**
@@ -134,7 +138,7 @@ export class SentLevel {
         while (s + 1 < segments.length && segments[s + 1].startMs <= t) ++s;
         nextStart = s + 1 < segments.length ? segments[s + 1].startMs : Infinity;
       }
-      out[offset + j * stride] = s >= 0 ? levelIn(segments[s], t) : 0;
+      out[offset + j * stride] = s >= 0 ? levelIn(segments[s], t, segments[s + 1]) : 0;
     }
   }
 }

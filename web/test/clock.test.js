@@ -39,6 +39,17 @@ test('SentLevel: the level at a running time, interpolated, 0 where nothing was 
   assert.equal(sent.at(20), 50);
 });
 
+test('SentLevel: the last ms of a message leads to the next one where it follows right after', () => {
+  const sent = new SentLevel();
+  sent.add(10e6, [100, 200]);
+  sent.add(12e6, [400, 500]);
+  assert.equal(sent.at(11.5), 300);  // not 100, toward 0
+  assert.equal(sent.at(13.5), 250);  // nothing after: toward 0
+  const lags = new Float64Array(4);
+  sent.sampleLags(11.5, 0, 4, lags);
+  assert.deepEqual([...lags], [300, 450, 250, 0]);
+});
+
 test('SentLevel keeps the last 30 s', () => {
   const sent = new SentLevel();
   sent.add(0, [1]);
