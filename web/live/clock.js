@@ -58,14 +58,15 @@ export function decodeLevelMessage(bytes) {
 // A segment's level at running time `ms` (not before its start): between two blocks' starts
 // interpolated, toward 0 after its last block, 0 after that.
 // The level at `ms` in `segment`, 0 past its end; its last block leads to the first of `after`
-// (the next segment) where that starts right at its end, as the sender's messages follow one
-// another, and to 0 where nothing follows.
+// (the next segment) where that starts at its end (within half a block: a running time's ms,
+// from its ns, and a sum of them differ in the last bits), as the sender's messages follow
+// one another, and to 0 where nothing follows.
 function levelIn({ startMs, levels }, ms, after) {
   const x = ms - startMs;
   const k = Math.floor(x);
   if (k >= levels.length) return 0;
-  const next = k + 1 < levels.length ? levels[k + 1]
-    : after !== undefined && after.startMs === startMs + levels.length ? after.levels[0] : 0;
+  const follows = after !== undefined && Math.abs(after.startMs - (startMs + levels.length)) < 0.5;
+  const next = k + 1 < levels.length ? levels[k + 1] : follows ? after.levels[0] : 0;
   return levels[k] + (next - levels[k]) * (x - k);
 }
 
