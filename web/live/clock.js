@@ -56,11 +56,10 @@ export function decodeLevelMessage(bytes) {
 }
 
 // A segment's level at running time `ms` (not before its start): between two blocks' starts
-// interpolated, toward 0 after its last block, 0 after that.
-// The level at `ms` in `segment`, 0 past its end; its last block leads to the first of `after`
-// (the next segment) where that starts at its end (within half a block: a running time's ms,
-// from its ns, and a sum of them differ in the last bits), as the sender's messages follow
-// one another, and to 0 where nothing follows.
+// interpolated, 0 past its last block. Its last block leads to the first of `after` (the next
+// segment) where that starts at its end, as the sender's messages follow one another (within
+// half a block: a running time's ms, from its ns, and a sum of them differ in the last bits),
+// and toward 0 where nothing follows.
 function levelIn({ startMs, levels }, ms, after) {
   const x = ms - startMs;
   const k = Math.floor(x);
