@@ -68,7 +68,8 @@ class LiveAligner {
 
  private:
   void step(bool at_end, std::vector<tts::SpokenPhoneme>& out);
-  // mfcc() of the audio from sample w0 to the newest, each frame computed once (frames_).
+  // mfcc()'s frames of the audio from sample w0 to the newest, the MFCCs normalized over them
+  // (the level dimension is step()'s), each frame's analysis done once (frames_).
   Features features_from(size_t w0);
   // Phoneme k's start `at` (a sample of the utterance) moved as align() moves it next to a
   // pause (snap_to_silence), on the audio kept.
