@@ -126,6 +126,7 @@ bool LiveAligner::start(const tts::Utterance& utterance, const tts::VoiceSetting
   // As align() does: a pause at each end holds the recording's silence before and after.
   pad_with_pauses(syn_, syn_.sample_rate / 10);
   synf_ = mfcc(syn_.samples, syn_.sample_rate);
+  analyzer_ = std::make_unique<FrameAnalyzer>(rate);
   silence_quiet_frames(synf_);
   rest_ = pause_frames(syn_.phonemes, 0, synf_);
   return true;
@@ -150,7 +151,7 @@ void LiveAligner::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
   if (problem_ == Problem::kNone && rec_settled_ < n) {
     const size_t context = samples_of(kContextMs, rate_);
     const size_t w0 = std::min(rec_settled_, n - std::min(n, context));
-    Features rec = mfcc(std::span(rec_).subspan(w0 - rec_first_), rate_);
+    Features rec = features_from(w0);
     // The level below the loudest frame of the utterance so far, not of this window.
     loudest_db_ =
         std::max(loudest_db_, *std::max_element(rec.level_db.begin(), rec.level_db.end()));
@@ -234,6 +235,45 @@ void LiveAligner::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
     rec_.erase(rec_.begin(), rec_.begin() + static_cast<std::ptrdiff_t>(keep_from - rec_first_));
     rec_first_ = keep_from;
   }
+}
+
+Features LiveAligner::features_from(size_t w0) {
+  Features f;
+  f.rate = rate_;
+  f.hop = analyzer_->hop();
+  f.window = analyzer_->window();
+  const std::span<const int16_t> audio = std::span(rec_).subspan(w0 - rec_first_);
+  f.n_frames = audio.size() <= f.window ? 1 : 1 + (audio.size() - f.window) / f.hop;
+  // w0 never goes back. The frames kept are those of w0's grid (the settled point and the
+  // context's start move by any number of samples): those from w0 on, or none.
+  if (w0 < frames_first_ || (w0 - frames_first_) % f.hop != 0) {
+    frames_.clear();
+  } else {
+    const size_t gone = std::min(frames_.size(), (w0 - frames_first_) / f.hop * Features::kDims);
+    frames_.erase(frames_.begin(), frames_.begin() + static_cast<std::ptrdiff_t>(gone));
+  }
+  frames_first_ = w0;
+  // A frame past the audio's end (zero-padded, when there is less than a window) is not kept.
+  const size_t whole = audio.size() < f.window ? 0 : f.n_frames;
+  for (size_t k = frames_.size() / Features::kDims; k < whole; ++k) {
+    frames_.resize((k + 1) * Features::kDims);
+    frames_[k * Features::kDims + Features::kMfccs] =
+        analyzer_->analyze(audio.subspan(k * f.hop), &frames_[k * Features::kDims]);
+  }
+  f.data.resize(f.n_frames * Features::kDims);
+  f.level_db.resize(f.n_frames);
+  if (whole == 0) {
+    f.level_db[0] = analyzer_->analyze(audio, f.data.data());
+  } else {
+    for (size_t k = 0; k < f.n_frames; ++k) {
+      const float* x = &frames_[k * Features::kDims];
+      std::copy(x, x + Features::kMfccs,
+                f.data.begin() + static_cast<std::ptrdiff_t>(k * Features::kDims));
+      f.level_db[k] = x[Features::kMfccs];
+    }
+  }
+  normalize_mfccs(f);
+  return f;
 }
 
 size_t LiveAligner::snap(size_t k, size_t at) const {

@@ -17,6 +17,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -67,6 +68,9 @@ class LiveAligner {
 
  private:
   void step(bool at_end, std::vector<tts::SpokenPhoneme>& out);
+  // mfcc()'s frames of the audio from sample w0 to the newest, the MFCCs normalized over them
+  // (the level dimension is step()'s), each frame's analysis done once (frames_).
+  Features features_from(size_t w0);
   // Phoneme k's start `at` (a sample of the utterance) moved as align() moves it next to a
   // pause (snap_to_silence), on the audio kept.
   size_t snap(size_t k, size_t at) const;
@@ -80,6 +84,11 @@ class LiveAligner {
   std::vector<bool> rest_;    // per frame of synf_: a pause may be matched here (open_warp)
   std::vector<int16_t> rec_;  // the utterance's audio from sample rec_first_ (what is needed)
   size_t rec_first_ = 0;
+  // The frames that features_from() computed, from sample frames_first_ a hop apart, each its
+  // MFCCs as FrameAnalyzer gives them and its level (Features::kDims values).
+  std::unique_ptr<FrameAnalyzer> analyzer_;
+  std::vector<float> frames_;
+  size_t frames_first_ = 0;
   float loudest_db_ = -100;    // the utterance's loudest frame so far
   size_t rec_settled_ = 0;     // samples of the utterance given out
   size_t syn_settled_ = 0;     // the sample of syn_ matched with rec_settled_

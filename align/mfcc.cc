@@ -26,51 +26,52 @@ size_t Features::frame_at(size_t sample) const {
   return static_cast<size_t>(std::clamp(std::lround(k), 0L, static_cast<long>(n_frames - 1)));
 }
 
-Features mfcc(std::span<const int16_t> samples, unsigned rate) {
-  Features f;
-  f.rate = rate;
-  f.hop = static_cast<size_t>(std::lround(kHopSeconds * rate));
-  f.window = static_cast<size_t>(std::lround(kWindowSeconds * rate));
-  f.n_frames = samples.size() <= f.window ? 1 : 1 + (samples.size() - f.window) / f.hop;
+struct FrameAnalyzer::Aubio {
+  std::unique_ptr<aubio_mfcc_t, decltype(&del_aubio_mfcc)> mfcc{nullptr, &del_aubio_mfcc};
+  std::unique_ptr<fvec_t, decltype(&del_fvec)> in{nullptr, &del_fvec};
+  std::unique_ptr<fvec_t, decltype(&del_fvec)> window{nullptr, &del_fvec};
+  std::unique_ptr<aubio_fft_t, decltype(&del_aubio_fft)> fft{nullptr, &del_aubio_fft};
+  std::unique_ptr<cvec_t, decltype(&del_cvec)> spectrum{nullptr, &del_cvec};
+  std::unique_ptr<fvec_t, decltype(&del_fvec)> out{nullptr, &del_fvec};
+};
 
-  std::unique_ptr<aubio_mfcc_t, decltype(&del_aubio_mfcc)> mf(
-      new_aubio_mfcc(static_cast<uint_t>(f.window), kFilters, Features::kMfccs + 1, rate),
-      &del_aubio_mfcc);
-  aubio_mfcc_set_mel_coeffs(mf.get(), kLowHz, kHighHz);
-  std::unique_ptr<fvec_t, decltype(&del_fvec)> in(new_fvec(static_cast<uint_t>(f.window)),
-                                                  &del_fvec);
-  std::unique_ptr<fvec_t, decltype(&del_fvec)> window(
-      new_aubio_window(const_cast<char*>("hanningz"), static_cast<uint_t>(f.window)), &del_fvec);
-  std::unique_ptr<aubio_fft_t, decltype(&del_aubio_fft)> fft(
-      new_aubio_fft(static_cast<uint_t>(f.window)), &del_aubio_fft);
-  std::unique_ptr<cvec_t, decltype(&del_cvec)> spectrum(new_cvec(static_cast<uint_t>(f.window)),
-                                                        &del_cvec);
-  std::unique_ptr<fvec_t, decltype(&del_fvec)> out(new_fvec(Features::kMfccs + 1), &del_fvec);
+FrameAnalyzer::FrameAnalyzer(unsigned rate)
+    : hop_(static_cast<size_t>(std::lround(kHopSeconds * rate))),
+      window_(static_cast<size_t>(std::lround(kWindowSeconds * rate))),
+      aubio_(std::make_unique<Aubio>()) {
+  const auto n = static_cast<uint_t>(window_);
+  aubio_->mfcc.reset(new_aubio_mfcc(n, kFilters, Features::kMfccs + 1, rate));
+  aubio_mfcc_set_mel_coeffs(aubio_->mfcc.get(), kLowHz, kHighHz);
+  aubio_->in.reset(new_fvec(n));
+  aubio_->window.reset(new_aubio_window(const_cast<char*>("hanningz"), n));
+  aubio_->fft.reset(new_aubio_fft(n));
+  aubio_->spectrum.reset(new_cvec(n));
+  aubio_->out.reset(new_fvec(Features::kMfccs + 1));
+}
 
-  f.data.resize(f.n_frames * Features::kDims);
-  f.level_db.resize(f.n_frames);
-  for (size_t k = 0; k < f.n_frames; ++k) {
-    double energy = 0;
-    for (size_t i = 0; i < f.window; ++i) {
-      const size_t j = k * f.hop + i;
-      const smpl_t x = j < samples.size() ? static_cast<smpl_t>(samples[j]) / 32768 : 0;
-      energy += static_cast<double>(x) * x;
-      in->data[i] = x * window->data[i];
-    }
-    f.level_db[k] =
-        energy > 0
-            ? std::max(kFloorDb,
-                       static_cast<float>(10 * std::log10(energy / static_cast<double>(f.window))))
-            : kFloorDb;
-    aubio_fft_do(fft.get(), in.get(), spectrum.get());
-    aubio_mfcc_do(mf.get(), spectrum.get(), out.get());
-    for (size_t d = 0; d < Features::kMfccs; ++d) {
-      // A log of a band with no energy at all would be -inf: such a coefficient counts as 0.
-      const smpl_t c = out->data[d + 1];
-      f.data[k * Features::kDims + d] = std::isfinite(c) ? c : 0;
-    }
+FrameAnalyzer::~FrameAnalyzer() = default;
+
+float FrameAnalyzer::analyze(std::span<const int16_t> samples, float* mfccs) {
+  double energy = 0;
+  for (size_t i = 0; i < window_; ++i) {
+    const smpl_t x = i < samples.size() ? static_cast<smpl_t>(samples[i]) / 32768 : 0;
+    energy += static_cast<double>(x) * x;
+    aubio_->in->data[i] = x * aubio_->window->data[i];
   }
+  aubio_fft_do(aubio_->fft.get(), aubio_->in.get(), aubio_->spectrum.get());
+  aubio_mfcc_do(aubio_->mfcc.get(), aubio_->spectrum.get(), aubio_->out.get());
+  for (size_t d = 0; d < Features::kMfccs; ++d) {
+    // A log of a band with no energy at all would be -inf: such a coefficient counts as 0.
+    const smpl_t c = aubio_->out->data[d + 1];
+    mfccs[d] = std::isfinite(c) ? c : 0;
+  }
+  return energy > 0
+             ? std::max(kFloorDb,
+                        static_cast<float>(10 * std::log10(energy / static_cast<double>(window_))))
+             : kFloorDb;
+}
 
+void normalize_mfccs(Features& f) {
   for (size_t d = 0; d < Features::kMfccs; ++d) {
     double sum = 0, sum2 = 0;
     for (size_t k = 0; k < f.n_frames; ++k) {
@@ -86,6 +87,22 @@ Features mfcc(std::span<const int16_t> samples, unsigned rate) {
       x = static_cast<float>((x - mean) * scale);
     }
   }
+}
+
+Features mfcc(std::span<const int16_t> samples, unsigned rate) {
+  FrameAnalyzer analyzer(rate);
+  Features f;
+  f.rate = rate;
+  f.hop = analyzer.hop();
+  f.window = analyzer.window();
+  f.n_frames = samples.size() <= f.window ? 1 : 1 + (samples.size() - f.window) / f.hop;
+  f.data.resize(f.n_frames * Features::kDims);
+  f.level_db.resize(f.n_frames);
+  for (size_t k = 0; k < f.n_frames; ++k) {
+    f.level_db[k] = analyzer.analyze(samples.subspan(std::min(samples.size(), k * f.hop)),
+                                     f.data.data() + k * Features::kDims);
+  }
+  normalize_mfccs(f);
   // The level below the utterance's loudest frame, the same scale in any recording, so that
   // pauses match pauses (the MFCCs of silence, normalized, are anything).
   const float loudest = *std::max_element(f.level_db.begin(), f.level_db.end());

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -44,5 +45,30 @@ struct Features {
 // Features of `samples` at `rate` (kMinRate..kMaxRate): 25 ms Hann windows every 5 ms, 40 mel
 // bands over 100..7000 Hz. Audio shorter than a window gives one frame (zero-padded).
 Features mfcc(std::span<const int16_t> samples, unsigned rate);
+
+// One frame of mfcc() before what is measured over all the frames: its MFCCs as aubio gives
+// them and its RMS level. They depend on the frame's samples alone, so that the live aligner
+// computes each frame once as its audio comes.
+class FrameAnalyzer {
+ public:
+  explicit FrameAnalyzer(unsigned rate);  // kMinRate..kMaxRate
+  ~FrameAnalyzer();
+  FrameAnalyzer(const FrameAnalyzer&) = delete;
+  FrameAnalyzer& operator=(const FrameAnalyzer&) = delete;
+
+  size_t hop() const { return hop_; }
+  size_t window() const { return window_; }
+  // The frame that starts at samples[0] (zero-padded past the end if fewer than window()):
+  // its Features::kMfccs coefficients into `mfccs`; returns its level in dBFS.
+  float analyze(std::span<const int16_t> samples, float* mfccs);
+
+ private:
+  struct Aubio;
+  size_t hop_, window_;
+  std::unique_ptr<Aubio> aubio_;
+};
+
+// mfcc()'s normalization of each MFCC over `f`'s frames (the level dimension left alone).
+void normalize_mfccs(Features& f);
 
 }  // namespace pfap::align
