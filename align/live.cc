@@ -238,12 +238,8 @@ void LiveAligner::step(bool at_end, std::vector<tts::SpokenPhoneme>& out) {
 }
 
 Features LiveAligner::features_from(size_t w0) {
-  Features f;
-  f.rate = rate_;
-  f.hop = analyzer_->hop();
-  f.window = analyzer_->window();
   const std::span<const int16_t> audio = std::span(rec_).subspan(w0 - rec_first_);
-  f.n_frames = audio.size() <= f.window ? 1 : 1 + (audio.size() - f.window) / f.hop;
+  Features f = analyzer_->frames_of(audio.size());
   // w0 never goes back. The frames kept are those of w0's grid (the settled point and the
   // context's start move by any number of samples): those from w0 on, or none.
   if (w0 < frames_first_ || (w0 - frames_first_) % f.hop != 0) {
@@ -260,8 +256,6 @@ Features LiveAligner::features_from(size_t w0) {
     frames_[k * Features::kDims + Features::kMfccs] =
         analyzer_->analyze(audio.subspan(k * f.hop), &frames_[k * Features::kDims]);
   }
-  f.data.resize(f.n_frames * Features::kDims);
-  f.level_db.resize(f.n_frames);
   if (whole == 0) {
     f.level_db[0] = analyzer_->analyze(audio, f.data.data());
   } else {

@@ -36,7 +36,8 @@ struct FrameAnalyzer::Aubio {
 };
 
 FrameAnalyzer::FrameAnalyzer(unsigned rate)
-    : hop_(static_cast<size_t>(std::lround(kHopSeconds * rate))),
+    : rate_(rate),
+      hop_(static_cast<size_t>(std::lround(kHopSeconds * rate))),
       window_(static_cast<size_t>(std::lround(kWindowSeconds * rate))),
       aubio_(std::make_unique<Aubio>()) {
   const auto n = static_cast<uint_t>(window_);
@@ -50,6 +51,17 @@ FrameAnalyzer::FrameAnalyzer(unsigned rate)
 }
 
 FrameAnalyzer::~FrameAnalyzer() = default;
+
+Features FrameAnalyzer::frames_of(size_t samples) const {
+  Features f;
+  f.rate = rate_;
+  f.hop = hop_;
+  f.window = window_;
+  f.n_frames = samples <= window_ ? 1 : 1 + (samples - window_) / hop_;
+  f.data.resize(f.n_frames * Features::kDims);
+  f.level_db.resize(f.n_frames);
+  return f;
+}
 
 float FrameAnalyzer::analyze(std::span<const int16_t> samples, float* mfccs) {
   double energy = 0;
@@ -91,13 +103,7 @@ void normalize_mfccs(Features& f) {
 
 Features mfcc(std::span<const int16_t> samples, unsigned rate) {
   FrameAnalyzer analyzer(rate);
-  Features f;
-  f.rate = rate;
-  f.hop = analyzer.hop();
-  f.window = analyzer.window();
-  f.n_frames = samples.size() <= f.window ? 1 : 1 + (samples.size() - f.window) / f.hop;
-  f.data.resize(f.n_frames * Features::kDims);
-  f.level_db.resize(f.n_frames);
+  Features f = analyzer.frames_of(samples.size());
   for (size_t k = 0; k < f.n_frames; ++k) {
     f.level_db[k] = analyzer.analyze(samples.subspan(std::min(samples.size(), k * f.hop)),
                                      f.data.data() + k * Features::kDims);

@@ -58,12 +58,16 @@ class FrameAnalyzer {
 
   size_t hop() const { return hop_; }
   size_t window() const { return window_; }
+  // Features of `samples` samples as mfcc() frames them: their rate, hop, window and number of
+  // frames, the values all 0.
+  Features frames_of(size_t samples) const;
   // The frame that starts at samples[0] (zero-padded past the end if fewer than window()):
   // its Features::kMfccs coefficients into `mfccs`; returns its level in dBFS.
   float analyze(std::span<const int16_t> samples, float* mfccs);
 
  private:
   struct Aubio;
+  unsigned rate_;
   size_t hop_, window_;
   std::unique_ptr<Aubio> aubio_;
 };
