@@ -1,15 +1,17 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// webrtcbin's receive bins against its ICE transports, before its pipeline goes to NULL
+// webrtcbin's transport bins against its ICE transports, before its pipeline goes to NULL
 // (docs/performance.md, "Sessions that come and go"). Used by pfap-web's close_session.
 //
-// Each receive bin of webrtcbin 1.22 (TransportReceiveBin, gst-plugins-bad's
-// ext/webrtc/transportreceivebin.c) connects a handler to its ICE transport's notify::state
-// when it is made and never disconnects it. The handler sets the bin's receive state again;
-// while ICE is neither connected nor completed, that blocks the bin's input with a pad probe
-// that holds a reference to the bin. The bin frees its probes only in its READY to NULL. So an
-// ICE state change between the bin's NULL and webrtcbin's disposal (on whichever thread
-// libnice emits it) leaves the bin, with its nicesrc, dtlsdec, srtpdec and 5 fds, for ever.
-// Upstream has the same code today (the GStreamer monorepo at 4cdf9d9796).
+// Each receive and send bin of webrtcbin 1.22 (TransportReceiveBin, TransportSendBin:
+// gst-plugins-bad's ext/webrtc/transportreceivebin.c and transportsendbin.c) connects a
+// handler to its ICE transport's notify::state when it is made and never disconnects it.
+// The receive bin's sets the bin's receive state again; while ICE is neither connected nor
+// completed, that blocks the bin's input with a pad probe that holds a reference to the bin.
+// The bin frees its probes only in its READY to NULL. So an ICE state change between the bin's
+// NULL and webrtcbin's disposal (on whichever thread libnice emits it) leaves the bin, with its
+// nicesrc, dtlsdec, srtpdec and 5 fds, for ever. The send bin's runs on a freed bin when the
+// ICE transport outlives webrtcbin: a crash. Upstream has the same code today (the GStreamer
+// monorepo at 4cdf9d9796).
 #pragma once
 
 #ifndef GST_USE_UNSTABLE_API
@@ -22,7 +24,7 @@
 #include <cstring>
 #include <vector>
 
-namespace webrtc_receive_bins {
+namespace webrtc_transport_bins {
 
 // Adds `dtls`'s ICE transport to `ice` (once), taking `dtls`'s reference.
 inline void add_ice_transport(GstWebRTCDTLSTransport* dtls, std::vector<GObject*>& ice) {
@@ -69,8 +71,9 @@ inline std::vector<GObject*> ice_transports(GstElement* webrtc) {
   return ice;
 }
 
-// `webrtc`'s receive bins (its children of the private type TransportReceiveBin), referenced.
-inline std::vector<GstElement*> receive_bins(GstElement* webrtc) {
+// `webrtc`'s transport bins (its children of the private types TransportReceiveBin and
+// TransportSendBin), referenced.
+inline std::vector<GstElement*> transport_bins(GstElement* webrtc) {
   std::vector<GstElement*> bins;
   GstIterator* children = gst_bin_iterate_elements(GST_BIN(webrtc));
   gst_iterator_foreach(
@@ -78,7 +81,9 @@ inline std::vector<GstElement*> receive_bins(GstElement* webrtc) {
       [](const GValue* value, gpointer data) {
         auto* element = GST_ELEMENT(g_value_get_object(value));
         auto& found = *static_cast<std::vector<GstElement*>*>(data);
-        if (std::strcmp(G_OBJECT_TYPE_NAME(element), "TransportReceiveBin") == 0 &&
+        const char* type = G_OBJECT_TYPE_NAME(element);
+        if ((std::strcmp(type, "TransportReceiveBin") == 0 ||
+             std::strcmp(type, "TransportSendBin") == 0) &&
             std::find(found.begin(), found.end(), element) == found.end()) {
           found.push_back(GST_ELEMENT(gst_object_ref(element)));
         }
@@ -88,22 +93,22 @@ inline std::vector<GstElement*> receive_bins(GstElement* webrtc) {
   return bins;
 }
 
-}  // namespace webrtc_receive_bins
+}  // namespace webrtc_transport_bins
 
-// Disconnects every handler on `webrtc`'s ICE transports whose data is one of its receive
-// bins, so that no ICE state change can block a bin after its NULL. Called before the pipeline
-// goes to NULL, on a webrtcbin that is not to play again (its bins no longer unblock when ICE
-// connects). Returns how many handlers it disconnected.
+// Disconnects every handler on `webrtc`'s ICE transports whose data is one of its transport
+// bins, so that no ICE state change can block a receive bin after its NULL or reach a send bin
+// after its disposal. Called before the pipeline goes to NULL, on a webrtcbin that is not to
+// play again (its bins no longer follow ICE). Returns how many handlers it disconnected.
 //
-// A handler that another thread has already entered runs to its end: it blocks a bin for good
-// only if its few instructions end after the bin's READY to NULL, which comes after every
-// element of the pipeline has gone from PLAYING to READY, so that thread would have to stand
-// still inside the handler for all of it. A receive bin that webrtcbin's thread makes after
-// this call keeps its handler: that takes a session closed while webrtcbin is still making
-// its offer, before a peer could have answered.
-inline guint detach_receive_bins_from_ice(GstElement* webrtc) {
-  std::vector<GObject*> ice = webrtc_receive_bins::ice_transports(webrtc);
-  std::vector<GstElement*> bins = webrtc_receive_bins::receive_bins(webrtc);
+// A handler that another thread has already entered runs to its end: it blocks a receive bin
+// for good only if its few instructions end after the bin's READY to NULL, which comes after
+// every element of the pipeline has gone from PLAYING to READY, so that thread would have to
+// stand still inside the handler for all of it. A bin that webrtcbin's thread makes after this
+// call keeps its handler: that takes a session closed while webrtcbin is still making its
+// offer, before a peer could have answered.
+inline guint detach_transport_bins_from_ice(GstElement* webrtc) {
+  std::vector<GObject*> ice = webrtc_transport_bins::ice_transports(webrtc);
+  std::vector<GstElement*> bins = webrtc_transport_bins::transport_bins(webrtc);
   guint disconnected = 0;
   for (GObject* transport : ice) {
     for (GstElement* bin : bins) {

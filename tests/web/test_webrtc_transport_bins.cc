@@ -1,19 +1,20 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
-// tools/webrtc_receive_bins.h: an ICE state change after a session's pipeline's NULL leaves no
-// receive bin behind, whether the answer was set or not (docs/performance.md, "Sessions that
-// come and go"). Two webrtcbins in one process make the offer and the answer as pfap-web and
-// a page do; the ICE state change that libnice would make on some thread, by luck, is emitted
-// here by hand (g_object_notify on the public ICE transports). Without
-// detach_receive_bins_from_ice every receive bin is left. No ICE candidate is exchanged, so
-// nothing is sent; the test still runs in a network namespace with only lo (unshare -n, as
-// root; skipped elsewhere), as every WebRTC test does, so that ICE gathers on lo alone.
+// tools/webrtc_transport_bins.h: an ICE state change after a session's pipeline's NULL leaves
+// no receive bin behind, whether the answer was set or not, and one after the session is gone
+// reaches no freed send bin (docs/performance.md, "Sessions that come and go"). Two webrtcbins
+// in one process make the offer and the answer as pfap-web and a page do; the ICE state change
+// that libnice would make on some thread, by luck, is emitted here by hand (g_object_notify on
+// the public ICE transports). Without detach_transport_bins_from_ice every receive bin is left,
+// and the send bins' handler runs on freed memory. No ICE candidate is exchanged, so nothing
+// is sent; the test still runs in a network namespace with only lo (unshare -n, as root;
+// skipped elsewhere), as every WebRTC test does, so that ICE gathers on lo alone.
 #include <gst/gst.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <vector>
 
-#include "webrtc_receive_bins.h"
+#include "webrtc_transport_bins.h"
 
 namespace {
 
@@ -92,14 +93,14 @@ GstElement* offering(GstWebRTCSessionDescription** offer) {
   return pipeline;
 }
 
-// Takes `pipeline` to NULL as pfap-web's close_session does, its receive bins detached from
+// Takes `pipeline` to NULL as pfap-web's close_session does, its transport bins detached from
 // ICE first; changes the state of each ICE transport, as libnice may before webrtcbin is
-// disposed; unrefs the pipeline. Returns how many of its receive bins were left (not
+// disposed; unrefs the pipeline. Returns how many of its transport bins were left (not
 // finalized).
 int bins_left_after_close(GstElement* pipeline) {
   GstElement* webrtc = webrtc_of(pipeline);
-  std::vector<GstElement*> bins = webrtc_receive_bins::receive_bins(webrtc);
-  std::vector<GObject*> ice = webrtc_receive_bins::ice_transports(webrtc);
+  std::vector<GstElement*> bins = webrtc_transport_bins::transport_bins(webrtc);
+  std::vector<GObject*> ice = webrtc_transport_bins::ice_transports(webrtc);
   EXPECT_FALSE(bins.empty());
   EXPECT_FALSE(ice.empty());
   int finalized = 0;
@@ -107,7 +108,7 @@ int bins_left_after_close(GstElement* pipeline) {
     g_object_weak_ref(G_OBJECT(bin), count_finalized, &finalized);
     gst_object_unref(bin);
   }
-  EXPECT_EQ(detach_receive_bins_from_ice(webrtc), bins.size());
+  EXPECT_EQ(detach_transport_bins_from_ice(webrtc), bins.size());
   EXPECT_EQ(gst_element_set_state(pipeline, GST_STATE_NULL), GST_STATE_CHANGE_SUCCESS);
   for (GObject* transport : ice) g_object_notify(transport, "state");
   gst_object_unref(pipeline);
@@ -115,29 +116,60 @@ int bins_left_after_close(GstElement* pipeline) {
   return static_cast<int>(bins.size()) - finalized;
 }
 
-// A page's session: the answer set on both sides.
-TEST(WebRtcReceiveBins, AnIceStateChangeAfterNullLeavesNoReceiveBinOnceAnswered) {
+// A page's session: pfap-web's offer and the page's answer, each set on both sides. False
+// (with a failure) if either did not come.
+bool answered(GstElement** offerer, GstElement** answerer) {
   GstWebRTCSessionDescription* offer = nullptr;
-  GstElement* offerer = offering(&offer);
-  ASSERT_NE(offerer, nullptr);
-  ASSERT_NE(offer, nullptr);
-  GstElement* answerer = launch(kAnswerer);
-  ASSERT_NE(answerer, nullptr);
-  gst_element_set_state(answerer, GST_STATE_PLAYING);
-  set_remote(webrtc_of(answerer), offer);
+  *offerer = offering(&offer);
+  *answerer = launch(kAnswerer);
+  if (*offerer == nullptr || offer == nullptr || *answerer == nullptr) {
+    ADD_FAILURE() << "no offer";
+    return false;
+  }
+  gst_element_set_state(*answerer, GST_STATE_PLAYING);
+  set_remote(webrtc_of(*answerer), offer);
   gst_webrtc_session_description_free(offer);
   GstWebRTCSessionDescription* answer =
-      create_and_set_local(webrtc_of(answerer), "create-answer", "answer");
-  ASSERT_NE(answer, nullptr);
-  set_remote(webrtc_of(offerer), answer);
+      create_and_set_local(webrtc_of(*answerer), "create-answer", "answer");
+  if (answer == nullptr) {
+    ADD_FAILURE() << "no answer";
+    return false;
+  }
+  set_remote(webrtc_of(*offerer), answer);
   gst_webrtc_session_description_free(answer);
+  return true;
+}
+
+TEST(WebRtcTransportBins, AnIceStateChangeAfterNullLeavesNoReceiveBinOnceAnswered) {
+  GstElement *offerer = nullptr, *answerer = nullptr;
+  ASSERT_TRUE(answered(&offerer, &answerer));
   EXPECT_EQ(bins_left_after_close(offerer), 0);
   EXPECT_EQ(bins_left_after_close(answerer), 0);
 }
 
+// The ICE transport can outlive webrtcbin (here the test holds it, as libnice's thread may
+// while it emits): a state change then must not reach a freed send bin (without the detach,
+// a crash in the normal build, and AddressSanitizer's SEGV in the sanitizer build).
+TEST(WebRtcTransportBins, AnIceStateChangeAfterTheSessionReachesNoFreedSendBin) {
+  GstElement *offerer = nullptr, *answerer = nullptr;
+  ASSERT_TRUE(answered(&offerer, &answerer));
+  for (GstElement* pipeline : {offerer, answerer}) {
+    GstElement* webrtc = webrtc_of(pipeline);
+    std::vector<GObject*> ice = webrtc_transport_bins::ice_transports(webrtc);
+    EXPECT_FALSE(ice.empty());
+    detach_transport_bins_from_ice(webrtc);
+    gst_element_set_state(pipeline, GST_STATE_NULL);
+    gst_object_unref(pipeline);
+    for (GObject* transport : ice) {
+      g_object_notify(transport, "state");
+      g_object_unref(transport);
+    }
+  }
+}
+
 // A session that never has its answer (pfap-web closes it after --connect-timeout): the
 // receive bin starts blocked, and the handler blocks it again as well.
-TEST(WebRtcReceiveBins, AnIceStateChangeAfterNullLeavesNoReceiveBinOfAnOfferNotAnswered) {
+TEST(WebRtcTransportBins, AnIceStateChangeAfterNullLeavesNoReceiveBinOfAnOfferNotAnswered) {
   GstWebRTCSessionDescription* offer = nullptr;
   GstElement* offerer = offering(&offer);
   ASSERT_NE(offerer, nullptr);
