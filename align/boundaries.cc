@@ -99,11 +99,16 @@ std::vector<bool> pause_frames(const std::vector<tts::SpokenPhoneme>& phonemes, 
 
 namespace {
 
-// A recording's 5 ms blocks, loud or silent as snap_to_silence() (boundaries.h) hears them, and
-// where a sound after a pause starts among them.
+// The length of the blocks whose levels snap_to_silence() hears, and a length in whole blocks.
+constexpr unsigned kBlockMs = 5;
+constexpr long blocks_in(unsigned ms) { return static_cast<long>(ms / kBlockMs); }
+
+// A recording's kBlockMs blocks, loud or silent as snap_to_silence() (boundaries.h) hears them,
+// and where a sound after a pause starts among them.
 class Silence {
  public:
-  Silence(std::span<const int16_t> audio, unsigned rate) : rate_(rate), block_(rate / 200) {
+  Silence(std::span<const int16_t> audio, unsigned rate)
+      : rate_(rate), block_(rate * kBlockMs / 1000) {
     const size_t n = block_ > 0 ? audio.size() / block_ : 0;
     if (n < 2 * kMinQuietBlocks) return;
     db_.resize(n);
@@ -140,7 +145,7 @@ class Silence {
   // The first edge into sound within kMaxHumMs after block `b`, when `b` starts a silence.
   long next_onset(long b) const {
     if (b < 1 || quiet_blocks(b, 1) < kMinQuietBlocks) return -1;
-    for (long e = b + 1; e < blocks() && e - b <= kMaxHumMs / 5; ++e) {
+    for (long e = b + 1; e < blocks() && e - b <= blocks_in(kMaxHumMs); ++e) {
       if (begins_at(e)) return e;
     }
     return -1;
@@ -166,7 +171,7 @@ class Silence {
   double sound_end(const tts::SpokenPhoneme& sound, long b) const {
     long end = b;
     if (is_stop(sound)) {
-      for (long e = b + 1; e < blocks() && e - b <= kMaxStopReleaseMs / 5; ++e) {
+      for (long e = b + 1; e < blocks() && e - b <= blocks_in(kMaxStopReleaseMs); ++e) {
         if (ends_at(e)) end = e;
       }
     }
@@ -174,7 +179,7 @@ class Silence {
   }
 
  private:
-  static constexpr size_t kMinQuietBlocks = kMinSilenceMs / 5;
+  static constexpr size_t kMinQuietBlocks = blocks_in(kMinSilenceMs);
 
   bool loud(long b) const { return db_[static_cast<size_t>(b)] >= threshold_; }
 
@@ -187,8 +192,7 @@ class Silence {
   // From the edge at block `b`: the edge after the hum that `b` starts, or `b` when what
   // follows it is louder or goes on without silence.
   long past_hum(long b) const {
-    constexpr long kMaxHumBlocks = kMaxHumMs / 5;
-    for (long e = b; e < blocks() && e - b <= kMaxHumBlocks; ++e) {
+    for (long e = b; e < blocks() && e - b <= blocks_in(kMaxHumMs); ++e) {
       if (db_[static_cast<size_t>(e)] >= loudest_ - kHumBelowLoudestDb) return b;
       const auto quiet = static_cast<long>(quiet_blocks(e, 1));
       if (quiet >= static_cast<long>(kMinQuietBlocks)) {
@@ -204,7 +208,7 @@ class Silence {
   // before it (the median of its blocks, digital silence left out), at most kMaxRiseMs back.
   long rise_start(long b) const {
     std::vector<float> before;
-    for (long e = std::max(0L, b - static_cast<long>(kSnapRadiusMs / 5)); e < b; ++e) {
+    for (long e = std::max(0L, b - blocks_in(kSnapRadiusMs)); e < b; ++e) {
       const float d = db_[static_cast<size_t>(e)];
       if (d < threshold_ && d > loudest_ - kFloorRangeDb) before.push_back(d);
     }
@@ -212,9 +216,8 @@ class Silence {
     std::nth_element(before.begin(), before.begin() + static_cast<long>(before.size() / 2),
                      before.end());
     const float rising = before[before.size() / 2] + kOnsetRiseDb;
-    constexpr long kMaxRiseBlocks = kMaxRiseMs / 5;
     long e = b;
-    while (e > 0 && b - e < kMaxRiseBlocks && db_[static_cast<size_t>(e - 1)] >= rising) --e;
+    while (e > 0 && b - e < blocks_in(kMaxRiseMs) && db_[static_cast<size_t>(e - 1)] >= rising) --e;
     return e > 0 && db_[static_cast<size_t>(e - 1)] < rising ? e : b;  // else no silence before
   }
 
@@ -228,7 +231,6 @@ class Silence {
 
 void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
                      std::span<const int16_t> audio, unsigned rate, std::vector<double>& starts) {
-  constexpr long kRadiusBlocks = kSnapRadiusMs / 5;
   const Silence silence(audio, rate);
   if (silence.empty()) return;
   const auto block = static_cast<double>(silence.block());
@@ -238,7 +240,7 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
     if (!speech_ends && !speech_begins) continue;
     // The edge between blocks b - 1 and b nearest the warp's boundary.
     const long at = std::lround(starts[k - 1] / block);
-    for (long d = 0; d <= kRadiusBlocks; ++d) {
+    for (long d = 0; d <= blocks_in(kSnapRadiusMs); ++d) {
       long found = -1;
       for (long b : {at - d, at + d}) {
         if (speech_ends ? silence.ends_at(b) : silence.begins_at(b)) {
@@ -248,7 +250,7 @@ void snap_to_silence(const std::vector<tts::SpokenPhoneme>& phonemes,
       }
       // The warp can put the first sound in the silence before it, at a hum quieter than the
       // threshold, farther than the radius: it starts at the next edge.
-      if (found < 0 && d == kRadiusBlocks && speech_begins && k == 1) {
+      if (found < 0 && d == blocks_in(kSnapRadiusMs) && speech_begins && k == 1) {
         found = silence.next_onset(at);
       }
       if (found >= 0) {

@@ -57,6 +57,7 @@
 #include "sent_pfap.h"
 #include "speech_level.h"
 #include "speech_opus.h"
+#include "webrtc_transport_bins.h"
 
 namespace {
 
@@ -678,6 +679,11 @@ void close_session(const std::shared_ptr<Session>& s) {
     gst_promise_unref(s->answer_set);
     s->answer_set = nullptr;
   }
+  // A change of ICE state after the bin's NULL would block it the same way, and one after
+  // webrtcbin's disposal would reach its freed send bins: both follow their ICE transport
+  // from handlers that webrtcbin 1.22 never disconnects. So the handlers go first
+  // (webrtc_transport_bins.h).
+  detach_transport_bins_from_ice(s->webrtc);
   gst_element_set_state(s->pipeline, GST_STATE_NULL);
   if (watch != nullptr) watch->now("the main loop");
   gst_bus_remove_watch(GST_ELEMENT_BUS(s->pipeline));
