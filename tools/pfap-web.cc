@@ -683,8 +683,7 @@ void close_session(const std::shared_ptr<Session>& s) {
   // webrtcbin's disposal would reach its freed send bins: both follow their ICE transport
   // from handlers that webrtcbin 1.22 never disconnects. So the handlers go first
   // (webrtc_transport_bins.h).
-  detach_transport_bins_from_ice(s->webrtc);
-  gst_element_set_state(s->pipeline, GST_STATE_NULL);
+  stop_webrtc_pipeline(s->pipeline, s->webrtc);
   if (watch != nullptr) watch->now("the main loop");
   gst_bus_remove_watch(GST_ELEMENT_BUS(s->pipeline));
   if (s->speaker_mixer_pad != nullptr) gst_object_unref(s->speaker_mixer_pad);

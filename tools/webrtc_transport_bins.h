@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // webrtcbin's transport bins against its ICE transports, before its pipeline goes to NULL
-// (docs/performance.md, "Sessions that come and go"). Used by pfap-web's close_session.
+// (docs/performance.md, "Sessions that come and go"). pfap-web's close_session stops its
+// pipeline with stop_webrtc_pipeline, and so does the test (tests/web).
 //
 // Each receive and send bin of webrtcbin 1.22 (TransportReceiveBin, TransportSendBin:
 // gst-plugins-bad's ext/webrtc/transportreceivebin.c and transportsendbin.c) connects a
@@ -93,12 +94,11 @@ inline std::vector<GstElement*> transport_bins(GstElement* webrtc) {
   return bins;
 }
 
-}  // namespace webrtc_transport_bins
-
 // Disconnects every handler on `webrtc`'s ICE transports whose data is one of its transport
 // bins, so that no ICE state change can block a receive bin after its NULL or reach a send bin
-// after its disposal. Called before the pipeline goes to NULL, on a webrtcbin that is not to
-// play again (its bins no longer follow ICE). Returns how many handlers it disconnected.
+// after its disposal. For a webrtcbin that is not to play again (its bins no longer follow ICE),
+// just before its pipeline goes to NULL (stop_webrtc_pipeline). Returns how many handlers it
+// disconnected.
 //
 // A handler that another thread has already entered runs to its end: it blocks a receive bin
 // for good only if its few instructions end after the bin's READY to NULL, which comes after
@@ -106,9 +106,9 @@ inline std::vector<GstElement*> transport_bins(GstElement* webrtc) {
 // stand still inside the handler for all of it. A bin that webrtcbin's thread makes after this
 // call keeps its handler: that takes a session closed while webrtcbin is still making its
 // offer, before a peer could have answered.
-inline guint detach_transport_bins_from_ice(GstElement* webrtc) {
-  std::vector<GObject*> ice = webrtc_transport_bins::ice_transports(webrtc);
-  std::vector<GstElement*> bins = webrtc_transport_bins::transport_bins(webrtc);
+inline guint detach_from_ice(GstElement* webrtc) {
+  std::vector<GObject*> ice = ice_transports(webrtc);
+  std::vector<GstElement*> bins = transport_bins(webrtc);
   guint disconnected = 0;
   for (GObject* transport : ice) {
     for (GstElement* bin : bins) {
@@ -118,5 +118,16 @@ inline guint detach_transport_bins_from_ice(GstElement* webrtc) {
     g_object_unref(transport);
   }
   for (GstElement* bin : bins) gst_object_unref(bin);
+  return disconnected;
+}
+
+}  // namespace webrtc_transport_bins
+
+// Takes `pipeline`, which holds `webrtc` and is not to play again, to NULL, `webrtc`'s
+// transport bins detached from its ICE transports first. Returns how many handlers it
+// disconnected.
+inline guint stop_webrtc_pipeline(GstElement* pipeline, GstElement* webrtc) {
+  guint disconnected = webrtc_transport_bins::detach_from_ice(webrtc);
+  gst_element_set_state(pipeline, GST_STATE_NULL);
   return disconnected;
 }

@@ -4,8 +4,8 @@
 // reaches no freed send bin (docs/performance.md, "Sessions that come and go"). Two webrtcbins
 // in one process make the offer and the answer as pfap-web and a page do; the ICE state change
 // that libnice would make on some thread, by luck, is emitted here by hand (g_object_notify on
-// the public ICE transports). Without detach_transport_bins_from_ice every receive bin is left,
-// and the send bins' handler runs on freed memory. No ICE candidate is exchanged, so nothing
+// the public ICE transports). Without the detach in stop_webrtc_pipeline every receive bin is
+// left, and the send bins' handler runs on freed memory. No ICE candidate is exchanged, so nothing
 // is sent; the test still runs in a network namespace with only lo (unshare -n, as root;
 // skipped elsewhere), as every WebRTC test does, so that ICE gathers on lo alone.
 #include <gst/gst.h>
@@ -93,10 +93,9 @@ GstElement* offering(GstWebRTCSessionDescription** offer) {
   return pipeline;
 }
 
-// Takes `pipeline` to NULL as pfap-web's close_session does, its transport bins detached from
-// ICE first; changes the state of each ICE transport, as libnice may before webrtcbin is
-// disposed; unrefs the pipeline. Returns how many of its transport bins were left (not
-// finalized).
+// Takes `pipeline` to NULL as pfap-web's close_session does (stop_webrtc_pipeline); changes
+// the state of each ICE transport, as libnice may before webrtcbin is disposed; unrefs the
+// pipeline. Returns how many of its transport bins were left (not finalized).
 int bins_left_after_close(GstElement* pipeline) {
   GstElement* webrtc = webrtc_of(pipeline);
   std::vector<GstElement*> bins = webrtc_transport_bins::transport_bins(webrtc);
@@ -108,8 +107,8 @@ int bins_left_after_close(GstElement* pipeline) {
     g_object_weak_ref(G_OBJECT(bin), count_finalized, &finalized);
     gst_object_unref(bin);
   }
-  EXPECT_EQ(detach_transport_bins_from_ice(webrtc), bins.size());
-  EXPECT_EQ(gst_element_set_state(pipeline, GST_STATE_NULL), GST_STATE_CHANGE_SUCCESS);
+  EXPECT_EQ(stop_webrtc_pipeline(pipeline, webrtc), bins.size());
+  EXPECT_EQ(GST_STATE(pipeline), GST_STATE_NULL);
   for (GObject* transport : ice) g_object_notify(transport, "state");
   gst_object_unref(pipeline);
   for (GObject* transport : ice) g_object_unref(transport);
@@ -157,8 +156,7 @@ TEST(WebRtcTransportBins, AnIceStateChangeAfterTheSessionReachesNoFreedSendBin) 
     GstElement* webrtc = webrtc_of(pipeline);
     std::vector<GObject*> ice = webrtc_transport_bins::ice_transports(webrtc);
     EXPECT_FALSE(ice.empty());
-    detach_transport_bins_from_ice(webrtc);
-    gst_element_set_state(pipeline, GST_STATE_NULL);
+    stop_webrtc_pipeline(pipeline, webrtc);
     gst_object_unref(pipeline);
     for (GObject* transport : ice) {
       g_object_notify(transport, "state");
