@@ -44,65 +44,30 @@ const VisemeModel& VisemeModel::builtin() {
 }
 
 std::unique_ptr<VisemeModel> VisemeModel::from_numbers(std::span<const float> n) {
-  auto model = std::make_unique<VisemeModel>();
-  while (!n.empty() && model->networks_.size() < kMaxVisemeNetworks) {
-    size_t used = 0;
-    std::optional<VisemeNetwork> network = VisemeNetwork::from_numbers(n, &used);
-    if (!network) return nullptr;
-    model->networks_.push_back(std::move(*network));
-    n = n.subspan(used);
-  }
-  if (model->networks_.empty() || !n.empty()) return nullptr;
-  return model;
-}
-
-size_t VisemeModel::weights() const {
-  size_t sum = 0;
-  for (const VisemeNetwork& network : networks_) sum += network.weights();
-  return sum;
-}
-
-std::optional<VisemeNetwork> VisemeNetwork::from_numbers(std::span<const float> n, size_t* used) {
   auto whole = [](float v, size_t low, size_t high) {
     return v >= static_cast<float>(low) && v <= static_cast<float>(high) && v == std::floor(v);
   };
   if (n.size() < kHeader || n[0] != kKind || n[1] != kVisemeMfccs ||
       !whole(n[2], 0, kMaxVisemePastFrames) || n[3] != kVisemeAheadFrames || n[6] != kVisemeCount ||
       !whole(n[4], 1, kMaxHiddenUnits) || !whole(n[5], 1, kMaxHiddenUnits)) {
-    return std::nullopt;
+    return nullptr;
   }
-  VisemeNetwork network;
-  network.past_ = static_cast<size_t>(n[2]);
-  const std::array<size_t, 4> sizes = {network.inputs(), static_cast<size_t>(n[4]),
-                                        static_cast<size_t>(n[5]), kVisemeCount};
-  size_t want = kHeader + kNormalization;
-  for (size_t l = 0; l < 3; ++l) want += sizes[l + 1] * (sizes[l] + 1);
-  if (n.size() < want) return std::nullopt;
-  const float* p = n.data() + kHeader;
-  network.normalization_.assign(p, p + kNormalization);
+  auto model = std::make_unique<VisemeModel>();
+  model->past_ = static_cast<size_t>(n[2]);
+  model->hidden1_ = static_cast<size_t>(n[4]);
+  model->hidden2_ = static_cast<size_t>(n[5]);
+  const size_t inputs = model->inputs(), h1 = model->hidden1_, h2 = model->hidden2_;
+  const size_t want = kNormalization + h1 * (inputs + 1) + h2 * (h1 + 1) + kVisemeCount * (h2 + 1);
+  if (n.size() != kHeader + want) return nullptr;
+  model->params_.assign(n.begin() + kHeader, n.end());
+  return model;
+}
+
+void VisemeModel::probabilities(std::span<const float> context, std::span<float> out) const {
+  const float* p = params_.data();
+  const float* mean = p;
+  const float* scale = p + kVisemeMfccs;
   p += kNormalization;
-  for (size_t l = 0; l < 3; ++l) {
-    Layer& layer = network.layers_[l];
-    layer.inputs = sizes[l];
-    layer.outputs = sizes[l + 1];
-    layer.weights.assign(p, p + layer.inputs * layer.outputs);
-    p += layer.weights.size();
-    layer.biases.assign(p, p + layer.outputs);
-    p += layer.outputs;
-  }
-  *used = want;
-  return network;
-}
-
-size_t VisemeNetwork::weights() const {
-  size_t sum = normalization_.size();
-  for (const Layer& layer : layers_) sum += layer.weights.size() + layer.biases.size();
-  return sum;
-}
-
-void VisemeNetwork::probabilities(std::span<const float> context, std::span<float> out) const {
-  const float* mean = normalization_.data();
-  const float* scale = mean + kVisemeMfccs;
   const size_t inputs = this->inputs();
   // On the stack, as large as any model's inputs and layers: no allocation a frame.
   std::array<float, (kMaxVisemePastFrames + 1 + kVisemeAheadFrames) * kVisemeMfccs> x;
@@ -110,20 +75,20 @@ void VisemeNetwork::probabilities(std::span<const float> context, std::span<floa
   for (size_t i = 0; i < inputs; ++i) {
     x[i] = (context[i] - mean[i % kVisemeMfccs]) * scale[i % kVisemeMfccs];
   }
-  // out[r] = b[r] + sum W[r][c] in[c], ReLU but on the last
-  auto apply = [](const Layer& layer, const float* in, float* result, bool relu) {
-    const float* w = layer.weights.data();
-    for (size_t r = 0; r < layer.outputs; ++r) {
-      double sum = layer.biases[r];
-      for (size_t c = 0; c < layer.inputs; ++c) {
-        sum += static_cast<double>(w[r * layer.inputs + c]) * in[c];
-      }
+  // layer: out[r] = b[r] + sum W[r][c] in[c], ReLU but on the last
+  auto layer = [&p](const float* in, size_t n_in, size_t n_out, float* result, bool relu) {
+    const float* w = p;
+    const float* b = p + n_in * n_out;
+    for (size_t r = 0; r < n_out; ++r) {
+      double sum = b[r];
+      for (size_t c = 0; c < n_in; ++c) sum += static_cast<double>(w[r * n_in + c]) * in[c];
       result[r] = relu ? std::max(0.0f, static_cast<float>(sum)) : static_cast<float>(sum);
     }
+    p += n_in * n_out + n_out;
   };
-  apply(layers_[0], x.data(), h1.data(), true);
-  apply(layers_[1], h1.data(), h2.data(), true);
-  apply(layers_[2], h2.data(), out.data(), false);
+  layer(x.data(), inputs, hidden1_, h1.data(), true);
+  layer(h1.data(), hidden1_, hidden2_, h2.data(), true);
+  layer(h2.data(), hidden2_, kVisemeCount, out.data(), false);
   const float top = *std::max_element(out.begin(), out.end());
   double sum = 0;
   for (float& v : out) sum += v = std::exp(v - top);
@@ -132,13 +97,13 @@ void VisemeNetwork::probabilities(std::span<const float> context, std::span<floa
 
 VisemeDetector::VisemeDetector(unsigned rate, size_t max_run_frames, VisemeSmoothing smoothing,
                                const VisemeModel& model)
-    : max_run_frames_(max_run_frames), smoothing_(smoothing), resampler_(rate) {
-  for (const VisemeNetwork& network : model.networks()) {
-    Member member{&network, CepstralMean(network.cepstral_prior()), {}};
-    for (size_t k = 0; k < network.past_frames(); ++k) {
-      member.context.insert(member.context.end(), silence_frame().begin(), silence_frame().end());
-    }
-    members_.push_back(std::move(member));
+    : model_(model),
+      max_run_frames_(max_run_frames),
+      smoothing_(smoothing),
+      resampler_(rate),
+      cepstral_mean_(model.cepstral_prior()) {
+  for (size_t k = 0; k < model.past_frames(); ++k) {
+    context_.insert(context_.end(), silence_frame().begin(), silence_frame().end());
   }
 }
 
@@ -153,7 +118,8 @@ void VisemeDetector::push(std::span<const float> samples, std::vector<VisemeRun>
   resampler_.push(samples, resampled_);
   coefficients_.clear();
   mfcc_.push(resampled_, coefficients_);
-  take_frames(true, out);
+  cepstral_mean_.apply(coefficients_);
+  take_frames(out);
 }
 
 void VisemeDetector::finish(std::vector<VisemeRun>& out) {
@@ -162,44 +128,31 @@ void VisemeDetector::finish(std::vector<VisemeRun>& out) {
   coefficients_.clear();
   mfcc_.push(resampled_, coefficients_);
   mfcc_.finish(coefficients_);
-  take_frames(true, out);
+  cepstral_mean_.apply(coefficients_);
+  take_frames(out);
   // The frames ahead of the last ones are silence.
   while (classified_ < mfcc_.frames()) {
     coefficients_.assign(silence_frame().begin(), silence_frame().end());
-    take_frames(false, out);
+    take_frames(out);
   }
   while (decided_ < classified_) decide(out);
   if (open_.frames > 0) out.push_back(open_);
   open_.frames = 0;
 }
 
-// `heard`: the frames are the stream's (each network's cepstral mean takes its own from them),
-// not the silence after its end.
-void VisemeDetector::take_frames(bool heard, std::vector<VisemeRun>& out) {
+void VisemeDetector::take_frames(std::vector<VisemeRun>& out) {
   for (size_t at = 0; at < coefficients_.size(); at += kVisemeMfccs) {
-    const auto frame = std::span(coefficients_).subspan(at, kVisemeMfccs);
-    for (Member& m : members_) {
-      m.context.insert(m.context.end(), frame.begin(), frame.end());
-      if (heard) m.cepstral_mean.apply(std::span(m.context).last(kVisemeMfccs));
-    }
-    // Every context fills at the same frame: each holds its past before the first.
-    if (members_[0].context.size() < members_[0].network->inputs()) continue;
+    context_.insert(context_.end(), coefficients_.begin() + static_cast<std::ptrdiff_t>(at),
+                    coefficients_.begin() + static_cast<std::ptrdiff_t>(at + kVisemeMfccs));
+    if (context_.size() < model_.inputs()) continue;
     classify(out);
-    for (Member& m : members_) m.context.erase(m.context.begin(), m.context.begin() + kVisemeMfccs);
+    context_.erase(context_.begin(), context_.begin() + kVisemeMfccs);
   }
 }
 
 void VisemeDetector::classify(std::vector<VisemeRun>& out) {
-  // The networks' mean probability of each viseme.
-  std::array<double, kVisemeCount> sum{};
   std::array<float, kVisemeCount> p;
-  for (const Member& m : members_) {
-    m.network->probabilities(m.context, p);
-    for (size_t v = 0; v < kVisemeCount; ++v) sum[v] += p[v];
-  }
-  for (size_t v = 0; v < kVisemeCount; ++v) {
-    p[v] = static_cast<float>(sum[v] / static_cast<double>(members_.size()));
-  }
+  model_.probabilities(context_, p);
   if (trace_ != nullptr) trace_->insert(trace_->end(), p.begin(), p.end());
   probs_.insert(probs_.end(), p.begin(), p.end());
   ++classified_;

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // A frame-level viseme detector for live audio without a text: the 15 Oculus visemes (the
 // MPEG-4 visemes with silence, pfap::Viseme) of each 10 ms frame, from MFCCs with the model's
-// past (160 ms in today's) and 40 ms ahead through small networks whose probabilities are
-// averaged (align/viseme_model.txt, made by tools/viseme-train), smoothed into runs. Live: push audio as it comes, take the runs
+// past (160 ms in today's) and 40 ms ahead through a small network (align/viseme_model.txt,
+// made by tools/viseme-train), smoothed into runs. Live: push audio as it comes, take the runs
 // that are settled; each needs at most kVisemeLookaheadMs of audio after its frames. No
 // GStreamer; web/src/viseme_detector.js is the same in JavaScript. docs/align.md, "A viseme
 // detector".
@@ -10,9 +10,7 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <array>
 #include <memory>
-#include <optional>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -68,13 +66,14 @@ struct VisemeRun {
   Viseme viseme = Viseme::kNone;
 };
 
-// One network of a model (a multilayer perceptron: kVisemeMfccs x the context's frames in,
-// two hidden layers with ReLU, kVisemeCount out), with the normalization it was trained with.
-class VisemeNetwork {
+// The network's weights (a multilayer perceptron: kVisemeMfccs x the context's frames in, two
+// hidden layers with ReLU, kVisemeCount out), read from the text of align/viseme_model.txt.
+class VisemeModel {
  public:
-  // The network whose block (kind 2: header, normalization, layers) starts `numbers`, and in
-  // `*used` how many numbers that block is; nullopt if they do not start with one.
-  static std::optional<VisemeNetwork> from_numbers(std::span<const float> numbers, size_t* used);
+  // The model built into the library (align/viseme_model.txt at build time).
+  static const VisemeModel& builtin();
+  // The model of `numbers` (the file's numbers in order); nullptr if they do not make one.
+  static std::unique_ptr<VisemeModel> from_numbers(std::span<const float> numbers);
 
   // Each viseme's probability for the frame of `context` (past_frames() + 1 +
   // kVisemeAheadFrames frames of kVisemeMfccs, oldest first), into `out` (kVisemeCount).
@@ -82,39 +81,15 @@ class VisemeNetwork {
   size_t past_frames() const { return past_; }
   // The network's inputs: kVisemeMfccs a frame of the context.
   size_t inputs() const { return (past_ + 1 + kVisemeAheadFrames) * kVisemeMfccs; }
-  size_t weights() const;
+  size_t weights() const { return params_.size(); }
   // The training set's mean of c1..c12 over frames of sound: where CepstralMean starts.
   std::span<const float> cepstral_prior() const {
-    return std::span(normalization_).subspan(2 * kVisemeMfccs, kVisemeMfccs - 1);
+    return std::span(params_).subspan(2 * kVisemeMfccs, kVisemeMfccs - 1);
   }
 
  private:
-  struct Layer {
-    size_t inputs = 0, outputs = 0;
-    std::vector<float> weights;  // row-major: a row of inputs per output, as the file
-    std::vector<float> biases;
-  };
-  size_t past_ = 0;
-  std::vector<float> normalization_;  // the inputs' means and scales, the cepstral prior
-  std::array<Layer, 3> layers_;
-};
-
-// The model of align/viseme_model.txt: one network or more, trained apart, whose
-// probabilities the detector averages (docs/align.md, "An ensemble").
-inline constexpr size_t kMaxVisemeNetworks = 8;
-class VisemeModel {
- public:
-  // The model built into the library (align/viseme_model.txt at build time).
-  static const VisemeModel& builtin();
-  // The model of `numbers` (the file's numbers in order: 1 to kMaxVisemeNetworks blocks one
-  // after the other); nullptr if they do not make one.
-  static std::unique_ptr<VisemeModel> from_numbers(std::span<const float> numbers);
-
-  std::span<const VisemeNetwork> networks() const { return networks_; }
-  size_t weights() const;
-
- private:
-  std::vector<VisemeNetwork> networks_;
+  size_t past_ = 0, hidden1_ = 0, hidden2_ = 0;
+  std::vector<float> params_;  // mean, scale, cepstral prior, then W1 b1 W2 b2 W3 b3, row-major
 };
 
 class VisemeDetector {
@@ -138,23 +113,18 @@ class VisemeDetector {
   void trace(std::vector<float>* probabilities) { trace_ = probabilities; }
 
  private:
-  void take_frames(bool heard, std::vector<VisemeRun>& out);
+  void take_frames(std::vector<VisemeRun>& out);
   void classify(std::vector<VisemeRun>& out);
   void decide(std::vector<VisemeRun>& out);
 
-  // Each network's own cepstral mean and context (the last frames' coefficients, oldest
-  // first).
-  struct Member {
-    const VisemeNetwork* network;
-    CepstralMean cepstral_mean;
-    std::vector<float> context;
-  };
+  const VisemeModel& model_;
   size_t max_run_frames_;
   VisemeSmoothing smoothing_;
   Resampler resampler_;
   MfccFrames mfcc_;
-  std::vector<Member> members_;
+  CepstralMean cepstral_mean_;
   std::vector<float> resampled_, coefficients_;
+  std::vector<float> context_;  // the last frames' coefficients, oldest first
   uint64_t classified_ = 0;     // frames whose probabilities are known
   std::vector<float> probs_;    // the last 2 * kSmoothFrames + 1 frames' probabilities
   uint64_t decided_ = 0;

@@ -239,10 +239,7 @@ export declare const OCULUS_VISEME_ALPHABET: 'x-pfap-oculus-viseme';
 export declare const OCULUS_VISEMES: readonly string[];
 export declare const OCULUS_VISEME_TABLE: PhonemeAlphabet;
 export declare const VISEME_LOOKAHEAD_MS: number;
-/** One network of a viseme model: its frames before, its layers' sizes, its numbers. */
-export interface VisemeNetwork { past: number; inputs: number; hidden1: number; hidden2: number; params: Float32Array }
-/** A viseme model: one network or more, whose probabilities the detector averages. */
-export interface VisemeModel { networks: VisemeNetwork[] }
+export interface VisemeModel { hidden1: number; hidden2: number; params: Float32Array }
 export interface VisemeRun { start: number; frames: number; viseme: number }
 export declare function parseVisemeModel(text: string): VisemeModel;
 export declare class VisemeDetector {

@@ -2,9 +2,8 @@
 // The frame-level viseme detector of align/viseme_detector.{h,cc} in JavaScript, step by
 // step the same (tests/web checks that both give the same visemes on the same audio): any
 // rate resampled to 16 kHz, 13 MFCCs of a 25 ms window every 10 ms, c1..c12 less their
-// running mean over the stream, small networks over the model's frames before (16 in today's)
-// and 4 after, their probabilities averaged (align/viseme_model.txt), smoothed into runs of the
-// 15 Oculus visemes. At most 60 ms of audio ahead. docs/align.md, "A viseme detector".
+// running mean over the stream, a small network over the model's frames before (16 in today's) and 4 after
+// (align/viseme_model.txt), smoothed into runs of the 15 Oculus visemes. At most 60 ms of audio ahead. docs/align.md, "A viseme detector".
 
 /** The alphabet of the detector's phonemes: symbol k is Oculus viseme k (= MPEG-4 viseme k). */
 export const OCULUS_VISEME_ALPHABET = 'x-pfap-oculus-viseme';
@@ -253,11 +252,8 @@ const SILENCE_FRAME = (() => {
   return out.slice(0, MFCCS);
 })();
 
-const MAX_NETWORKS = 8;
-
 /**
- * The model of align/viseme_model.txt, from the file's text: one network or more (each a
- * block of kind 2, one after the other), whose probabilities the detector averages.
+ * The network of align/viseme_model.txt, from the file's text.
  * @param {string} text
  */
 export function parseVisemeModel(text) {
@@ -267,28 +263,20 @@ export function parseVisemeModel(text) {
     .map((s) => s.trim())
     .filter((s) => s !== '')
     .map(Number);
-  const refuse = () => new Error('not a viseme model of this version (align/viseme_model.txt)');
-  if (numbers.some((n) => !Number.isFinite(n))) throw refuse();
+  const [kind, mfccs, past, ahead, hidden1, hidden2, visemes] = numbers;
+  const inputs = (past + 1 + AHEAD) * MFCCS;
+  const want = HEADER + NORMALIZATION + hidden1 * (inputs + 1) + hidden2 * (hidden1 + 1) + VISEMES * (hidden2 + 1);
   const whole = (n, low, high) => Number.isInteger(n) && n >= low && n <= high;
-  const networks = [];
-  for (let at = 0; at < numbers.length || networks.length === 0;) {
-    if (networks.length === MAX_NETWORKS) throw refuse();
-    const [kind, mfccs, past, ahead, hidden1, hidden2, visemes] = numbers.slice(at, at + HEADER);
-    if (kind !== KIND || mfccs !== MFCCS || !whole(past, 0, MAX_PAST) || ahead !== AHEAD || visemes !== VISEMES ||
-        !whole(hidden1, 1, 1024) || !whole(hidden2, 1, 1024)) {
-      throw refuse();
-    }
-    const inputs = (past + 1 + AHEAD) * MFCCS;
-    const end = at + HEADER + NORMALIZATION + hidden1 * (inputs + 1) + hidden2 * (hidden1 + 1) + VISEMES * (hidden2 + 1);
-    if (end > numbers.length) throw refuse();
-    networks.push({ past, inputs, hidden1, hidden2, params: Float32Array.from(numbers.slice(at + HEADER, end)) });
-    at = end;
+  if (kind !== KIND || mfccs !== MFCCS || !whole(past, 0, MAX_PAST) || ahead !== AHEAD || visemes !== VISEMES ||
+      !whole(hidden1, 1, 1024) || !whole(hidden2, 1, 1024) ||
+      numbers.length !== want || numbers.some((n) => !Number.isFinite(n))) {
+    throw new Error('not a viseme model of this version (align/viseme_model.txt)');
   }
-  return { networks };
+  return { past, inputs, hidden1, hidden2, params: Float32Array.from(numbers.slice(HEADER)) };
 }
 
-function probabilities(network, context, out) {
-  const { params, inputs, hidden1, hidden2 } = network;
+function probabilities(model, context, out) {
+  const { params, inputs, hidden1, hidden2 } = model;
   let p = NORMALIZATION;
   const x = new Float32Array(inputs);
   for (let i = 0; i < inputs; i++) {
@@ -338,12 +326,9 @@ export class VisemeDetector {
     this.traceTo = trace;
     this.resampler = new Resampler(rate);
     this.mfcc = new MfccFrames();
-    // Each network's own cepstral mean and context (the last frames' coefficients, oldest first).
-    this.members = model.networks.map((network) => {
-      const context = [];
-      for (let k = 0; k < network.past; k++) context.push(...SILENCE_FRAME);
-      return { network, cepstralMean: new CepstralMean(network.params.subarray(2 * MFCCS, NORMALIZATION)), context };
-    });
+    this.cepstralMean = new CepstralMean(model.params.subarray(2 * MFCCS, NORMALIZATION));
+    this.context = [];
+    for (let k = 0; k < model.past; k++) this.context.push(...SILENCE_FRAME);
     this.classified = 0;
     this.probs = [];
     this.decided = 0;
@@ -365,7 +350,8 @@ export class VisemeDetector {
     this.resampler.push(samples, resampled);
     const coefficients = [];
     this.mfcc.push(resampled, coefficients);
-    this.takeFrames(coefficients, true, out);
+    this.cepstralMean.apply(coefficients);
+    this.takeFrames(coefficients, out);
     return out;
   }
 
@@ -377,37 +363,26 @@ export class VisemeDetector {
     const coefficients = [];
     this.mfcc.push(resampled, coefficients);
     this.mfcc.finish(coefficients);
-    this.takeFrames(coefficients, true, out);
-    while (this.classified < this.mfcc.frames) this.takeFrames(SILENCE_FRAME, false, out);
+    this.cepstralMean.apply(coefficients);
+    this.takeFrames(coefficients, out);
+    while (this.classified < this.mfcc.frames) this.takeFrames(SILENCE_FRAME, out);
     while (this.decided < this.classified) this.decide(out);
     if (this.open.frames > 0) out.push(this.open);
     this.open = { start: this.decided, frames: 0, viseme: this.shown };
     return out;
   }
 
-  // heard: the frames are the stream's (each network's cepstral mean takes its own from
-  // them), not the silence after its end.
-  takeFrames(coefficients, heard, out) {
+  takeFrames(coefficients, out) {
     for (let at = 0; at < coefficients.length; at += MFCCS) {
-      for (const m of this.members) {
-        const frame = coefficients.slice(at, at + MFCCS);
-        if (heard) m.cepstralMean.apply(frame);
-        for (let i = 0; i < MFCCS; i++) m.context.push(frame[i]);
-      }
-      // Every context fills at the same frame: each holds its past before the first.
-      if (this.members[0].context.length < this.members[0].network.inputs) continue;
-      const sum = new Float64Array(VISEMES);
+      for (let i = 0; i < MFCCS; i++) this.context.push(coefficients[at + i]);
+      if (this.context.length < this.model.inputs) continue;
       const p = new Float32Array(VISEMES);
-      for (const m of this.members) {
-        probabilities(m.network, m.context, p);
-        for (let v = 0; v < VISEMES; v++) sum[v] += p[v];
-        m.context.splice(0, MFCCS);
-      }
-      for (let v = 0; v < VISEMES; v++) p[v] = f32(sum[v] / this.members.length);
+      probabilities(this.model, this.context, p);
       if (this.traceTo) this.traceTo.push(...p);
       this.probs.push(...p);
       this.classified++;
       if (this.classified > SMOOTH) this.decide(out);
+      this.context.splice(0, MFCCS);
     }
   }
 
