@@ -275,29 +275,35 @@ export function parseVisemeModel(text) {
   return { past, inputs, hidden1, hidden2, params: Float32Array.from(numbers.slice(HEADER)) };
 }
 
+// Each layer's output, kept from frame to frame: the audio thread allocates nothing a frame.
+const scratch = {
+  x: new Float32Array((MAX_PAST + 1 + AHEAD) * MFCCS),
+  h1: new Float32Array(1024),
+  h2: new Float32Array(1024),
+  logits: new Float32Array(VISEMES),
+};
+
 function probabilities(model, context, out) {
   const { params, inputs, hidden1, hidden2 } = model;
   let p = NORMALIZATION;
-  const x = new Float32Array(inputs);
+  const { x, h1, h2, logits } = scratch;
   for (let i = 0; i < inputs; i++) {
     x[i] = f32(context[i] - params[i % MFCCS]) * params[MFCCS + (i % MFCCS)];
   }
-  const layer = (input, nIn, nOut, relu) => {
-    const result = new Float32Array(nOut);
+  const layer = (input, nIn, nOut, relu, result) => {
     const b = p + nIn * nOut;
-    for (let r = 0; r < nOut; r++) {
+    for (let r = 0, w = p; r < nOut; r++, w += nIn) {
       let sum = params[b + r];
-      for (let c = 0; c < nIn; c++) sum += params[p + r * nIn + c] * input[c];
+      for (let c = 0; c < nIn; c++) sum += params[w + c] * input[c];
       result[r] = relu ? Math.max(0, sum) : sum;
     }
     p += nIn * nOut + nOut;
-    return result;
   };
-  const h1 = layer(x, inputs, hidden1, true);
-  const h2 = layer(h1, hidden1, hidden2, true);
-  const logits = layer(h2, hidden2, VISEMES, false);
+  layer(x, inputs, hidden1, true, h1);
+  layer(h1, hidden1, hidden2, true, h2);
+  layer(h2, hidden2, VISEMES, false, logits);
   let top = -Infinity;
-  for (const v of logits) top = Math.max(top, v);
+  for (let v = 0; v < VISEMES; v++) top = Math.max(top, logits[v]);
   let sum = 0;
   for (let v = 0; v < VISEMES; v++) {
     out[v] = f32(Math.exp(logits[v] - top));
@@ -329,6 +335,7 @@ export class VisemeDetector {
     this.cepstralMean = new CepstralMean(model.params.subarray(2 * MFCCS, NORMALIZATION));
     this.context = [];
     for (let k = 0; k < model.past; k++) this.context.push(...SILENCE_FRAME);
+    this.frameProbabilities = new Float32Array(VISEMES);  // the last frame's, copied out
     this.classified = 0;
     this.probs = [];
     this.decided = 0;
@@ -376,7 +383,7 @@ export class VisemeDetector {
     for (let at = 0; at < coefficients.length; at += MFCCS) {
       for (let i = 0; i < MFCCS; i++) this.context.push(coefficients[at + i]);
       if (this.context.length < this.model.inputs) continue;
-      const p = new Float32Array(VISEMES);
+      const p = this.frameProbabilities;
       probabilities(this.model, this.context, p);
       if (this.traceTo) this.traceTo.push(...p);
       this.probs.push(...p);
