@@ -34,6 +34,7 @@ const CUTOFF = 0.45;
 const ZERO_CROSSINGS = 16;
 const AHEAD = 4;
 const MAX_PAST = 100;  // frames before; the model file says how many
+const MAX_HIDDEN = 1024;  // a hidden layer's units at most
 const VISEMES = 15;
 const SMOOTH = 1;
 const HEADER = 7;
@@ -268,7 +269,7 @@ export function parseVisemeModel(text) {
   const want = HEADER + NORMALIZATION + hidden1 * (inputs + 1) + hidden2 * (hidden1 + 1) + VISEMES * (hidden2 + 1);
   const whole = (n, low, high) => Number.isInteger(n) && n >= low && n <= high;
   if (kind !== KIND || mfccs !== MFCCS || !whole(past, 0, MAX_PAST) || ahead !== AHEAD || visemes !== VISEMES ||
-      !whole(hidden1, 1, 1024) || !whole(hidden2, 1, 1024) ||
+      !whole(hidden1, 1, MAX_HIDDEN) || !whole(hidden2, 1, MAX_HIDDEN) ||
       numbers.length !== want || numbers.some((n) => !Number.isFinite(n))) {
     throw new Error('not a viseme model of this version (align/viseme_model.txt)');
   }
@@ -278,8 +279,8 @@ export function parseVisemeModel(text) {
 // Each layer's output, kept from frame to frame: the audio thread allocates nothing a frame.
 const scratch = {
   x: new Float32Array((MAX_PAST + 1 + AHEAD) * MFCCS),
-  h1: new Float32Array(1024),
-  h2: new Float32Array(1024),
+  h1: new Float32Array(MAX_HIDDEN),
+  h2: new Float32Array(MAX_HIDDEN),
   logits: new Float32Array(VISEMES),
 };
 
