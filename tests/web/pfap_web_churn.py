@@ -110,7 +110,9 @@ async def main():
                                 env=dict(os.environ, GST_TRACERS='leaks', GST_DEBUG_NO_COLOR='1',
                                          GST_DEBUG='*:1,GST_TRACER:7'))
     opened, closed = set(), set()
-    alive, err = {}, []
+    # The server's stderr: its last lines, and a sanitizer's report whole from its first line
+    # (a rare leak's stacks are what tell where it comes from).
+    alive, err, report = {}, [], []
 
     def follow():
         for out in server.stdout:
@@ -121,7 +123,11 @@ async def main():
         for out in server.stderr:
             if m := re.search(r'object-alive, type-name=\(string\)(\w+)', out):
                 alive[m.group(1)] = alive.get(m.group(1), 0) + 1
-            elif 'GST_TRACER' not in out:
+            elif 'GST_TRACER' in out:
+                pass
+            elif report or re.match(r'==\d+==ERROR: \w+Sanitizer', out):
+                report.append(out)
+            else:
                 err.append(out)
                 del err[:-20]
     followers = [threading.Thread(target=f, daemon=True) for f in (follow, follow_errors)]
@@ -145,7 +151,7 @@ async def main():
         for f in followers:
             f.join(timeout=10)
         print(f'pfap-web died (exit {server.returncode}) after {len(opened)} sessions:\n'
-              + ''.join(err), file=sys.stderr)
+              + ''.join(err + report), file=sys.stderr)
         sys.exit(1)
 
     async def settled(target=(0, 0)):
@@ -211,7 +217,7 @@ async def main():
           and len(opened) == started and server.returncode == 0)
     if not ok:
         print(f'left behind: sessions {left_open[:20]}', file=sys.stderr)
-        print(''.join(err), file=sys.stderr)
+        print(''.join(err + report), file=sys.stderr)
         sys.exit(1)
 
 
