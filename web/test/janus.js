@@ -192,16 +192,22 @@ export function launchChromium() {
   });
 }
 
-/**
- * Opens `url` in a new page of `browser`, its console and failed loads kept in `.messages`;
- * `timeout` bounds the load (ms; playwright's 30 s by default).
- */
-export async function newPage(browser, url, { timeout } = {}) {
+/** A new blank page of `browser`, its console and failed loads kept in `.messages`. */
+export async function blankPage(browser) {
   const page = await browser.newPage({ viewport: { width: 640, height: 720 } });
   const messages = [];
   page.on('console', (m) => messages.push(m.text()));
   page.on('response', (r) => r.status() >= 400 && messages.push(`${r.status()} ${r.url()}`));
   page.messages = messages;
+  return page;
+}
+
+/**
+ * Opens `url` in `page` (by default a new blank page of `browser`); `timeout` bounds the load
+ * (ms; playwright's 30 s by default).
+ */
+export async function newPage(browser, url, { timeout, page } = {}) {
+  page ??= await blankPage(browser);
   await page.goto(url, { timeout });
   return page;
 }
@@ -212,7 +218,10 @@ export async function watching(page, janus, { timeout = 30000 } = {}) {
     .catch((e) => { throw new Error(`${e.message}\npage: ${page.messages.join('\n')}\njanus: ${janus.out}${janus.log}`); });
 }
 
-/** Opens a viewer page; resolves once it receives the mountpoint's data stream (`timeout` bounds each, ms). */
+/**
+ * Opens a viewer page (in `page`, a blank page made beforehand, if given); resolves once it
+ * receives the mountpoint's data stream (`timeout` bounds each, ms).
+ */
 export async function openViewer(browser, pageServer, janus, options = {}) {
   const { port } = pageServer.address();
   const page = await newPage(browser, `http://127.0.0.1:${port}/broadcast/?janus=http://127.0.0.1:${JANUS_PORT}/janus`, options);
