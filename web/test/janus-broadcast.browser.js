@@ -14,9 +14,8 @@ import { writeFileSync } from 'node:fs';
 import { after, before, test } from 'node:test';
 
 import {
-  blankPage, COMPLETE_INTERVAL_MS, DATA_PORT, describeFds, exited, figures, launchChromium, openViewer, resources, servePages,
-  settledResources,
-  startJanus, startSender, stop, watching,
+  blankPage, COMPLETE_INTERVAL_MS, DATA_PORT, describeFds, exited, figures, launchChromium, openViewer, received, resources,
+  servePages, settledResources, startJanus, startSender, stop, watching,
 } from './janus.js';
 
 // Sharp onsets after silence for the lip-sync measurement (each "pa" sounds as its closed
@@ -82,9 +81,9 @@ test('three viewers through Janus, a tenth of the PFAP datagrams dropped before 
   const started = Date.now();
   let senderEndedMs = null;
   exited(sender).then(() => { senderEndedMs = Date.now() - started; });
-  // Bad input on the data port, as from a confused or hostile sender: each page drops both
-  // messages whole, counts them, and goes on.
-  await new Promise((r) => setTimeout(r, 1000));
+  // Bad input on the data port 1 s into the speech (12 phonemes a second), as from a confused
+  // or hostile sender: each page drops both messages whole, counts them, and goes on.
+  await received(viewers[0], 12);
   const socket = dgram.createSocket('udp4');
   // A level message cut short: its header counts 50 levels, 10 follow.
   const truncatedLevel = Buffer.from([1, 0, 0, 50, 1, 2, 3, 4, 0, 0, 0, 0, ...new Array(10).fill(100)]);
@@ -93,7 +92,7 @@ test('three viewers through Janus, a tenth of the PFAP datagrams dropped before 
   }
   socket.close();
   // A fourth joins 1.5 s into the speech.
-  await new Promise((r) => setTimeout(r, 500));
+  await received(viewers[0], 18);
   const late = await openViewer(browser, pageServer, janus, { page: latePage });
   const lateJoin = `the late joiner watching ${Date.now() - started} ms after the sender started, ` +
     `which ended ${senderEndedMs === null ? 'later' : `after ${senderEndedMs} ms`}`;
@@ -141,7 +140,7 @@ test('a viewer drops mid-sentence and rejoins: whole again within a complete-sta
   const open = () => openViewer(browser, pageServer, janus);
   const viewers = await Promise.all([open(), open(), open()]);
   const sender = startSender(TEXT);
-  await new Promise((r) => setTimeout(r, 2500));
+  await received(viewers[2], 30);  // 2.5 s into the text
   // The third reloads, as a viewer whose tab is reloaded: janus.js destroys its session as the
   // page unloads (its handle, PeerConnection and data channel go), and the new page watches
   // the mountpoint afresh, mid-sentence.
@@ -175,7 +174,7 @@ test('the sender restarts mid-sentence: each viewer takes the new stream and end
   const open = () => openViewer(browser, pageServer, janus);
   const viewers = await Promise.all([open(), open()]);
   const first = startSender(TEXT);
-  await new Promise((r) => setTimeout(r, 2500));
+  await received(viewers[0], 30);  // 2.5 s into the text
   assert.equal(await stop(first), 0, first.log);  // SIGTERM mid-sentence: it stops cleanly
   const second = startSender('Hello again. <FAP 2 1 40 0 0 500 1> I am back, pa. pa.', ['--drop=0.1', '--seed=5']);
   const all = await Promise.all(viewers.map((page) => figures(page)));
@@ -195,7 +194,7 @@ test('Janus restarts mid-sentence: each viewer watches again and ends whole with
   const open = () => openViewer(browser, pageServer, janus);
   const viewers = await Promise.all([open(), open()]);
   const sender = startSender(TEXT);
-  await new Promise((r) => setTimeout(r, 2000));
+  await received(viewers[0], 24);  // 2 s into the text
   const senderBefore = resources(sender.pid, { pipes: false });
   // Killed, as a crash ends it: Debian's Janus 1.1.2 stopped by SIGTERM while viewers' data
   // channels are open died of SIGFPE in its SCTP teardown in 1 of 8 runs (docs/web.md,

@@ -230,6 +230,16 @@ export async function openViewer(browser, pageServer, janus, options = {}) {
 }
 
 /**
+ * Resolves once the viewer page has received `phonemes` phonemes of the stream. The tests time
+ * what they do mid-speech by it, not by the clock: a loaded machine's sender can take seconds
+ * to begin (a fresh root's sanitizer build once had not sent its first packet 2.5 s in).
+ */
+export async function received(page, phonemes, { timeout = 30000 } = {}) {
+  await page.waitForFunction((n) => window.pfapStats.phonemes >= n, phonemes, { timeout, polling: 50 })
+    .catch(async (e) => { throw new Error(`${e.message}\n${JSON.stringify(await page.evaluate(() => window.pfapStats))}`); });
+}
+
+/**
  * Waits until the page has the sender's state at the end and has played the audio past the
  * last phoneme (pfap-web's page and the viewer page alike); its figures (lip sync measured).
  * The page then leaves as a viewer closing the tab does: navigating away runs its unload
