@@ -67,8 +67,8 @@ constexpr const char* kDefaultText =
     "data channel, in step with it. <FAP 2 1 50 0 0 800 3> Type something for me to say!";
 constexpr uint32_t kAudioClockRate = 48000;  // Opus's RTP clock rate, whatever the audio's
 constexpr uint32_t kPfapClockRate = 44100;   // the draft's default
-// A new text starts this far ahead of the running time it is added at, so that its first
-// audio reaches the mixer in time (the mixer drops what comes after its output has passed).
+// A new text starts this far ahead of the running time its first audio is made at, so that
+// the audio reaches the mixer in time (the mixer drops what comes after its output has passed).
 constexpr GstClockTime kSpeakLead = 300 * GST_MSECOND;
 // PFAP packets go this far ahead of their time: the page holds their events until the audio
 // reaches them, and what comes late is drawn late.
@@ -467,6 +467,38 @@ void send_envelope(Session& s, GstClockTime start, const std::vector<int64_t>& l
   finish(s, b);
 }
 
+// When a text starts: kSpeakLead of running time after its first audio is ready for the mixer
+// (or the speaker ends without any), not after the text is asked for. A start fixed when it
+// was asked for lost a short text's audio whole when the speaker took longer than the lead to
+// begin (three sessions starting at once in the sanitizer build, where the first audio's
+// conversion and negotiation took over a second): the mixer dropped it as late, while the
+// PFAP stream went on (docs/web.md, Timing). Both of the speaker's branches get the same pad
+// offset then; its PFAP branch is held until they have.
+struct SpeechStart {
+  GstElement* speaker;  // the speaker bin and its ghost pads, which outlive its data flow
+  GstPad* audio;
+  GstPad* pfap;
+  gulong pfap_hold;
+};
+
+GstPadProbeReturn hold(GstPad*, GstPadProbeInfo*, gpointer) { return GST_PAD_PROBE_OK; }
+
+GstPadProbeReturn on_speaker_audio(GstPad*, GstPadProbeInfo* info, gpointer data) {
+  if ((info->type & GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM) != 0 &&
+      GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) != GST_EVENT_EOS) {
+    return GST_PAD_PROBE_OK;
+  }
+  const auto& start = *static_cast<SpeechStart*>(data);
+  GstClock* clock = gst_element_get_clock(start.speaker);
+  if (clock == nullptr) return GST_PAD_PROBE_OK;  // not in the playing pipeline (yet)
+  const GstClockTime now = gst_clock_get_time(clock) - gst_element_get_base_time(start.speaker);
+  gst_object_unref(clock);
+  gst_pad_set_offset(start.audio, static_cast<gint64>(now + kSpeakLead));
+  gst_pad_set_offset(start.pfap, static_cast<gint64>(now + kSpeakLead));
+  gst_pad_remove_probe(start.pfap, start.pfap_hold);
+  return GST_PAD_PROBE_REMOVE;
+}
+
 // Starts saying `text` now, or after the text being said.
 void say(Session& s, const std::string& text) {
   if (s.speaker != nullptr || !s.audio_flowing) {
@@ -498,18 +530,23 @@ void say(Session& s, const std::string& text) {
   GstPad* pfap = ghost("pfap");
   gst_pad_add_probe(audio, GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM, on_speaker_eos, nullptr, nullptr);
   gst_pad_add_probe(pfap, GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM, on_pfap_eos, nullptr, nullptr);
-  // Both start kSpeakLead from now in running time: the timestamps of the audio the mixer
-  // sends and of the PFAP packets come from the same running time.
-  GstClock* clock = gst_element_get_clock(s.pipeline);
-  const GstClockTime now = gst_clock_get_time(clock) - gst_element_get_base_time(s.pipeline);
-  gst_object_unref(clock);
-  gst_pad_set_offset(audio, static_cast<gint64>(now + kSpeakLead));
-  gst_pad_set_offset(pfap, static_cast<gint64>(now + kSpeakLead));
-  // Its level, as early as the speaker makes it (the queue before the mixer fills ahead).
+  // Both branches start from the same running time, decided as the first audio, converted,
+  // enters the queue before the mixer: the timestamps of the audio the mixer sends and of the
+  // PFAP packets agree.
   GstElement* queue = gst_bin_get_by_name(GST_BIN(speaker), "audio");
   GstPad* queue_sink = gst_element_get_static_pad(queue, "sink");
+  auto* start = new SpeechStart{speaker, audio, pfap, 0};
+  start->pfap_hold = gst_pad_add_probe(pfap, GST_PAD_PROBE_TYPE_BLOCK_DOWNSTREAM, hold, nullptr,
+                                       nullptr);
+  GstPad* converted = gst_pad_get_peer(queue_sink);
+  gst_pad_add_probe(
+      converted, GstPadProbeType(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM),
+      on_speaker_audio, start, [](gpointer data) { delete static_cast<SpeechStart*>(data); });
+  gst_object_unref(converted);
+  // Its level, as early as the speaker makes it (the queue before the mixer fills ahead), from
+  // the start above (its pad's probe sees each buffer first).
   add_speech_level_probe(
-      queue_sink, now + kSpeakLead,
+      queue_sink, audio,
       [session = s.weak_from_this()](GstClockTime start, std::vector<int64_t> levels) {
         if (std::shared_ptr<Session> locked = session.lock()) {
           post(locked, [start, levels = std::move(levels)](Session& s) {
@@ -531,7 +568,6 @@ void say(Session& s, const std::string& text) {
 
   JsonBuilder* b = message("saying");
   member(b, "text", text.c_str());
-  member(b, "runningTimeNs", static_cast<int64_t>(now + kSpeakLead));
   finish(s, b);
 }
 

@@ -111,11 +111,12 @@ using SpeechLevelSend = std::function<void(GstClockTime start, std::vector<int64
 
 // Takes the level of the S16 mono 48 kHz audio passing `pad` and calls `send` on its streaming
 // thread with each kLevelsPerMessage ms of it, and the rest at EOS; silent batches are not
-// sent. The running times are the pad's plus `offset` (a pad offset further downstream).
-inline void add_speech_level_probe(GstPad* pad, GstClockTime offset, SpeechLevelSend send) {
+// sent. The running times are the pad's plus the pad offset of `offset_pad` (a pad further
+// downstream, or nullptr for none) as it is when the first buffer passes.
+inline void add_speech_level_probe(GstPad* pad, GstPad* offset_pad, SpeechLevelSend send) {
   struct Probe {
     SpeechLevelSend send;
-    GstClockTime offset = 0;
+    GstPad* offset_pad = nullptr;
     GstClockTime start = GST_CLOCK_TIME_NONE;  // running time of the first level waiting
     SpeechLevel level;
 
@@ -139,7 +140,7 @@ inline void add_speech_level_probe(GstPad* pad, GstClockTime offset, SpeechLevel
     if (p.start == GST_CLOCK_TIME_NONE) {
       const GstClockTime running = running_time_of(pad, buffer);
       if (running == GST_CLOCK_TIME_NONE) return GST_PAD_PROBE_OK;
-      p.start = running + p.offset;
+      p.start = running + (p.offset_pad != nullptr ? gst_pad_get_offset(p.offset_pad) : 0);
     }
     GstMapInfo map;
     if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) return GST_PAD_PROBE_OK;
@@ -150,8 +151,12 @@ inline void add_speech_level_probe(GstPad* pad, GstClockTime offset, SpeechLevel
   };
   auto* probe = new Probe;
   probe->send = std::move(send);
-  probe->offset = offset;
+  probe->offset_pad = offset_pad != nullptr ? GST_PAD(gst_object_ref(offset_pad)) : nullptr;
   gst_pad_add_probe(
       pad, GstPadProbeType(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM),
-      on_buffer_or_eos, probe, [](gpointer data) { delete static_cast<Probe*>(data); });
+      on_buffer_or_eos, probe, [](gpointer data) {
+        auto* p = static_cast<Probe*>(data);
+        if (p->offset_pad != nullptr) gst_object_unref(p->offset_pad);
+        delete p;
+      });
 }

@@ -108,7 +108,13 @@ async function openPage(url, { screenshot, next } = {}) {
       return s;
     });
   } catch (e) {
-    throw new Error(`${e.message}\npage: ${messages.join('\n')}`);
+    // The page's figures but its level and frames, with the loudest level it played (0: it
+    // played silence, as when the server's mixer dropped a text's audio as late).
+    const stats = await page.evaluate(() => {
+      const { envelope = [], frames, ...rest } = window.pfapStats ?? {};
+      return JSON.stringify({ ...rest, loudestPlayed: envelope.reduce((m, e) => Math.max(m, e.rms), 0) });
+    }).catch(() => 'none');
+    throw new Error(`${e.message}\nstats: ${stats}\npage: ${messages.join('\n')}`);
   } finally {
     await page.close();
   }
