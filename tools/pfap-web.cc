@@ -473,11 +473,14 @@ void send_envelope(Session& s, GstClockTime start, const std::vector<int64_t>& l
 // begin (three sessions starting at once in the sanitizer build, where the first audio's
 // conversion and negotiation took over a second): the mixer dropped it as late, while the
 // PFAP stream went on (docs/web.md, Timing). Both of the speaker's branches get the same pad
-// offset then; its PFAP branch is held until they have.
+// offset then; its PFAP branch is held until they have, at its queue's source pad, which a
+// pipeline going to NULL sets flushing first, letting the hold go (held at the ghost pad, the
+// queue's thread could not be stopped: a stop hung at a speaker's pipeline going to NULL).
 struct SpeechStart {
-  GstElement* speaker;  // the speaker bin and its ghost pads, which outlive its data flow
-  GstPad* audio;
+  GstElement* speaker;  // the speaker bin and its pads, which outlive its data flow
+  GstPad* audio;        // the ghost pads
   GstPad* pfap;
+  GstPad* pfap_queue;  // the PFAP queue's source pad, held
   gulong pfap_hold;
 };
 
@@ -495,7 +498,7 @@ GstPadProbeReturn on_speaker_audio(GstPad*, GstPadProbeInfo* info, gpointer data
   gst_object_unref(clock);
   gst_pad_set_offset(start.audio, static_cast<gint64>(now + kSpeakLead));
   gst_pad_set_offset(start.pfap, static_cast<gint64>(now + kSpeakLead));
-  gst_pad_remove_probe(start.pfap, start.pfap_hold);
+  gst_pad_remove_probe(start.pfap_queue, start.pfap_hold);
   return GST_PAD_PROBE_REMOVE;
 }
 
@@ -535,9 +538,13 @@ void say(Session& s, const std::string& text) {
   // PFAP packets agree.
   GstElement* queue = gst_bin_get_by_name(GST_BIN(speaker), "audio");
   GstPad* queue_sink = gst_element_get_static_pad(queue, "sink");
-  auto* start = new SpeechStart{speaker, audio, pfap, 0};
-  start->pfap_hold = gst_pad_add_probe(pfap, GST_PAD_PROBE_TYPE_BLOCK_DOWNSTREAM, hold, nullptr,
-                                       nullptr);
+  GstElement* pfap_queue = gst_bin_get_by_name(GST_BIN(speaker), "pfap");
+  GstPad* pfap_queue_src = gst_element_get_static_pad(pfap_queue, "src");
+  auto* start = new SpeechStart{speaker, audio, pfap, pfap_queue_src, 0};
+  start->pfap_hold = gst_pad_add_probe(pfap_queue_src, GST_PAD_PROBE_TYPE_BLOCK_DOWNSTREAM, hold,
+                                       nullptr, nullptr);
+  gst_object_unref(pfap_queue_src);  // the queue keeps it
+  gst_object_unref(pfap_queue);
   GstPad* converted = gst_pad_get_peer(queue_sink);
   gst_pad_add_probe(
       converted, GstPadProbeType(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM),
