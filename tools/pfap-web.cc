@@ -68,8 +68,9 @@ constexpr const char* kDefaultText =
     "data channel, in step with it. <FAP 2 1 50 0 0 800 3> Type something for me to say!";
 constexpr uint32_t kAudioClockRate = 48000;  // Opus's RTP clock rate, whatever the audio's
 constexpr uint32_t kPfapClockRate = 44100;   // the draft's default
-// A new text starts this far ahead of the running time its first audio is made at, so that
-// the audio reaches the mixer in time (the mixer drops what comes after its output has passed).
+// A new text starts this far ahead of the running time its first audio is ready for the mixer
+// at, so that the audio reaches the mixer in time (the mixer drops what comes after its output
+// has passed).
 constexpr GstClockTime kSpeakLead = 300 * GST_MSECOND;
 // PFAP packets go this far ahead of their time: the page holds their events until the audio
 // reaches them, and what comes late is drawn late.
