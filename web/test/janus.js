@@ -236,7 +236,14 @@ export async function openViewer(browser, pageServer, janus, options = {}) {
  */
 export async function received(page, phonemes, { timeout = 30000 } = {}) {
   await page.waitForFunction((n) => window.pfapStats.phonemes >= n, phonemes, { timeout, polling: 50 })
-    .catch(async (e) => { throw new Error(`${e.message}\n${JSON.stringify(await page.evaluate(() => window.pfapStats))}`); });
+    .catch(async (e) => {
+      // The page's figures but its level and frames, as figures() gives them.
+      const stats = await page.evaluate(() => {
+        const { envelope, frames, ...rest } = window.pfapStats;
+        return JSON.stringify(rest);
+      });
+      throw new Error(`${e.message}\n${stats}`);
+    });
 }
 
 /**
