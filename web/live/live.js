@@ -271,6 +271,18 @@ export function start({ canvas, audio, form, input, status, saying }) {
   }
 
   drawInTime({ receiver, canvas, stats, streamNs, drawn: drawnPhonemes });
+  // What reached the page's audio, for a test's failure message: the RTP packets and bytes
+  // received, the energy decoded from them (0: the server sent silence), the AudioContext's
+  // state and how many levels its tap measured (none: it heard nothing at all).
+  stats.receivedAudio = async () => {
+    const received = { context: audioContext?.state ?? null, levels: stats.envelope.length };
+    for (const r of audioReceiver ? (await audioReceiver.getStats()).values() : []) {
+      if (r.type === 'inbound-rtp') {
+        Object.assign(received, { packets: r.packetsReceived, bytes: r.bytesReceived, energy: r.totalAudioEnergy });
+      }
+    }
+    return received;
+  };
   stats.measureLipSync = () => {
     stats.lipSyncErrorsMs = lipSyncErrors(stats.envelope, stats.frames, { sent: clock.sentForMeasurement() });
     stats.lipSyncErrorsPlayedMs = lipSyncErrors(stats.envelope, stats.frames);  // for the figures (docs/web.md)

@@ -109,10 +109,15 @@ async function openPage(url, { screenshot, next } = {}) {
     });
   } catch (e) {
     // The page's figures but its level and frames, with the loudest level it played (0: it
-    // played silence, as when the server's mixer dropped a text's audio as late).
-    const stats = await page.evaluate(() => {
+    // played silence, as when the server's mixer dropped a text's audio as late) and what
+    // reached its audio.
+    const stats = await page.evaluate(async () => {
       const { envelope = [], frames, ...rest } = window.pfapStats ?? {};
-      return JSON.stringify({ ...rest, loudestPlayed: envelope.reduce((m, e) => Math.max(m, e.rms), 0) });
+      return JSON.stringify({
+        ...rest,
+        loudestPlayed: envelope.reduce((m, e) => Math.max(m, e.rms), 0),
+        receivedAudio: await window.pfapStats?.receivedAudio(),
+      });
     }).catch(() => 'none');
     throw new Error(`${e.message}\nstats: ${stats}\npage: ${messages.join('\n')}`);
   } finally {
