@@ -295,7 +295,7 @@ int main(int argc, char** argv) {
     gst_object_unref(pad);
   };
   GstPad* level_pad = gst_element_get_static_pad(by_name("level"), "sink");
-  add_speech_level_probe(level_pad, nullptr, [&s](GstClockTime start, std::vector<int64_t> levels) {
+  add_speech_level_probe(level_pad, [&s](GstClockTime start, std::vector<int64_t> levels) {
     send_levels(s, start, levels);
   });
   gst_object_unref(level_pad);

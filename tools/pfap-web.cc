@@ -483,20 +483,30 @@ void send_envelope(Session& s, GstClockTime start, const std::vector<int64_t>& l
 // begin (three sessions starting at once in the sanitizer build, where the first audio's
 // conversion and negotiation took over a second): the mixer dropped it as late, while the
 // PFAP stream went on (docs/web.md, Timing). Both of the speaker's branches get the same pad
-// offset then; its PFAP branch is held until they have, at its queue's source pad, which a
-// pipeline going to NULL sets flushing first, letting the hold go (held at the ghost pad, the
-// queue's thread could not be stopped: a stop hung at a speaker's pipeline going to NULL).
+// offset then.
+//
+// The audio's offset is set on the pad the first converted buffer is leaving, from its own
+// probe: that pad sends its sticky events again, with the offset, before the buffer. Set on a
+// pad another thread pushes through (the ghost pad after the queue), it was lost when that
+// thread was sending the segment at the time: GstPad marks the segment sent once its push
+// returns, over gst_pad_set_offset()'s mark, so the segment went without the offset and the
+// mixer dropped the whole text as late (1 run in 5 of "three browsers at once" in the normal
+// build, and in CI).
+//
+// The PFAP branch is held until then at its queue's source pad, so nothing has passed its
+// ghost pad when that gets its offset; a pipeline going to NULL sets that pad flushing first,
+// letting the hold go (held at the ghost pad, the queue's thread could not be stopped: a stop
+// hung at a speaker's pipeline going to NULL).
 struct SpeechStart {
   GstElement* speaker;  // the speaker bin and its pads, which outlive its data flow
-  GstPad* audio;        // the ghost pads
-  GstPad* pfap;
-  GstPad* pfap_queue;  // the PFAP queue's source pad, held
+  GstPad* pfap;         // the PFAP ghost pad
+  GstPad* pfap_queue;   // the PFAP queue's source pad, held
   gulong pfap_hold;
 };
 
 GstPadProbeReturn hold(GstPad*, GstPadProbeInfo*, gpointer) { return GST_PAD_PROBE_OK; }
 
-GstPadProbeReturn on_speaker_audio(GstPad*, GstPadProbeInfo* info, gpointer data) {
+GstPadProbeReturn on_speaker_audio(GstPad* converted, GstPadProbeInfo* info, gpointer data) {
   if ((info->type & GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM) != 0 &&
       GST_EVENT_TYPE(GST_PAD_PROBE_INFO_EVENT(info)) != GST_EVENT_EOS) {
     return GST_PAD_PROBE_OK;
@@ -506,7 +516,7 @@ GstPadProbeReturn on_speaker_audio(GstPad*, GstPadProbeInfo* info, gpointer data
   if (clock == nullptr) return GST_PAD_PROBE_OK;  // not in the playing pipeline (yet)
   const GstClockTime now = gst_clock_get_time(clock) - gst_element_get_base_time(start.speaker);
   gst_object_unref(clock);
-  gst_pad_set_offset(start.audio, static_cast<gint64>(now + kSpeakLead));
+  gst_pad_set_offset(converted, static_cast<gint64>(now + kSpeakLead));
   gst_pad_set_offset(start.pfap, static_cast<gint64>(now + kSpeakLead));
   gst_pad_remove_probe(start.pfap_queue, start.pfap_hold);
   return GST_PAD_PROBE_REMOVE;
@@ -550,7 +560,7 @@ void say(Session& s, const std::string& text) {
   GstPad* queue_sink = gst_element_get_static_pad(queue, "sink");
   GstElement* pfap_queue = gst_bin_get_by_name(GST_BIN(speaker), "pfap");
   GstPad* pfap_queue_src = gst_element_get_static_pad(pfap_queue, "src");
-  auto* start = new SpeechStart{speaker, audio, pfap, pfap_queue_src, 0};
+  auto* start = new SpeechStart{speaker, pfap, pfap_queue_src, 0};
   start->pfap_hold = gst_pad_add_probe(pfap_queue_src, GST_PAD_PROBE_TYPE_BLOCK_DOWNSTREAM, hold,
                                        nullptr, nullptr);
   gst_object_unref(pfap_queue_src);  // the queue keeps it
@@ -560,11 +570,10 @@ void say(Session& s, const std::string& text) {
       converted, GstPadProbeType(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM),
       on_speaker_audio, start, [](gpointer data) { delete static_cast<SpeechStart*>(data); });
   gst_object_unref(converted);
-  // Its level, as early as the speaker makes it (the queue before the mixer fills ahead), from
-  // the start above (its pad's probe sees each buffer first).
+  // Its level, as early as the speaker makes it (the queue before the mixer fills ahead), at
+  // running times from the start above (the segment the queue gets has the offset).
   add_speech_level_probe(
-      queue_sink, audio,
-      [session = s.weak_from_this()](GstClockTime start, std::vector<int64_t> levels) {
+      queue_sink, [session = s.weak_from_this()](GstClockTime start, std::vector<int64_t> levels) {
         if (std::shared_ptr<Session> locked = session.lock()) {
           post(locked, [start, levels = std::move(levels)](Session& s) {
             send_envelope(s, start, levels);

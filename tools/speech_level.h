@@ -111,12 +111,10 @@ using SpeechLevelSend = std::function<void(GstClockTime start, std::vector<int64
 
 // Takes the level of the S16 mono 48 kHz audio passing `pad` and calls `send` on its streaming
 // thread with each kLevelsPerMessage ms of it, and the rest at EOS; silent batches are not
-// sent. The running times are the pad's plus the pad offset of `offset_pad` (a pad further
-// downstream, or nullptr for none) as it is when the first buffer passes.
-inline void add_speech_level_probe(GstPad* pad, GstPad* offset_pad, SpeechLevelSend send) {
+// sent. The running times are the pad's.
+inline void add_speech_level_probe(GstPad* pad, SpeechLevelSend send) {
   struct Probe {
     SpeechLevelSend send;
-    GstPad* offset_pad = nullptr;
     GstClockTime start = GST_CLOCK_TIME_NONE;  // running time of the first level waiting
     SpeechLevel level;
 
@@ -140,7 +138,7 @@ inline void add_speech_level_probe(GstPad* pad, GstPad* offset_pad, SpeechLevelS
     if (p.start == GST_CLOCK_TIME_NONE) {
       const GstClockTime running = running_time_of(pad, buffer);
       if (running == GST_CLOCK_TIME_NONE) return GST_PAD_PROBE_OK;
-      p.start = running + (p.offset_pad != nullptr ? gst_pad_get_offset(p.offset_pad) : 0);
+      p.start = running;
     }
     GstMapInfo map;
     if (!gst_buffer_map(buffer, &map, GST_MAP_READ)) return GST_PAD_PROBE_OK;
@@ -151,12 +149,7 @@ inline void add_speech_level_probe(GstPad* pad, GstPad* offset_pad, SpeechLevelS
   };
   auto* probe = new Probe;
   probe->send = std::move(send);
-  probe->offset_pad = offset_pad != nullptr ? GST_PAD(gst_object_ref(offset_pad)) : nullptr;
   gst_pad_add_probe(
       pad, GstPadProbeType(GST_PAD_PROBE_TYPE_BUFFER | GST_PAD_PROBE_TYPE_EVENT_DOWNSTREAM),
-      on_buffer_or_eos, probe, [](gpointer data) {
-        auto* p = static_cast<Probe*>(data);
-        if (p->offset_pad != nullptr) gst_object_unref(p->offset_pad);
-        delete p;
-      });
+      on_buffer_or_eos, probe, [](gpointer data) { delete static_cast<Probe*>(data); });
 }
