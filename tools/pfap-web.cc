@@ -490,7 +490,7 @@ void send_envelope(Session& s, GstClockTime start, const std::vector<int64_t>& l
 // pad another thread pushes through (the ghost pad after the queue), it was lost when that
 // thread was sending the segment at the time: GstPad marks the segment sent once its push
 // returns, over gst_pad_set_offset()'s mark, so the segment went without the offset and the
-// mixer dropped the whole text as late (1 run in 5 of "three browsers at once" in the normal
+// mixer dropped the whole text as late (2 runs in 5 of "three browsers at once" in the normal
 // build, and in CI).
 //
 // The PFAP branch is held until then at its queue's source pad, so nothing has passed its
