@@ -2,12 +2,22 @@
 """Counts the test cases behind meson test logs: GoogleTest cases from each gtest program's
 result lines, pytest's from its summary line, node's test runner's from its closing '# pass N'
 and '# fail N' (web/), one case for any other test (scripts/check-install and
-scripts/check-packages write their checks in the same format). With one log, prints 'tests: N
-passed, M failed' (and ', K skipped' when a test was skipped); with several (one per build or
-step), a line for each and then that line for them all."""
+scripts/check-packages write their checks in the same format). First a line for each case
+that failed, naming its log, its test and the case (CI shows the end of the output, where the
+failure's own log may not be). With one log, then prints 'tests: N passed, M failed' (and ',
+K skipped' when a test was skipped); with several (one per build or step), a line for each and
+then that line for them all."""
 import json
 import re
 import sys
+
+
+def failed_cases(out):
+    """The names of the cases that failed in a test's output: GoogleTest's, pytest's and
+    node's test runner's."""
+    return (re.findall(r"^\[  FAILED  \] (.*) \(\d+ ms\)$", out, re.M) +
+            re.findall(r"^FAILED (\S+)", out, re.M) +
+            re.findall(r"^not ok \d+ - (.*)$", out, re.M))
 
 
 def count(path):
@@ -16,6 +26,10 @@ def count(path):
         for line in log:
             test = json.loads(line)
             out = test.get("stdout") or ""
+            if test["result"] not in ("OK", "EXPECTEDFAIL", "SKIP"):
+                cases = failed_cases(out) or ["(no case named)"]
+                for case in cases:
+                    print(f"failed: {path}: {test['name']} ({test['result']}): {case}")
             ok = len(re.findall(r"^\[       OK \]", out, re.M))
             bad = len(re.findall(r"^\[  FAILED  \] .*\(\d+ ms\)$", out, re.M))
             # pytest (tests/python): its closing summary, "== 3 failed, 21 passed in 2.1s ==".
