@@ -7,7 +7,9 @@
 #include <gst/gst.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
@@ -85,18 +87,30 @@ class Pipeline {
   }
 
   // Waits for EOS: "" or why it did not come (an error, with `warnings` a warning, or the
-  // timeout).
+  // timeout). A timeout says where each sink is, the pipeline's state and the warnings
+  // posted meanwhile.
   std::string wait_eos(std::chrono::milliseconds timeout, bool warnings = false) {
-    GstMessage* m = gst_bus_timed_pop_filtered(
-        bus_, static_cast<GstClockTime>(timeout.count()) * GST_MSECOND,
-        static_cast<GstMessageType>(GST_MESSAGE_EOS | failures(warnings)));
-    if (m == nullptr) {
-      return "no EOS within " + std::to_string(timeout.count()) + " ms (" + sinks() + ")";
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    std::string seen;  // the warnings that do not end the wait
+    for (;;) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+          deadline - std::chrono::steady_clock::now());
+      GstMessage* m = gst_bus_timed_pop_filtered(
+          bus_, static_cast<GstClockTime>(std::max<int64_t>(left.count(), 0)) * GST_MSECOND,
+          static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR | GST_MESSAGE_WARNING));
+      if (m == nullptr) {
+        GstState state = GST_STATE_VOID_PENDING, pending = GST_STATE_VOID_PENDING;
+        gst_element_get_state(pipeline_, &state, &pending, 0);
+        return "no EOS within " + std::to_string(timeout.count()) + " ms (" + sinks() +
+               "; pipeline " + gst_element_state_get_name(state) + ", pending " +
+               gst_element_state_get_name(pending) + ")" + seen;
+      }
+      const bool ends = GST_MESSAGE_TYPE(m) != GST_MESSAGE_WARNING || warnings;
+      std::string text = GST_MESSAGE_TYPE(m) == GST_MESSAGE_EOS ? "" : describe(m);
+      gst_message_unref(m);
+      if (ends) return text;
+      seen += "; " + text;
     }
-    std::string text;
-    if (GST_MESSAGE_TYPE(m) != GST_MESSAGE_EOS) text = describe(m);
-    gst_message_unref(m);
-    return text;
   }
 
   // Sends EOS into every source, as gst-launch-1.0 -e does on Ctrl-C, and waits for it.
