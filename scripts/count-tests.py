@@ -12,10 +12,14 @@ import re
 import sys
 
 
+# A GoogleTest case that failed, by name (the list at the end repeats names without a time).
+GTEST_FAILED = re.compile(r"^\[  FAILED  \] (.*) \(\d+ ms\)$", re.M)
+
+
 def failed_cases(out):
     """The names of the cases that failed in a test's output: GoogleTest's, pytest's and
     node's test runner's."""
-    return (re.findall(r"^\[  FAILED  \] (.*) \(\d+ ms\)$", out, re.M) +
+    return (GTEST_FAILED.findall(out) +
             re.findall(r"^FAILED (\S+)", out, re.M) +
             re.findall(r"^not ok \d+ - (.*)$", out, re.M))
 
@@ -31,7 +35,7 @@ def count(path):
                 for case in cases:
                     print(f"failed: {path}: {test['name']} ({test['result']}): {case}")
             ok = len(re.findall(r"^\[       OK \]", out, re.M))
-            bad = len(re.findall(r"^\[  FAILED  \] .*\(\d+ ms\)$", out, re.M))
+            bad = len(GTEST_FAILED.findall(out))
             # pytest (tests/python): its closing summary, "== 3 failed, 21 passed in 2.1s ==".
             summary = re.findall(r"^=+ (.*\d+ (?:passed|failed|errors?).*) in [\d.]+s.* =+$",
                                  out, re.M)
