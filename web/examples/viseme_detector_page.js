@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // The viseme detector's example page (viseme-detector.html): any audio source of an
 // AudioContext through the detector's AudioWorklet, the face drawn from its visemes.
-import { Animator, OCULUS_VISEME_TABLE, VISEME_LOOKAHEAD_MS, renderFace } from '../src/index.js';
+import { AnimationFrames, Animator, OCULUS_VISEME_TABLE, VISEME_LOOKAHEAD_MS, renderFace } from '../src/index.js';
 
 /** The Animator's longest phoneme: a viseme lasts until the next one replaces it. */
 const HOLD_MS = 4095;
@@ -42,11 +42,13 @@ export async function drive(canvas, context, source, options = {}) {
   };
   const face = { node, animator, delayMs, output: out, onFrame: null };
   const ctx = canvas.getContext('2d');
+  const frames = new AnimationFrames();
   const frame = (now) => {
-    // The stream's time heard at this frame: the context's time at the output less the delay,
-    // from the first audio.
+    // The stream's time heard while this frame shows: the context's time at the output less the
+    // delay, from the first audio.
     const { contextTime, performanceTime } = context.getOutputTimestamp();
-    const heard = performanceTime > 0 ? contextTime + (now - performanceTime) / 1000 : context.currentTime;
+    const shown = frames.drawTime(now);
+    const heard = performanceTime > 0 ? contextTime + (shown - performanceTime) / 1000 : context.currentTime;
     const ms = Math.max(0, startTime === null ? 0 : (heard - startTime) * 1000 - delayMs);
     renderFace(ctx, animator.pose(ms * 1e6), { overlay: animator.describe(ms * 1e6) });
     face.onFrame?.(now, ms);

@@ -7,6 +7,7 @@
 // receiver's synchronization source say roughly which running time is heard, the played
 // level found in the level the sender sent (clock.js) says exactly, and between matches the
 // jitter buffer's stretching and the concealment that delays the audio (getStats) are followed.
+import { AnimationFrames } from '../src/index.js';
 import { SentLevel, matchLevels } from './clock.js';
 
 // The value of `history` ([from, value], in order) at heard time t.
@@ -330,14 +331,16 @@ export class DrawnPhonemes {
 }
 
 /**
- * Draws the face at each animation frame at the stream time `streamNs(now)` gives (null: not
- * yet), and keeps what the browser tests read: which phoneme each frame draws (`drawn`, a
- * DrawnPhonemes), `stats.streamNs` and `stats.endNs`.
+ * Draws the face at each animation frame at the stream time `streamNs(t)` gives (null: not
+ * yet) for the moment t the frame shows (AnimationFrames), and keeps what the browser tests
+ * read: which phoneme each frame draws (`drawn`, a DrawnPhonemes, at the frame's own time),
+ * `stats.streamNs` and `stats.endNs`.
  */
 export function drawInTime({ receiver, canvas, stats, streamNs, drawn }) {
   const ctx = canvas.getContext('2d');
+  const frames = new AnimationFrames();
   const frame = (now) => {
-    const ns = streamNs(now);
+    const ns = streamNs(frames.drawTime(now));
     if (ns !== null) {
       stats.streamNs = ns;
       stats.endNs = receiver.animator.endNs;

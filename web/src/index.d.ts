@@ -155,6 +155,12 @@ export declare class Animator {
   reset(): void;
 }
 
+export declare class AnimationFrames {
+  constructor();
+  drawTime(now: number): number;
+  intervalMs(): number;
+}
+
 export declare const Style: Readonly<{ CARTOON: 'cartoon'; LINE: 'line' }>;
 export declare function renderFace(
   ctx: CanvasRenderingContext2D,

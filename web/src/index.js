@@ -8,6 +8,7 @@ export { RecoveryReceiver } from './recovery.js';
 export { ARPABET_ALPHABET, Viseme, findAlphabet, findPhoneme, findSymbol } from './phoneme_table.js';
 export { ANGLE_UNIT, FAP_UNITS, addExpressions, expressionWeight, fapValues, poseFromFaps } from './face_model.js';
 export { Animator, MOUTH_EASE_NS, visemeShape } from './animator.js';
+export { AnimationFrames } from './animation_frames.js';
 export { Style, renderFace } from './renderer.js';
 export { DEFAULT_CLOCK_RATE, PfapReceiver } from './receiver.js';
 export { OCULUS_VISEMES, OCULUS_VISEME_ALPHABET, OCULUS_VISEME_TABLE, VISEME_LOOKAHEAD_MS, VisemeDetector, parseVisemeModel } from './viseme_detector.js';

@@ -8,6 +8,7 @@
 // tests/web/meson.build type-checks this and src/ with web/tsconfig.json (test web-types); it
 // is not run.
 import type * as Declared from '../src/index.js';
+import * as animationFrames from '../src/animation_frames.js';
 import * as animator from '../src/animator.js';
 import * as faceModel from '../src/face_model.js';
 import * as fapState from '../src/fap_state.js';
@@ -20,7 +21,7 @@ import * as renderer from '../src/renderer.js';
 import * as rtp from '../src/rtp.js';
 import * as visemeDetector from '../src/viseme_detector.js';
 
-type Code = typeof animator & typeof faceModel & typeof fapState & typeof model & typeof payload &
+type Code = typeof animationFrames & typeof animator & typeof faceModel & typeof fapState & typeof model & typeof payload &
   typeof phonemeTable & typeof receiver & typeof recovery & typeof renderer & typeof rtp &
   typeof visemeDetector;
 type Declarations = typeof Declared;
