@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: LGPL-2.1-or-later
 // The moment an animation frame shows (docs/web.md, "The moment a frame shows").
 
-/** How many frame intervals the display's is the median of. */
+/** The display's frame interval is the median of this many of the last intervals between frames. */
 const KEPT_INTERVALS = 31;
 /** The display's frame interval until two frames have come: 60 Hz. */
 const FIRST_INTERVAL_MS = 1000 / 60;
