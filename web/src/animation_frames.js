@@ -19,7 +19,7 @@ export class AnimationFrames {
     /** @type {number | null} */
     this.last = null;
     this.intervals = new Float64Array(KEPT_INTERVALS);
-    this.sorted = new Float64Array(KEPT_INTERVALS);  // kept, so a frame makes no garbage
+    this.sorted = new Float64Array(KEPT_INTERVALS);  // kept: each frame sorts a view of it
     this.count = 0;
   }
 
