@@ -175,7 +175,7 @@ test('the example page draws the pressed lips of "pa" in time with the sound it 
       `median ${median(detector).toFixed(1)}; the page's own (the medians' difference): ${own.toFixed(1)} ms` +
       (paired ? `, onset by onset: ${paired.join(' ')}` : '');
     console.log(text);
-    if (process.env.PFAP_LIPSYNC_OUT) appendFileSync(process.env.PFAP_LIPSYNC_OUT, `${JSON.stringify({ page: figures.errors, detector, paired })}\n`);
+    if (process.env.PFAP_LIPSYNC_OUT) appendFileSync(process.env.PFAP_LIPSYNC_OUT, `${JSON.stringify({ page: figures.errors, detector, paired, underruns: figures.underruns })}\n`);
     assert.ok(figures.visemes > 10, `${figures.visemes} viseme messages: ${page.messages.join('\n')}`);
     assert.ok(figures.errors.length >= 5, text);
     // Frames come every 16.7 ms and draw the middle of their time on show (AnimationFrames): in
