@@ -8,9 +8,10 @@ plays and leaves mid-sentence (at its first PFAP packet); e, one that hears its 
 and leaves. After a warm-up (the first sessions load plugins and fill caches that stay), it
 takes the server's file descriptors, threads and RSS; after the cycles, once the server has
 closed every session, it takes them again. The server runs with GStreamer's leaks tracer,
-which lists at exit every GstObject still alive. Exits 1 if a session was left open (pfap-web
-prints "session N opened" and "closed"), if any file descriptor or thread was left behind, or
-if any object but dtlsdec's one shared DTLS agent (GStreamer's, made once per process for the
+which lists at exit every GstObject still alive. Exits 1 if a cycle did not end within
+CYCLE_S or the server within 30 s of SIGTERM, if a session was left open (pfap-web prints
+"session N opened" and "closed"), if any file descriptor or thread was left behind, or if any
+object but dtlsdec's one shared DTLS agent (GStreamer's, made once per process for the
 default certificate) outlived the sessions. RSS is printed, not checked: glibc's arenas grow
 with the sessions open at once and keep what they took, so only a long run tells a leak from
 that (scripts/bench churn, docs/performance.md).
@@ -22,14 +23,18 @@ In a network namespace with lo and a veth pair, as tests/web/pfap_web_load.py.""
 import asyncio
 import os
 import re
+import subprocess
 import sys
 import threading
 import time
 
 from pfap_web_load import (WebSocket, answer_offer, enter_network_namespace, playing_peer,
-                           rss_kib, skip_opus_decoding, start_server)
+                           rss_kib, skip_opus_decoding, stacks, start_server)
 
 WARM_UP = 9
+# A cycle takes about 1 s (3 to 8 s in the sanitizer build): one still going after CYCLE_S is
+# stuck. The run then stops, and says where, within meson's timeout.
+CYCLE_S = 30
 # Alive at exit whatever the sessions did: dtlsdec keeps one agent for its generated
 # certificate for the life of the process (gst-plugins-bad ext/dtls/gstdtlsdec.c).
 ALIVE_ANYWAY = {'GstDtlsAgent': 1}
@@ -73,7 +78,7 @@ async def connects(port, to_the_end):
 
 async def cycle(port, kind):
     await asyncio.wait_for(never_answers(port) if kind == 'n' else answers_and_leaves(port)
-                           if kind == 'a' else connects(port, kind == 'e'), 60)
+                           if kind == 'a' else connects(port, kind == 'e'), CYCLE_S)
 
 
 def runs_pfap_espeak(pid):
@@ -134,16 +139,23 @@ async def main():
     for f in followers:
         f.start()
 
+    stuck = []
+
     async def run(first, count):
         queue = iter(range(first, first + count))
         failures = []
 
         async def worker():
             for n in queue:
+                if stuck:
+                    return
+                kind = kinds[n % len(kinds)]
                 try:
-                    await cycle(port, kinds[n % len(kinds)])
+                    await cycle(port, kind)
+                except asyncio.TimeoutError:
+                    stuck.append(f'cycle {n} ({kind}) still going after {CYCLE_S} s')
                 except Exception as e:  # noqa: BLE001 (counted; the server is what is checked)
-                    failures.append(f'cycle {n}: {type(e).__name__}: {e}')
+                    failures.append(f'cycle {n} ({kind}): {type(e).__name__}: {e}')
         await asyncio.gather(*(worker() for _ in range(concurrent)))
         return failures
 
@@ -199,7 +211,13 @@ async def main():
     after = await settled(before)
     left_open = sorted(opened - closed)
     server.terminate()
-    server.wait(timeout=30)
+    try:
+        server.wait(timeout=30)
+    except subprocess.TimeoutExpired:
+        stuck.append('pfap-web still running 30 s after SIGTERM')
+        stacks(server.pid)
+        server.kill()
+        server.wait()
     for f in followers:
         f.join(timeout=10)
     leaked = {k: n - ALIVE_ANYWAY.get(k, 0) for k, n in alive.items()
@@ -213,10 +231,10 @@ async def main():
           f'{before[2]} KiB; after: {after[0]}, {after[1]}, {after[2]} KiB '
           f'({(after[2] - before[2]) / cycles:+.1f} KiB per cycle); GstObjects alive at exit '
           f'besides dtlsdec\'s agent: {leaked or "none"}; pfap-web exited {server.returncode}')
-    ok = (not left_open and after[0] <= before[0] and after[1] <= before[1] and not leaked
-          and len(opened) == started and server.returncode == 0)
+    ok = (not stuck and not left_open and after[0] <= before[0] and after[1] <= before[1]
+          and not leaked and len(opened) == started and server.returncode == 0)
     if not ok:
-        print(f'left behind: sessions {left_open[:20]}', file=sys.stderr)
+        print('; '.join(stuck + [f'left behind: sessions {left_open[:20]}']), file=sys.stderr)
         print(''.join(err + report), file=sys.stderr)
         sys.exit(1)
 

@@ -445,6 +445,13 @@ def start_server(options, env=None):
     return server, int(re.search(r'127\.0\.0\.1:(\d+)/', line).group(1))
 
 
+def stacks(pid):
+    """Where a server that does not exit is, by gdb if there is one."""
+    if shutil.which('gdb'):
+        subprocess.run(['gdb', '-p', str(pid), '-batch', '-ex', 'thread apply all bt'],
+                       stdout=sys.stderr, stderr=subprocess.DEVNULL, timeout=120)
+
+
 def rss_kib(pid, field):
     """VmRSS (now) or VmHWM (peak) of a process, in KiB."""
     return int(open(f'/proc/{pid}/status').read().split(f'{field}:')[1].split()[0])

@@ -20,12 +20,12 @@ In a network namespace with lo and a veth pair, as tests/web/pfap_web_load.py.""
 import asyncio
 import os
 import re
-import shutil
 import subprocess
 import sys
 import time
 
-from pfap_web_load import enter_network_namespace, playing_peer, skip_opus_decoding, start_server
+from pfap_web_load import (enter_network_namespace, playing_peer, skip_opus_decoding, stacks,
+                           start_server)
 
 TEXT = ' '.join(['One, <FAP 3 100 400 1> two, three, four, five, six, seven, eight.'] * 6)
 # Short texts, each asked for as the one before starts: texts end and start as the stop closes
@@ -49,13 +49,6 @@ async def open_session(port, first_packet, leave, again):
         return True
     finally:
         first_packet.set()  # the others go on
-
-
-def stacks(pid):
-    """Where a server that does not exit is, by gdb if there is one."""
-    if shutil.which('gdb'):
-        subprocess.run(['gdb', '-p', str(pid), '-batch', '-ex', 'thread apply all bt'],
-                       stdout=sys.stderr, stderr=subprocess.DEVNULL, timeout=120)
 
 
 # A GLib CRITICAL of GStreamer's, not of the stop: a data race in gst-plugins-good 1.22.0's
