@@ -143,12 +143,13 @@ async def main():
 
     async def run(first, count):
         queue = iter(range(first, first + count))
-        failures = []
+        failures, begun = [], [0]
 
         async def worker():
             for n in queue:
                 if stuck:
                     return
+                begun[0] += 1
                 kind = kinds[n % len(kinds)]
                 try:
                     await cycle(port, kind)
@@ -157,7 +158,7 @@ async def main():
                 except Exception as e:  # noqa: BLE001 (counted; the server is what is checked)
                     failures.append(f'cycle {n} ({kind}): {type(e).__name__}: {e}')
         await asyncio.gather(*(worker() for _ in range(concurrent)))
-        return failures
+        return failures, begun[0]
 
     def died():
         for f in followers:
@@ -205,7 +206,7 @@ async def main():
     started = speaking + WARM_UP
     before = await settled((1 << 30, 1 << 30))
     start = time.monotonic()
-    failures = await run(started, cycles)
+    failures, begun = await run(started, cycles)  # fewer begun than asked: a cycle was stuck
     took = time.monotonic() - start
     started += cycles
     after = await settled(before)
@@ -224,13 +225,13 @@ async def main():
               if n > ALIVE_ANYWAY.get(k, 0)}
     for f in failures[:10]:
         print(f)
-    print(f'{cycles} cycles of kinds {kinds} ({concurrent} at a time, {len(failures)} client '
-          f'errors, {orphans[0]} in aiortc\'s tasks) in {took:.1f} s '
+    print(f'{begun} of {cycles} cycles of kinds {kinds} ({concurrent} at a time, '
+          f'{len(failures)} client errors, {orphans[0]} in aiortc\'s tasks) in {took:.1f} s '
           f'after {speaking + WARM_UP} to warm up; pfap-web opened {len(opened)} sessions, closed '
           f'{len(closed)}; before: {before[0]} file descriptors, {before[1]} threads, RSS '
           f'{before[2]} KiB; after: {after[0]}, {after[1]}, {after[2]} KiB '
-          f'({(after[2] - before[2]) / cycles:+.1f} KiB per cycle); GstObjects alive at exit '
-          f'besides dtlsdec\'s agent: {leaked or "none"}; pfap-web exited {server.returncode}')
+          f'({(after[2] - before[2]) / max(begun, 1):+.1f} KiB per cycle); GstObjects alive at '
+          f'exit besides dtlsdec\'s agent: {leaked or "none"}; pfap-web exited {server.returncode}')
     ok = (not stuck and not left_open and after[0] <= before[0] and after[1] <= before[1]
           and not leaked and len(opened) == started and server.returncode == 0)
     if not ok:
