@@ -862,11 +862,12 @@ static void gst_pfap_align_class_init(GstPfapAlignClass* klass) {
    *
    * Without a text, what hears the audio. `phonemes`: pocketsphinx's all-phone search,
    * x-pfap-arpabet, the accurate choice (its visemes right on 56 % of the frames of human
-   * speech offline, 52 % live; the detector's on 48 %), which declares 700 ms live. `visemes`: the frame-level viseme
-   * detector, x-pfap-oculus-viseme, each run of 10 ms frames one phoneme standing for its
-   * viseme; live it declares 95 ms (docs/align.md, "The viseme detector in pfapalign"), for
-   * lips on live speech in a conversation. Ignored when there is a text. Read when the
-   * element goes to PAUSED; the stream's alphabet is chosen when it starts.
+   * speech offline, 52 % live; the detector's on 48 %), which declares 700 ms live.
+   * `visemes`: the frame-level viseme detector, x-pfap-oculus-viseme, each run of 10 ms
+   * frames one phoneme standing for its viseme; live it declares 95 ms (docs/align.md, "The
+   * viseme detector in pfapalign"), for lips on live speech in a conversation. Ignored when
+   * there is a text. Read when the element goes to PAUSED; the stream's alphabet is chosen
+   * when it starts.
    */
   g_object_class_install_property(
       gobject_class, PROP_RECOGNIZER,

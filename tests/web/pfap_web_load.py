@@ -445,15 +445,19 @@ def start_server(options, env=None):
     return server, int(re.search(r'127\.0\.0\.1:(\d+)/', line).group(1))
 
 
+# gdb's bound in stacks() (a few seconds is usual), so that a test still says what it saw before
+# meson's timeout.
+STACKS_S = 30
+
+
 def stacks(pid):
-    """Where a server that does not exit is, by gdb if there is one. Bounded by 30 s (a few
-    seconds is usual), so that the test still says what it saw before meson's timeout."""
+    """Where a server that does not exit is, by gdb if there is one, within STACKS_S."""
     if shutil.which('gdb'):
         try:
             subprocess.run(['gdb', '-p', str(pid), '-batch', '-ex', 'thread apply all bt'],
-                           stdout=sys.stderr, stderr=subprocess.DEVNULL, timeout=30)
+                           stdout=sys.stderr, stderr=subprocess.DEVNULL, timeout=STACKS_S)
         except subprocess.TimeoutExpired:
-            print('gdb gave no stacks within 30 s', file=sys.stderr)
+            print(f'gdb gave no stacks within {STACKS_S} s', file=sys.stderr)
 
 
 def rss_kib(pid, field):
